@@ -1,0 +1,274 @@
+"""Band analysis of a bidirectional stair code inside fringe regions (the default decoder).
+
+Inside one fringe region the fringe order ``k`` is constant, so the stair phase takes only
+two values: ``k mod S`` on the local-order rows and ``k // S`` on the partition rows, in
+horizontal bands that alternate down the region. Averaging the stair phase over each row of
+a region (across the fringe) gives a clean 1-D profile; its runs are the bands, their
+lengths tell the local bands (``L`` of every ``G`` projector rows) from the partition bands
+(``G - L``), and together they give the region's order. Where a region is too small to
+tell, the evidence says so and the neighbours decide (see :func:`bistair.order.resolve_regions`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .phase import TWO_PI, wrap
+from .stair import level_distance, quantize, stair_level_phase
+
+
+@dataclass
+class Runs:
+    """Vertical runs of one stair value in the row profiles of fringe regions."""
+
+    region: np.ndarray
+    y0: np.ndarray
+    y1: np.ndarray
+    length: np.ndarray  # rows, including half of the blurred transitions on each side
+    theta: np.ndarray  # circular mean stair phase
+    weight: np.ndarray
+    uid: np.ndarray  # stair level (on the union of both stairs' levels)
+    top_ok: np.ndarray  # bounded above by another run of the same region
+    bottom_ok: np.ndarray
+
+    def take(self, sel: np.ndarray) -> Runs:
+        return Runs(**{k: v[sel] for k, v in self.__dict__.items()})
+
+
+def union_levels(partitions: int, stairs: int) -> np.ndarray:
+    """Phases of all stair levels of both stairs, near-coincident ones merged."""
+    phases = np.concatenate([stair_level_phase(np.arange(stairs), stairs),
+                             stair_level_phase(np.arange(partitions), partitions)])
+    phases = np.sort(wrap(phases))
+    tol = 0.25 * TWO_PI / max(partitions, stairs)
+    keep = [phases[0]]
+    for p in phases[1:]:
+        if abs(wrap(p - keep[-1])) > tol:
+            keep.append(p)
+    if len(keep) > 1 and abs(wrap(keep[0] - keep[-1])) <= tol:
+        keep.pop()
+    return np.array(keep)
+
+
+def nearest_level(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    d = np.abs(wrap(np.asarray(theta)[:, None] - levels[None, :]))
+    return d.argmin(axis=1).astype(np.int32)
+
+
+def row_runs(labels: np.ndarray, theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray,
+             levels: np.ndarray) -> Runs:
+    """Runs of constant stair level in the per-row profiles of every region.
+
+    ``weight`` scales each pixel's vote, ``ratio`` is the stair-pair modulation over the fringe
+    modulation: rows where it collapses are blurred band transitions and are skipped.
+    """
+    ys, _ = np.nonzero(labels > 0)
+    reg = labels[labels > 0].astype(np.int64)
+    height = labels.shape[0]
+    key, inv = np.unique(reg * height + ys, return_inverse=True)
+    w = weight[labels > 0].astype(np.float64)
+    t = theta[labels > 0]
+    c = np.bincount(inv, w * np.cos(t))
+    s = np.bincount(inv, w * np.sin(t))
+    wsum = np.bincount(inv, w)
+    rsum = np.bincount(inv, ratio[labels > 0]) / np.bincount(inv)
+    region, row = key // height, key % height
+    row_theta = np.arctan2(s, c)
+    # Transitional rows: the stair pair's modulation drops where two bands blur together.
+    n_reg = int(region.max()) + 1 if region.size else 1
+    ref = np.bincount(region, rsum * wsum, n_reg) / np.maximum(np.bincount(region, wsum, n_reg),
+                                                               1e-12)
+    kept = rsum >= 0.7 * ref[region]
+    dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
+    idx = np.flatnonzero(kept)
+    region_k, row_k = region[idx], row[idx]
+    uid = nearest_level(row_theta[idx], levels)
+    same = np.zeros(idx.size, bool)
+    same[1:] = region_k[1:] == region_k[:-1]
+    gap = np.zeros(idx.size, np.int64)
+    gap[1:] = row_k[1:] - row_k[:-1] - 1
+    between = np.zeros(idx.size, np.int64)
+    between[1:] = dropped_before[idx[1:]] - dropped_before[idx[:-1]]
+    soft = same & (gap == between) & (gap <= 3)
+    changed = np.ones(idx.size, bool)
+    changed[1:] = uid[1:] != uid[:-1]
+    start = ~soft | changed
+    start[0] = True
+    run_id = np.cumsum(start) - 1
+    first = np.flatnonzero(start)
+    last = np.r_[first[1:] - 1, idx.size - 1]
+    top_ok = soft[first] & changed[first]
+    nxt = np.r_[first[1:], idx.size]
+    bottom_ok = np.zeros(first.size, bool)
+    has_next = nxt < idx.size
+    bottom_ok[has_next] = top_ok[1:][has_next[:-1]] if first.size > 1 else False
+    half_top = np.where(top_ok, gap[first] / 2.0, 0.0)
+    half_bottom = np.zeros(first.size)
+    half_bottom[:-1] = np.where(bottom_ok[:-1], gap[first[1:]] / 2.0, 0.0)
+    cw = np.bincount(run_id, c[idx])
+    sw = np.bincount(run_id, s[idx])
+    runs = Runs(
+        region=region_k[first], y0=row_k[first], y1=row_k[last],
+        length=(row_k[last] - row_k[first] + 1) + half_top + half_bottom,
+        theta=np.arctan2(sw, cw), weight=np.bincount(run_id, wsum[idx]),
+        uid=uid[first], top_ok=top_ok, bottom_ok=bottom_ok,
+    )
+    return _drop_transitions(runs)
+
+
+def _drop_transitions(runs: Runs) -> Runs:
+    """Remove 1-2 row runs that are not bands.
+
+    Squeezed between two different bands they are blurred transitions (their rows go half to
+    each neighbour); at the top or bottom end of a region they are its ragged edge, and the
+    band next to them is then cut by the edge, not bounded by another band.
+    """
+    n = runs.uid.size
+    if n < 2:
+        return runs
+    short = runs.length <= 2.0
+    prev_uid = np.r_[-1, runs.uid[:-1]]
+    next_uid = np.r_[runs.uid[1:], -1]
+    inner = short & runs.top_ok & runs.bottom_ok & (prev_uid != next_uid)
+    top_end = short & ~runs.top_ok & runs.bottom_ok
+    bottom_end = short & runs.top_ok & ~runs.bottom_ok
+    drop = inner | top_end | bottom_end
+    if not drop.any():
+        return runs
+    length = runs.length.copy()
+    j = np.flatnonzero(inner)
+    np.add.at(length, j - 1, runs.length[j] / 2)
+    np.add.at(length, j + 1, runs.length[j] / 2)
+    runs.length = length
+    runs.top_ok = runs.top_ok & ~np.r_[False, top_end[:-1]]
+    runs.bottom_ok = runs.bottom_ok & ~np.r_[bottom_end[1:], False]
+    return runs.take(~drop)
+
+
+@dataclass(frozen=True)
+class BandLayout:
+    """What the decoder knows of the code: stairs ``S``, partitions ``P``, group rows."""
+
+    stairs: int
+    partitions: int
+    local_share: float  # local rows / group rows
+    default_height: float  # group height in camera rows when nothing better is known
+
+
+def group_heights(runs: Runs, n_regions: int, centroids: np.ndarray) -> np.ndarray:
+    """Group height (camera rows) per region: its own bands where two complete ones show,
+    else the median of the nearest regions that have one."""
+    complete = runs.top_ok & runs.bottom_ok & (runs.length >= 2)
+    own = np.full(n_regions + 1, np.nan)
+    for r in np.unique(runs.region[complete]):
+        sel = complete & (runs.region == r)
+        vals, inv, counts = np.unique(runs.uid[sel], return_inverse=True, return_counts=True)
+        if vals.size < 2:
+            continue
+        top_two = np.argsort(counts)[-2:]
+        own[r] = sum(np.median(runs.length[sel][inv == v]) for v in top_two)
+    have = np.flatnonzero(np.isfinite(own))
+    out = own.copy()
+    if have.size == 0:
+        return out
+    tree = cKDTree(centroids[have])
+    missing = np.flatnonzero(~np.isfinite(own))
+    missing = missing[missing > 0]
+    if missing.size:
+        k = min(7, have.size)
+        _, nn = tree.query(centroids[missing], k=k)
+        nn = np.asarray(nn).reshape(missing.size, k)
+        out[missing] = np.median(own[have][nn], axis=1)
+    return out
+
+
+def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
+                    layout: BandLayout) -> np.ndarray:
+    """Evidence for every fringe order per region, shape (n_regions + 1, P*S).
+
+    A region whose bands show both values gets close to 1 for its order (and less for the
+    orders that share only one of its values, the less the surer both values are); a region
+    that shows a single band value gets
+    0.4 for every order compatible with it (its neighbours decide), unless the band is far
+    longer than a band can be, which is the merged case ``k mod S == k // S``.
+    """
+    S, P = layout.stairs, layout.partitions
+    ks = np.arange(S * P)
+    a_of_k, b_of_k = ks % S, ks // S
+    ev = np.zeros((n_regions + 1, S * P))
+    if runs.uid.size == 0:
+        return ev
+    order = np.argsort(runs.region, kind="stable")
+    runs = runs.take(order)
+    bounds = np.flatnonzero(np.r_[True, runs.region[1:] != runs.region[:-1], True])
+    f_loc, f_par = layout.local_share, 1.0 - layout.local_share
+    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
+        r = int(runs.region[lo])
+        uid, wgt, length = runs.uid[lo:hi], runs.weight[lo:hi], runs.length[lo:hi]
+        theta = runs.theta[lo:hi]
+        complete = runs.top_ok[lo:hi] & runs.bottom_ok[lo:hi]
+        h = heights[r] if np.isfinite(heights[r]) else layout.default_height
+        total = wgt.sum()
+        row_weight = total / max(length.sum(), 1.0)
+        vals, inv = np.unique(uid, return_inverse=True)
+        cls_w = np.bincount(inv, wgt)
+        rank = np.argsort(cls_w)[::-1]
+        x = rank[0]
+        y = rank[1] if vals.size > 1 else -1
+        if y >= 0 and (cls_w[y] < 0.05 * total or length[inv == y].max() < 2):
+            y = -1
+        th_x = _circmean(theta[inv == x], wgt[inv == x])
+        if y < 0:
+            a, b = quantize(th_x, S), quantize(th_x, P)
+            if length.max() >= 1.3 * max(f_loc, f_par) * h:
+                fit = _fit(th_x, a, S) + _fit(th_x, b, P)
+                ev[r, a + S * b] = cls_w[x] / total - 0.5 * fit
+            else:
+                share = 0.4 * cls_w[x] / total
+                ev[r, a_of_k == a] = share
+                ev[r, b_of_k == b] = share
+            continue
+        th_y = _circmean(theta[inv == y], wgt[inv == y])
+        options = []
+        for loc, par in ((x, y), (y, x)):
+            th_l, th_p = (th_x, th_y) if loc == x else (th_y, th_x)
+            a, b = quantize(th_l, S), quantize(th_p, P)
+            expect = np.where(inv == loc, f_loc * h, np.where(inv == par, f_par * h, np.nan))
+            cost = _length_cost(length, expect, complete)
+            fit = _fit(th_l, a, S) + _fit(th_p, b, P)
+            # A class seen in 3 or more rows' worth of pixels is certain; a match counts +1,
+            # a mismatch -1, each weighted by how certain its class is.
+            e_l, e_p = np.minimum(1.0, cls_w[[loc, par]] / (3.0 * row_weight))
+            hits = e_l * np.where(a_of_k == a, 1.0, -1.0) + e_p * np.where(b_of_k == b, 1.0, -1.0)
+            options.append((hits / (e_l + e_p) - 0.5 * fit, cost))
+        # Band lengths decide which value is the local one: the worse-fitting reading
+        # loses up to 0.5, the better one nothing (its absolute fit depends on h).
+        low = min(cost for _, cost in options)
+        ev[r] = np.max([score - 0.5 * min(1.0, cost - low) for score, cost in options], axis=0)
+    return ev
+
+
+def _circmean(theta: np.ndarray, weight: np.ndarray) -> float:
+    return float(np.arctan2((weight * np.sin(theta)).sum(), (weight * np.cos(theta)).sum()))
+
+
+def _fit(theta: float, level: int, levels: int) -> float:
+    """Squared distance to a stair level, in half-steps (0 on the level, 1 at the border)."""
+    return float((level_distance(theta, level, levels) / (np.pi / levels)) ** 2)
+
+
+def _length_cost(length: np.ndarray, expect: np.ndarray, complete: np.ndarray) -> float:
+    """How badly band lengths fit the expected local/partition heights (summed squared
+    log-ratios). Complete bands must match; bands cut by the region's edge only must not be
+    longer.
+    """
+    ok = np.isfinite(expect)
+    if not ok.any():
+        return 0.0
+    ratio = np.log(np.maximum(length[ok], 0.5) / expect[ok])
+    over = np.maximum(ratio - np.log(1.25), 0.0)
+    terms = np.where(complete[ok], ratio**2, over**2)
+    return float(terms.sum())

@@ -1,0 +1,227 @@
+"""Bidirectional stair-phase coding (Qi, Zhou et al.): N phase shifts plus one coded pair.
+
+Frames: ``shift-0 .. shift-(N-1)`` (Eq. 1-4) and ``stair-cos``, ``stair-sin`` (Eq. 15-16).
+Along x the pair carries two stairs: a local stair of ``S`` levels that steps every fringe
+(``k mod S``, Eq. 13) and a partition stair of ``P`` levels that steps every ``S`` fringes
+(``k // S``, Eq. 14). Down the pattern the two alternate in groups of ``group_rows`` rows,
+the first ``local_rows`` carrying the local stair and the rest the partition stair, so every
+small region of the image holds both and ``k = k_s1 + S * k_s2`` (Eq. 22).
+
+Decoding strategies:
+
+``"region"`` (default)
+    Fringe regions (2-D areas between wrapped-phase jumps, :mod:`bistair.regions`) each
+    hold one order. The stair phase is averaged along each row of a region, the bands of
+    the resulting profile are told apart by their lengths (:mod:`bistair.bands`), and every
+    region gets one order, checked against its neighbours across each wrap, where orders
+    must step by exactly one (:func:`bistair.order.resolve_regions`).
+``"paper"``
+    The paper's decoder: ``k_s`` by Eq. 19-20, a column scan of run lengths ``C`` whose
+    increases mark group starts, ``k = k_s1 + S*k_s2`` per group (``k_s1 * (S+1)`` where the
+    runs merge), then each fringe (a 2-D stripe between two phase jumps) takes the mode.
+
+Examples
+--------
+>>> import numpy as np
+>>> from bistair import decode, encode, make_spec
+>>> spec = make_spec("bidirectional", width=360, height=120, period=20, partitions=3,
+...                  stairs=6)
+>>> pats = encode(spec)
+>>> pats.shape
+(6, 120, 360)
+>>> res = decode(pats, spec)
+>>> x = np.arange(360)
+>>> bool(np.allclose(res.coord[60], x, atol=1e-3)), res.order[60, ::60].tolist()
+(True, [0, 3, 6, 9, 12, 15])
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..bands import BandLayout, group_heights, region_evidence, row_runs, union_levels
+from ..captures import Prepared, check_decodable, noise_level, saturation, validity
+from ..errors import BistairError
+from ..order import jump_violations, mode_by_label, resolve_regions
+from ..phase import TWO_PI, phase_shift_patterns, wrapped_phase
+from ..regions import fill_from_neighbours, fringe_regions, region_links
+from ..result import DecodeResult, make_result
+from ..spec import BaseSpec, field, register_spec
+from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
+from .base import Codec
+
+
+@register_spec
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class BidirectionalSpec(BaseSpec):
+    method = "bidirectional"
+    required = ("period",)
+
+    period: int = field(30, "fringe period T in projector pixels")
+    partitions: int = field(6, "partition stair levels P")
+    stairs: int = field(6, "local stair levels S (fringes per partition)")
+    group_rows: int = field(30, "projector rows per group (local + partition rows)")
+    local_rows: int = field(20, "rows of each group that carry the local stair")
+
+    def _frames(self) -> tuple[str, ...]:
+        return (*(f"shift-{n}" for n in range(self.steps)), "stair-cos", "stair-sin")
+
+    @property
+    def fringes(self) -> int:
+        return self.partitions * self.stairs
+
+    def validate(self) -> None:
+        super().validate()
+        if self.period < 4:
+            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
+        if self.stairs < 2:
+            raise BistairError(f"stairs must be at least 2, got {self.stairs}")
+        if self.partitions < 2:
+            raise BistairError(
+                f"partitions must be at least 2 (use phase-coding for one stair), got "
+                f"{self.partitions}"
+            )
+        if max(self.stairs, self.partitions) > 32:
+            raise BistairError("stairs and partitions above 32 leave too little phase per level")
+        span = self.fringes * self.period
+        if span < self.coded_length:
+            raise BistairError(
+                f"partitions*stairs*period = {self.partitions}*{self.stairs}*{self.period} = "
+                f"{span} px is narrower than the {self.coded_length}-px coded axis"
+            )
+        if not 1 <= self.local_rows < self.group_rows:
+            raise BistairError(
+                f"local rows must lie in 1..{self.group_rows - 1} (group rows "
+                f"{self.group_rows}), got {self.local_rows}"
+            )
+        if 2 * self.local_rows == self.group_rows:
+            raise BistairError(
+                f"local rows ({self.local_rows}) equal partition rows "
+                f"({self.group_rows - self.local_rows}): the bands could not be told apart"
+            )
+        if self.group_rows < 3 or self.group_rows > self.other_length:
+            raise BistairError(
+                f"group rows must lie in 3..{self.other_length}, got {self.group_rows}"
+            )
+
+
+def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
+    """The N phase-shift patterns and the bidirectional pair, vertical fringes."""
+    x = np.arange(spec.coded_length)
+    y = np.arange(spec.other_length)
+    k = x // spec.period
+    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
+    local = stair_level_phase(k % spec.stairs, spec.stairs)
+    partition = stair_level_phase(k // spec.stairs, spec.partitions)
+    is_local = (y % spec.group_rows) < spec.local_rows
+    theta = np.where(is_local[:, None], local[None, :], partition[None, :])
+    pair = stair_pair(theta, spec.offset, spec.amplitude)
+    rows = np.broadcast_to(shifts[:, None, :], (spec.steps, y.size, x.size))
+    return np.concatenate([rows, pair]).astype(np.float32)
+
+
+def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = "region",
+                   min_modulation: float | None = None) -> DecodeResult:
+    """Decode a capture stack (vertical fringes) into absolute phase."""
+    frames = prepared.frames
+    n = spec.steps
+    phi, avg, mod = wrapped_phase(frames[:n])
+    noise = noise_level(frames[:n], phi, avg, mod)
+    saturated = saturation(prepared.clipped, avg, mod)
+    valid = validity(mod, saturated, noise, min_modulation)
+    check_decodable(valid, saturated)
+    theta, stair_mod = stair_phase(frames[n], frames[n + 1], avg)
+    ks = np.where(valid, quantize(theta, spec.stairs), -1).astype(np.int32)
+    info = {"strategy": strategy, "noise": noise, "valid_modulation": int(valid.sum())}
+    if strategy == "paper":
+        order = _paper_orders(ks, theta, valid, phi, spec)
+        abs_phase = np.where(order >= 0, phi + TWO_PI * order, np.nan)
+    elif strategy == "region":
+        abs_phase = _region_phase(phi, mod, theta, stair_mod, valid, spec, info)
+    else:
+        raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
+    order = np.where(np.isfinite(abs_phase), np.round((abs_phase - phi) / TWO_PI), -1)
+    return make_result("bidirectional", phi, order.astype(np.int64), spec.period, mod, avg,
+                       code=ks, wrapped=np.where(valid, phi, np.nan), info=info)
+
+
+def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod: np.ndarray,
+                  valid: np.ndarray, spec: BidirectionalSpec, info: dict) -> np.ndarray:
+    labels, n_reg = fringe_regions(phi, valid)
+    ratio = np.clip(stair_mod / np.maximum(mod, 1e-6), 0.0, 2.0)
+    core = np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
+    weight = core * np.minimum(ratio, 1.0)
+    runs = row_runs(labels, theta, weight, ratio, union_levels(spec.partitions, spec.stairs))
+    ys, xs = np.nonzero(labels)
+    count = np.maximum(np.bincount(labels[ys, xs], minlength=n_reg + 1), 1)
+    centroids = np.c_[np.bincount(labels[ys, xs], ys, n_reg + 1) / count,
+                      np.bincount(labels[ys, xs], xs, n_reg + 1) / count]
+    heights = group_heights(runs, n_reg, centroids)
+    default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
+    layout = BandLayout(spec.stairs, spec.partitions, spec.local_rows / spec.group_rows, default)
+    evidence = region_evidence(runs, n_reg, heights, layout)
+    links = region_links(phi, labels)
+    k_reg, score, margin = resolve_regions(evidence, links)
+    k_reg[(score < 0.5) | (margin < 0.1)] = -1
+    k_reg[0] = -1
+    bad, total = jump_violations(links, k_reg)
+    info.update(regions=n_reg, regions_decoded=int((k_reg[1:] >= 0).sum()),
+                jump_violations=bad, jump_links=total, group_height=default)
+    k_pix = k_reg[labels]
+    abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
+    return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
+
+
+def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.ndarray,
+                  spec: BidirectionalSpec) -> np.ndarray:
+    """The paper's column scan (Sec. 2.3) and per-fringe mode (Sec. 3)."""
+    S, P = spec.stairs, spec.partitions
+    h, w = ks.shape
+    v = valid.T.ravel()
+    q = ks.T.ravel()
+    t = theta.T.ravel()
+    col_start = np.zeros(v.size, bool)
+    col_start[::h] = True
+    seg_start = v & (col_start | ~np.r_[False, v[:-1]])
+    start = seg_start | (v & np.r_[True, q[1:] != q[:-1]])
+    pix = np.flatnonzero(v)
+    run_of = np.cumsum(start)[pix] - 1
+    first = np.flatnonzero(start)
+    c_len = np.bincount(run_of)  # C: run lengths
+    run_theta = np.arctan2(np.bincount(run_of, np.sin(t[pix])), np.bincount(run_of, np.cos(t[pix])))
+    new_group = seg_start[first].copy()
+    new_group[1:] |= c_len[1:] > c_len[:-1]  # difference of C above zero: a group starts
+    # "When k_s1 and k_s2 are the same, the value of C is very large": such a run is a
+    # group of its own. Very large = 1.4 times the run length a typical pixel sits in.
+    merged = c_len > 1.4 * np.median(c_len[run_of])
+    new_group[1:] |= merged[:-1]
+    group = np.cumsum(new_group) - 1
+    g_first = np.flatnonzero(new_group)
+    g_second = g_first + 1
+    has_second = np.zeros(g_first.size, bool)
+    ok = g_second < first.size
+    has_second[ok] = group[g_second[ok]] == group[g_first[ok]]
+    has_second &= ~merged[g_first]
+    k1 = quantize(run_theta[g_first], S)
+    second_theta = np.where(has_second, run_theta[np.minimum(g_second, first.size - 1)],
+                            run_theta[g_first])
+    k2 = quantize(second_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
+    k_group = k1 + S * k2
+    order = np.full(v.size, -1, np.int64)
+    order[pix] = k_group[group[run_of]]
+    order = order.reshape(w, h).T
+    fringes, n_fringes = fringe_regions(phi, valid, min_size=1)
+    mode, _ = mode_by_label(fringes, order, n_fringes, S * P)
+    return np.where(fringes > 0, mode[fringes], -1)
+
+
+CODEC = Codec(
+    name="bidirectional",
+    spec_class=BidirectionalSpec,
+    encode_columns=encode_columns,
+    decode_columns=decode_columns,
+    summary="N phase shifts + a bidirectional stair-phase pair (Qi, Zhou et al.)",
+    options=("strategy", "min_modulation"),
+)

@@ -1,0 +1,79 @@
+"""N-step phase shifting: the patterns and the wrapped phase, average and modulation.
+
+Convention: frame ``n`` of an ``N``-step set shows ``a + b*cos(2*pi*x/T + 2*pi*n/N)``; the
+camera sees ``A + B*cos(phi + 2*pi*n/N)`` and the wrapped phase ``phi`` lies in ``[0, 2*pi)``.
+
+Examples
+--------
+>>> import numpy as np
+>>> x = np.arange(60.0)
+>>> frames = phase_shift_patterns(x, period=30, steps=4)[:, None, :]
+>>> phi, avg, mod = wrapped_phase(frames)
+>>> bool(np.allclose(phi[0], 2 * np.pi * (x % 30) / 30, atol=1e-5))
+True
+>>> float(avg.mean()), round(float(mod.mean()), 4)
+(0.5, 0.5)
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+TWO_PI = 2.0 * np.pi
+
+
+def phase_shift_patterns(
+    x: np.ndarray, period: float, steps: int, offset: float = 0.5, amplitude: float = 0.5
+) -> np.ndarray:
+    """Intensities ``offset + amplitude*cos(2*pi*x/period + 2*pi*n/steps)``, n = 0..steps-1.
+
+    Returns an array of shape ``(steps, *x.shape)``.
+    """
+    shifts = TWO_PI * np.arange(steps) / steps
+    shifts = shifts.reshape((steps,) + (1,) * np.ndim(x))
+    return offset + amplitude * np.cos(TWO_PI * np.asarray(x, dtype=np.float64) / period + shifts)
+
+
+def wrapped_phase(frames: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Wrapped phase in ``[0, 2*pi)``, average ``A`` and modulation ``B`` of an N-step stack.
+
+    Least-squares N-step estimate (Eq. 9-11 of the paper for N = 4, general N here):
+    ``phi = atan2(-sum I_n sin d_n, sum I_n cos d_n)`` with ``d_n = 2*pi*n/N``.
+
+    Parameters
+    ----------
+    frames : (N, H, W) array, any dtype.
+
+    Returns
+    -------
+    phi, A, B : float32 arrays of shape (H, W).
+    """
+    stack = np.asarray(frames, dtype=np.float32)
+    steps = stack.shape[0]
+    if steps < 3:
+        raise ValueError("N-step phase shifting needs at least 3 frames")
+    shifts = TWO_PI * np.arange(steps) / steps
+    num = -np.tensordot(np.sin(shifts).astype(np.float32), stack, axes=1)
+    den = np.tensordot(np.cos(shifts).astype(np.float32), stack, axes=1)
+    phi = np.arctan2(num, den)
+    phi = np.where(phi < 0, phi + np.float32(TWO_PI), phi)
+    phi[phi >= np.float32(TWO_PI)] = 0.0  # float32 rounding of tiny negatives
+    mod = np.hypot(num, den) * np.float32(2.0 / steps)
+    avg = stack.mean(axis=0)
+    return phi.astype(np.float32), avg.astype(np.float32), mod.astype(np.float32)
+
+
+def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
+                   mod: np.ndarray) -> np.ndarray:
+    """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy)."""
+    stack = np.asarray(frames, dtype=np.float32)
+    steps = stack.shape[0]
+    shifts = (TWO_PI * np.arange(steps) / steps).astype(np.float32)[:, None, None]
+    model = avg[None] + mod[None] * np.cos(phi[None] + shifts)
+    dof = max(steps - 3, 1)
+    return np.sqrt(((stack - model) ** 2).sum(axis=0) / dof).astype(np.float32)
+
+
+def wrap(angle: np.ndarray) -> np.ndarray:
+    """Wrap angles into ``[-pi, pi)``."""
+    return (np.asarray(angle) + np.pi) % TWO_PI - np.pi

@@ -1,0 +1,104 @@
+"""The decode result every codec returns, and how it is written to a folder.
+
+Examples
+--------
+>>> import numpy as np
+>>> phi = np.full((2, 3), 1.0, np.float32)
+>>> order = np.array([[0, 1, 2], [3, -1, 5]])
+>>> res = make_result("demo", phi, order, period=30.0, modulation=np.ones((2, 3)))
+>>> res.coord[0].round(3).tolist(), int(res.mask.sum())
+([4.775, 34.775, 64.775], 5)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .phase import TWO_PI
+
+
+@dataclass
+class DecodeResult:
+    """Absolute phase and everything needed to judge it, per camera pixel.
+
+    Attributes
+    ----------
+    phase : float32, absolute phase ``Phi = 2*pi*x_p/T`` (NaN where invalid).
+    coord : float32, projector coordinate ``x_p`` along the coded axis (NaN where invalid).
+    order : int32, fringe order ``floor(x_p/T)`` (-1 where invalid).
+    wrapped : float32, wrapped phase in ``[0, 2*pi)`` (NaN where the modulation is too low).
+    modulation : float32, fringe modulation ``B`` as a fraction of full scale.
+    average : float32, average intensity ``A`` as a fraction of full scale.
+    mask : bool, pixels with a valid absolute phase.
+    code : int32, the method's decoded code word per pixel (``k_s`` for stair methods;
+        -1 where not decoded), for previews and diagnosis.
+    period : projector pixels per fringe of ``phase`` and ``order``.
+    method : the codec's name.
+    info : figures about the decode (thresholds, counts, consistency checks).
+    """
+
+    phase: np.ndarray
+    coord: np.ndarray
+    order: np.ndarray
+    wrapped: np.ndarray
+    modulation: np.ndarray
+    average: np.ndarray
+    mask: np.ndarray
+    code: np.ndarray
+    period: float
+    method: str
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The arrays written as ``NAME.npy``."""
+        return {"phase": self.phase, "coord": self.coord, "order": self.order,
+                "wrapped": self.wrapped, "modulation": self.modulation, "mask": self.mask}
+
+    def transposed(self) -> DecodeResult:
+        """The same result with image axes swapped (for the rows orientation)."""
+        swap = {name: np.ascontiguousarray(getattr(self, name).T) for name in
+                ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
+        return DecodeResult(**swap, period=self.period, method=self.method, info=self.info)
+
+    def save(self, folder: str | Path, previews: bool = True) -> None:
+        """Write the arrays (and PNG previews) into an existing folder."""
+        folder = Path(folder)
+        for name, arr in self.arrays().items():
+            np.save(folder / f"{name}.npy", arr)
+        if previews:
+            from .preview import write_previews
+
+            write_previews(self, folder)
+
+
+def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
+                modulation: np.ndarray, average: np.ndarray | None = None,
+                code: np.ndarray | None = None, wrapped: np.ndarray | None = None,
+                info: dict[str, Any] | None = None) -> DecodeResult:
+    """Assemble a result from the wrapped phase and the fringe order (``< 0`` = invalid).
+
+    The order is recomputed as ``floor(Phi / 2pi)`` so that ``order``, ``phase`` and ``coord``
+    always agree, and ``phase - 2*pi*order`` lies in ``[0, 2*pi)``.
+    """
+    order = np.asarray(order)
+    valid = order >= 0
+    phase = np.where(valid, phi + TWO_PI * order.astype(np.float64), np.nan).astype(np.float32)
+    mask = np.isfinite(phase)
+    out_order = np.full(phase.shape, -1, np.int32)
+    out_order[mask] = np.floor(phase[mask] / np.float32(TWO_PI)).astype(np.int32)
+    bad = mask & (out_order < 0)  # a pixel just left of x_p = 0
+    phase[bad], out_order[bad], mask[bad] = np.nan, -1, False
+    coord = (phase * np.float32(period / TWO_PI)).astype(np.float32)
+    if wrapped is None:
+        wrapped = phi
+    return DecodeResult(
+        phase=phase, coord=coord, order=out_order, wrapped=wrapped.astype(np.float32),
+        modulation=np.asarray(modulation, np.float32),
+        average=(np.zeros_like(phase) if average is None else average).astype(np.float32),
+        mask=mask, code=(np.full(phase.shape, -1, np.int32) if code is None else code),
+        period=float(period), method=method, info=dict(info or {}),
+    )

@@ -1,0 +1,55 @@
+"""Stair phases: levels, the cos/sin coded pair, the decoded stair phase and its quantisation.
+
+A stair of ``levels`` steps uses the phases ``-pi + pi/levels + 2*pi*j/levels`` (Eq. 13-14),
+so level ``j`` is the centre of the bin ``[-pi + 2*pi*j/levels, -pi + 2*pi*(j+1)/levels)``.
+The top level sits next to the wrap at ``+-pi``; quantisation is taken modulo ``levels`` so
+a top-level pixel whose noise pushes it across the wrap still reads as the top level.
+
+Examples
+--------
+>>> import numpy as np
+>>> theta = stair_level_phase(np.arange(6), 6)
+>>> quantize(theta, 6).tolist()
+[0, 1, 2, 3, 4, 5]
+>>> quantize(np.array([np.pi + 0.1, -np.pi - 0.1]), 6).tolist()   # across the wrap
+[0, 5]
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .phase import TWO_PI
+
+
+def stair_level_phase(level: np.ndarray, levels: int) -> np.ndarray:
+    """Phase of stair level ``level`` (0-based) of a ``levels``-step stair."""
+    return -np.pi + np.pi / levels + TWO_PI * np.asarray(level, dtype=np.float64) / levels
+
+
+def stair_pair(theta: np.ndarray, offset: float = 0.5, amplitude: float = 0.5) -> np.ndarray:
+    """The coded pair ``a + b*cos(theta)``, ``a + b*sin(theta)`` (Eq. 15-16), shape (2, ...)."""
+    return np.stack([offset + amplitude * np.cos(theta), offset + amplitude * np.sin(theta)])
+
+
+def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
+                avg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Decoded stair phase in ``[-pi, pi)`` and its modulation (Eq. 19).
+
+    ``avg`` is the average intensity of the fringe frames (Eq. 9).
+    """
+    c = np.asarray(cos_frame, dtype=np.float32) - avg
+    s = np.asarray(sin_frame, dtype=np.float32) - avg
+    return np.arctan2(s, c).astype(np.float32), np.hypot(s, c).astype(np.float32)
+
+
+def quantize(theta: np.ndarray, levels: int) -> np.ndarray:
+    """Stair level index of the phase ``theta`` (Eq. 20), modulo ``levels``; int32."""
+    scaled = (np.asarray(theta) + np.pi) * (levels / TWO_PI)
+    return (np.floor(scaled).astype(np.int64) % levels).astype(np.int32)
+
+
+def level_distance(theta: np.ndarray, level: np.ndarray, levels: int) -> np.ndarray:
+    """Circular distance (radians) from ``theta`` to the phase of ``level``."""
+    d = np.asarray(theta) - stair_level_phase(level, levels)
+    return np.abs((d + np.pi) % TWO_PI - np.pi)
