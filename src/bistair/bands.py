@@ -148,6 +148,47 @@ def _drop_transitions(runs: Runs) -> Runs:
     return runs.take(~drop)
 
 
+def band_splits(runs: Runs) -> list[tuple[int, int]]:
+    """Where a region's band values change pair down its profile: two surfaces (say one
+    object above another) joined into one fringe region. Returns ``(region, first row of the
+    lower part)`` pairs.
+
+    Down one surface the bands alternate between two values, so a run whose value is neither
+    of the two before it starts another surface, if what follows confirms it: the run after
+    next repeats its value, the next run is new as well, or the run is a merged band.
+    """
+    splits = []
+    if runs.uid.size < 3:
+        return splits
+    uid, reg = runs.uid, runs.region
+    for i in range(2, uid.size):
+        if reg[i] != reg[i - 2] or not (runs.top_ok[i] and runs.top_ok[i - 1]):
+            continue
+        if uid[i] in (uid[i - 1], uid[i - 2]):
+            continue
+        nxt = i + 1 < uid.size and reg[i + 1] == reg[i] and runs.top_ok[i + 1]
+        nxt2 = nxt and i + 2 < uid.size and reg[i + 2] == reg[i] and runs.top_ok[i + 2]
+        confirmed = (
+            (nxt2 and uid[i + 2] == uid[i])
+            or (nxt and uid[i + 1] not in (uid[i - 1], uid[i - 2]))
+            or runs.length[i] >= runs.length[i - 2] + runs.length[i - 1]
+        )
+        if confirmed and (not splits or splits[-1][0] != reg[i] or splits[-1][1] < runs.y0[i - 1]):
+            splits.append((int(reg[i]), int(runs.y0[i])))
+    return splits
+
+
+def split_regions(labels: np.ndarray, n_regions: int,
+                  splits: list[tuple[int, int]]) -> tuple[np.ndarray, int]:
+    """Give the rows of a region from each split row down a new label."""
+    labels = labels.copy()
+    for region, row in sorted(splits, key=lambda s: (s[0], -s[1])):
+        n_regions += 1
+        lower = labels[row:] == region
+        labels[row:][lower] = n_regions
+    return labels, n_regions
+
+
 @dataclass(frozen=True)
 class BandLayout:
     """What the decoder knows of the code: stairs ``S``, partitions ``P``, group rows."""

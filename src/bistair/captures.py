@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
 from .errors import BistairError
 from .phase import residual_noise
@@ -70,11 +71,19 @@ def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
 
 
 def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> float:
-    """Robust camera noise estimate (fraction of full scale) from an N-step set's residual."""
-    if frames.shape[0] <= 3:
+    """Camera noise sigma (fraction of full scale) from an N-step set's fit residual.
+
+    The median residual over pixels that no frame clips at 0 or full scale, scaled by the
+    median of a chi distribution with N - 3 degrees of freedom. Zero for N = 3.
+    """
+    steps = frames.shape[0]
+    if steps <= 3:
         return 0.0
     res = residual_noise(frames, phi, avg, mod)
-    return float(np.median(res))
+    unclipped = (frames.min(axis=0) > 0.0) & (frames.max(axis=0) < 1.0)
+    sample = res[unclipped] if unclipped.sum() >= 100 else res.ravel()
+    dof = steps - 3
+    return float(np.median(sample) / np.sqrt(stats.chi2.ppf(0.5, dof) / dof))
 
 
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
@@ -94,12 +103,13 @@ def validity(mod: np.ndarray, saturated: np.ndarray, noise: float,
     return (mod >= threshold) & ~saturated
 
 
-def check_decodable(valid: np.ndarray, saturated: np.ndarray) -> None:
-    """Refuse captures with (almost) nothing to decode, saying whether they are dark or blown."""
+def check_decodable(valid: np.ndarray, clipped: np.ndarray) -> None:
+    """Refuse captures with (almost) nothing to decode, saying whether they are dark or blown
+    (``clipped``: pixels with a frame at full scale)."""
     min_pixels = max(50, valid.size // 10000)
     if int(valid.sum()) >= min_pixels:
         return
-    share = float(saturated.mean())
+    share = float(clipped.mean())
     if share > 0.25:
         raise BistairError(
             f"captures are saturated: {100 * share:.0f}% of pixels reach full scale"

@@ -8,7 +8,7 @@ Examples
 --------
 >>> import numpy as np
 >>> from bistair.result import make_result
->>> truth = np.tile(np.arange(90.0), (4, 1))
+>>> truth = np.tile(np.arange(90.0) + 0.5, (4, 1))
 >>> phi = (2 * np.pi * truth / 30) % (2 * np.pi)
 >>> order = truth // 30
 >>> order[0, 10] += 1

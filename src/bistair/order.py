@@ -22,8 +22,8 @@ import numpy as np
 from .regions import RegionLinks
 
 
-def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int,
-                  n_values: int, weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
+                  weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Most frequent value (0..n_values-1) per label 1..n_labels; label 0 and values < 0 ignored.
 
     Returns ``(mode, support)`` indexed by label (index 0 unused, mode -1 where no vote).

@@ -8,7 +8,7 @@ and neighbouring regions across a wrap differ by exactly one order.
 Examples
 --------
 >>> import numpy as np
->>> x = np.arange(90.0)
+>>> x = np.arange(90.0) + 0.5
 >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (20, 1)).astype(np.float32)
 >>> labels, n = fringe_regions(phi, np.ones(phi.shape, bool), min_size=1)
 >>> n, labels[0, [0, 29, 30, 89]].tolist()

@@ -6,7 +6,7 @@ Examples
 >>> phi = np.full((2, 3), 1.0, np.float32)
 >>> order = np.array([[0, 1, 2], [3, -1, 5]])
 >>> res = make_result("demo", phi, order, period=30.0, modulation=np.ones((2, 3)))
->>> res.coord[0].round(3).tolist(), int(res.mask.sum())
+>>> [round(float(c), 3) for c in res.coord[0]], int(res.mask.sum())
 ([4.775, 34.775, 64.775], 5)
 """
 
@@ -81,18 +81,16 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
                 info: dict[str, Any] | None = None) -> DecodeResult:
     """Assemble a result from the wrapped phase and the fringe order (``< 0`` = invalid).
 
-    The order is recomputed as ``floor(Phi / 2pi)`` so that ``order``, ``phase`` and ``coord``
-    always agree, and ``phase - 2*pi*order`` lies in ``[0, 2*pi)``.
+    ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly; phase and
+    coordinate are computed in float64 and stored as float32.
     """
     order = np.asarray(order)
-    valid = order >= 0
-    phase = np.where(valid, phi + TWO_PI * order.astype(np.float64), np.nan).astype(np.float32)
-    mask = np.isfinite(phase)
-    out_order = np.full(phase.shape, -1, np.int32)
-    out_order[mask] = np.floor(phase[mask] / np.float32(TWO_PI)).astype(np.int32)
-    bad = mask & (out_order < 0)  # a pixel just left of x_p = 0
-    phase[bad], out_order[bad], mask[bad] = np.nan, -1, False
-    coord = (phase * np.float32(period / TWO_PI)).astype(np.float32)
+    phi64 = np.asarray(phi, dtype=np.float64)
+    mask = (order >= 0) & np.isfinite(phi64)
+    full = np.where(mask, phi64 + TWO_PI * order, np.nan)
+    phase = full.astype(np.float32)
+    coord = (full * (period / TWO_PI)).astype(np.float32)
+    out_order = np.where(mask, order, -1).astype(np.int32)
     if wrapped is None:
         wrapped = phi
     return DecodeResult(

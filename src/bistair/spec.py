@@ -209,5 +209,7 @@ def load_spec(path: str | Path) -> BaseSpec:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise BistairError(f"spec file {path} is not valid JSON ({exc.msg}, line {exc.lineno})")
+        raise BistairError(
+            f"spec file {path} is not valid JSON ({exc.msg}, line {exc.lineno})"
+        ) from None
     return spec_from_dict(data)

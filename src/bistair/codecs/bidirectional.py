@@ -41,7 +41,16 @@ import dataclasses
 
 import numpy as np
 
-from ..bands import BandLayout, group_heights, region_evidence, row_runs, union_levels
+from ..bands import (
+    BandLayout,
+    band_splits,
+    group_heights,
+    nearest_level,
+    region_evidence,
+    row_runs,
+    split_regions,
+    union_levels,
+)
 from ..captures import Prepared, check_decodable, noise_level, saturation, validity
 from ..errors import BistairError
 from ..order import jump_violations, mode_by_label, resolve_regions
@@ -131,7 +140,7 @@ def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = 
     noise = noise_level(frames[:n], phi, avg, mod)
     saturated = saturation(prepared.clipped, avg, mod)
     valid = validity(mod, saturated, noise, min_modulation)
-    check_decodable(valid, saturated)
+    check_decodable(valid, prepared.clipped)
     theta, stair_mod = stair_phase(frames[n], frames[n + 1], avg)
     ks = np.where(valid, quantize(theta, spec.stairs), -1).astype(np.int32)
     info = {"strategy": strategy, "noise": noise, "valid_modulation": int(valid.sum())}
@@ -153,7 +162,12 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
     ratio = np.clip(stair_mod / np.maximum(mod, 1e-6), 0.0, 2.0)
     core = np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
     weight = core * np.minimum(ratio, 1.0)
-    runs = row_runs(labels, theta, weight, ratio, union_levels(spec.partitions, spec.stairs))
+    levels = union_levels(spec.partitions, spec.stairs)
+    runs = row_runs(labels, theta, weight, ratio, levels)
+    splits = band_splits(runs)
+    if splits:  # surfaces stacked in one fringe region: decode them apart
+        labels, n_reg = split_regions(labels, n_reg, splits)
+        runs = row_runs(labels, theta, weight, ratio, levels)
     ys, xs = np.nonzero(labels)
     count = np.maximum(np.bincount(labels[ys, xs], minlength=n_reg + 1), 1)
     centroids = np.c_[np.bincount(labels[ys, xs], ys, n_reg + 1) / count,
@@ -167,8 +181,9 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
     k_reg[(score < 0.5) | (margin < 0.1)] = -1
     k_reg[0] = -1
     bad, total = jump_violations(links, k_reg)
-    info.update(regions=n_reg, regions_decoded=int((k_reg[1:] >= 0).sum()),
-                jump_violations=bad, jump_links=total, group_height=default)
+    info.update(regions=n_reg, region_splits=len(splits),
+                regions_decoded=int((k_reg[1:] >= 0).sum()), jump_violations=bad,
+                jump_links=total, group_height=default)
     k_pix = k_reg[labels]
     abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
     return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
@@ -180,8 +195,9 @@ def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.
     S, P = spec.stairs, spec.partitions
     h, w = ks.shape
     v = valid.T.ravel()
-    q = ks.T.ravel()
     t = theta.T.ravel()
+    # Runs of equal k_s; with P != S the levels of both stairs are told apart.
+    q = ks.T.ravel() if P == S else nearest_level(t, union_levels(P, S))
     col_start = np.zeros(v.size, bool)
     col_start[::h] = True
     seg_start = v & (col_start | ~np.r_[False, v[:-1]])
@@ -204,10 +220,14 @@ def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.
     ok = g_second < first.size
     has_second[ok] = group[g_second[ok]] == group[g_first[ok]]
     has_second &= ~merged[g_first]
-    k1 = quantize(run_theta[g_first], S)
     second_theta = np.where(has_second, run_theta[np.minimum(g_second, first.size - 1)],
                             run_theta[g_first])
-    k2 = quantize(second_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
+    # The longer run opens a group: the local one unless the spec gives it fewer rows.
+    local_first = 2 * spec.local_rows > spec.group_rows
+    local_theta, part_theta = ((run_theta[g_first], second_theta) if local_first
+                               else (second_theta, run_theta[g_first]))
+    k1 = quantize(local_theta, S)
+    k2 = quantize(part_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
     k_group = k1 + S * k2
     order = np.full(v.size, -1, np.int64)
     order[pix] = k_group[group[run_of]]
