@@ -58,24 +58,61 @@ def nearest_level(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
     return d.argmin(axis=1).astype(np.int32)
 
 
-def row_runs(labels: np.ndarray, theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray,
-             levels: np.ndarray) -> Runs:
-    """Runs of constant stair level in the per-row profiles of every region.
+@dataclass
+class RowProfiles:
+    """Per (region, row) sums of the stair phasor over a region's pixels in that row."""
 
-    ``weight`` scales each pixel's vote, ``ratio`` is the stair-pair modulation over the fringe
-    modulation: rows where it collapses are blurred band transitions and are skipped.
+    region: np.ndarray
+    row: np.ndarray
+    cos: np.ndarray  # sum of weight * cos(theta)
+    sin: np.ndarray
+    weight: np.ndarray
+    ratio: np.ndarray  # mean stair-pair / fringe modulation
+    count: np.ndarray
+    col_sum: np.ndarray  # sum of the pixels' column indices
+
+
+def row_profiles(labels: np.ndarray, theta: np.ndarray, weight: np.ndarray,
+                 ratio: np.ndarray) -> RowProfiles:
+    """Sum each region's pixels row by row (sorted by region, then row).
+
+    Dense bincounts over ``region * height + row`` while that table stays small, else a sort.
     """
-    ys, _ = np.nonzero(labels > 0)
-    reg = labels[labels > 0].astype(np.int64)
-    height = labels.shape[0]
-    key, inv = np.unique(reg * height + ys, return_inverse=True)
-    w = weight[labels > 0].astype(np.float64)
-    t = theta[labels > 0]
-    c = np.bincount(inv, w * np.cos(t))
-    s = np.bincount(inv, w * np.sin(t))
-    wsum = np.bincount(inv, w)
-    rsum = np.bincount(inv, ratio[labels > 0]) / np.bincount(inv)
-    region, row = key // height, key % height
+    h, w = labels.shape
+    values = [weight * np.cos(theta), weight * np.sin(theta), weight, ratio,
+              np.broadcast_to(np.arange(w, dtype=np.float32), (h, w))]
+    n_bins = (int(labels.max()) + 1) * h
+    key = (labels.astype(np.int64) * h + np.arange(h)[:, None]).ravel()
+    if n_bins <= 4 * labels.size:
+        count = np.bincount(key, minlength=n_bins)
+        used = np.flatnonzero(count)
+        used = used[used >= h]  # region 0 is no region
+        count = count[used]
+        sums = [np.bincount(key, v.ravel(), minlength=n_bins)[used] for v in values]
+    else:
+        sel = labels.ravel() > 0
+        used, inv, count = np.unique(key[sel], return_inverse=True, return_counts=True)
+        sums = [np.bincount(inv, v.ravel()[sel], minlength=used.size) for v in values]
+    c, s, wsum, rsum, cols = sums
+    return RowProfiles(used // h, used % h, c, s, wsum, rsum / np.maximum(count, 1), count, cols)
+
+
+def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
+    """(row, column) centroid of each region 0..n_regions from its row profiles."""
+    count = np.maximum(np.bincount(prof.region, prof.count, n_regions + 1), 1)
+    rows = np.bincount(prof.region, prof.row * prof.count, n_regions + 1)
+    cols = np.bincount(prof.region, prof.col_sum, n_regions + 1)
+    return np.c_[rows / count, cols / count]
+
+
+def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
+    """Runs of constant stair level in the row profiles of every region.
+
+    Rows where the stair pair's modulation collapses relative to the fringes' (``ratio``)
+    are blurred band transitions and are skipped.
+    """
+    c, s, wsum, rsum = prof.cos, prof.sin, prof.weight, prof.ratio
+    region, row = prof.region, prof.row
     row_theta = np.arctan2(s, c)
     # Transitional rows: the stair pair's modulation drops where two bands blur together.
     n_reg = int(region.max()) + 1 if region.size else 1

@@ -28,26 +28,29 @@ from scipy import ndimage
 from .phase import TWO_PI
 
 
-def _link_cuts(phi: np.ndarray, valid: np.ndarray, axis: int,
+def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray,
                cut: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For links between pixel i and i+1 along ``axis``: (connected, wrap, step_cut)."""
-    a = phi.take(np.arange(phi.shape[axis] - 1), axis=axis)
-    b = phi.take(np.arange(1, phi.shape[axis]), axis=axis)
-    va = valid.take(np.arange(phi.shape[axis] - 1), axis=axis)
-    vb = valid.take(np.arange(1, phi.shape[axis]), axis=axis)
+    """For the links between pixels ``a`` and ``b``: (connected, drop_a, drop_b).
+
+    A wrap link drops its high-phase end, a phase step both ends, so that 4-connected
+    components of the pixels kept never cross a cut link.
+    """
     raw = b - a
-    wrap = np.abs(raw) > np.pi
-    step_cut = ~wrap & (np.abs(raw) > cut)
-    connected = va & vb & ~wrap & ~step_cut
-    return connected, wrap & va & vb, step_cut & va & vb
+    both = va & vb
+    wrap = both & (np.abs(raw) > np.pi)
+    step = both & ~wrap & (np.abs(raw) > cut)
+    connected = both & ~wrap & ~step
+    return connected, (wrap & (raw <= 0)) | step, (wrap & (raw > 0)) | step
 
 
 def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     """Cut threshold for phase steps: three times the median phase gradient, in [0.6, 2.2]."""
-    gx = np.abs(np.diff(phi, axis=1))
-    gx = np.minimum(gx, TWO_PI - gx)[valid[:, 1:] & valid[:, :-1]]
-    gy = np.abs(np.diff(phi, axis=0))
-    gy = np.minimum(gy, TWO_PI - gy)[valid[1:] & valid[:-1]]
+    # Neighbour differences on every fourth row and column: plenty for a median.
+    a, va = phi[::4, ::4], valid[::4, ::4]
+    gx = np.abs(phi[::4, 1::4][:, :a.shape[1]] - a[:, :phi[::4, 1::4].shape[1]])
+    gx = np.minimum(gx, TWO_PI - gx)[va[:, :gx.shape[1]] & valid[::4, 1::4][:, :gx.shape[1]]]
+    gy = np.abs(phi[1::4, ::4][:a.shape[0]] - a[:phi[1::4, ::4].shape[0]])
+    gy = np.minimum(gy, TWO_PI - gy)[va[:gy.shape[0]] & valid[1::4, ::4][:gy.shape[0]]]
     if gx.size + gy.size == 0:
         return 1.5
     grad = np.hypot(np.median(gx) if gx.size else 0.0, np.median(gy) if gy.size else 0.0)
@@ -64,39 +67,33 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     valid = np.asarray(valid, dtype=bool)
     if cut is None:
         cut = default_cut(phi, valid)
+    vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
+    horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
+                                              valid[:, 1:], cut)
     keep = valid.copy()
-    links = []
-    for axis in (0, 1):
-        connected, wrap, step = _link_cuts(phi, valid, axis, cut)
-        links.append(connected)
-        lo = [slice(None)] * 2
-        hi = [slice(None)] * 2
-        lo[axis] = slice(0, -1)
-        hi[axis] = slice(1, None)
-        a, b = phi[tuple(lo)], phi[tuple(hi)]
-        # Remove one endpoint of each wrap link (the high-phase side) and both ends of a step,
-        # so that 4-connected components of what is kept never cross a cut link.
-        keep[tuple(lo)] &= ~((wrap & (a >= b)) | step)
-        keep[tuple(hi)] &= ~((wrap & (b > a)) | step)
+    keep[:-1] &= ~drop_up
+    keep[1:] &= ~drop_down
+    keep[:, :-1] &= ~drop_left
+    keep[:, 1:] &= ~drop_right
     labels, n = ndimage.label(keep)
     labels = labels.astype(np.int32)
-    # Reattach the removed pixels through links that are not cut.
+    # Reattach the removed pixels through links that are not cut (a few passes, on the
+    # removed pixels only: they are thin lines along the wraps).
+    h, w = labels.shape
+    ty, tx = np.nonzero(valid & ~keep)
     for _ in range(3):
-        todo = valid & (labels == 0)
-        if not todo.any():
+        if ty.size == 0:
             break
-        vert, horiz = links
-        cand = np.zeros_like(labels)
-        cand[:-1][vert & todo[:-1]] = labels[1:][vert & todo[:-1]]
-        cand[1:][vert & todo[1:] & (cand[1:] == 0)] = labels[:-1][vert & todo[1:] & (cand[1:] == 0)]
-        sel = horiz & todo[:, :-1] & (cand[:, :-1] == 0)
-        cand[:, :-1][sel] = labels[:, 1:][sel]
-        sel = horiz & todo[:, 1:] & (cand[:, 1:] == 0)
-        cand[:, 1:][sel] = labels[:, :-1][sel]
-        grow = todo & (cand > 0)
-        if not grow.any():
-            break
-        labels[grow] = cand[grow]
+        got = np.zeros(ty.size, np.int32)
+        for dy, dx, link in ((1, 0, vert), (-1, 0, vert), (0, 1, horiz), (0, -1, horiz)):
+            ny, nx = ty + dy, tx + dx
+            inside = (ny >= 0) & (ny < h) & (nx >= 0) & (nx < w)
+            ly, lx = np.minimum(ty, ny), np.minimum(tx, nx)  # the link's own index
+            ok = inside & (got == 0)
+            ok[ok] = link[ly[ok], lx[ok]]
+            got[ok] = labels[ny[ok], nx[ok]]
+        labels[ty, tx] = got
+        ty, tx = ty[got == 0], tx[got == 0]
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     small = sizes < min_size
     small[0] = False
@@ -130,13 +127,10 @@ def region_links(phi: np.ndarray, labels: np.ndarray) -> RegionLinks:
     is reported once per direction of walk (``src`` before ``dst``).
     """
     src, dst, step = [], [], []
-    for axis in (0, 1):
-        n = phi.shape[axis]
-        a = phi.take(np.arange(n - 1), axis=axis)
-        b = phi.take(np.arange(1, n), axis=axis)
-        la = labels.take(np.arange(n - 1), axis=axis)
-        lb = labels.take(np.arange(1, n), axis=axis)
-        sel = (la > 0) & (lb > 0) & (la != lb) & (np.abs(b - a) > np.pi)
+    for a, b, la, lb in ((phi[:-1], phi[1:], labels[:-1], labels[1:]),
+                         (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:])):
+        sel = (la != lb) & (la > 0) & (lb > 0)
+        sel[sel] = np.abs(b[sel] - a[sel]) > np.pi
         src.append(la[sel])
         dst.append(lb[sel])
         step.append(np.where(a[sel] > b[sel], 1, -1))
@@ -144,9 +138,9 @@ def region_links(phi: np.ndarray, labels: np.ndarray) -> RegionLinks:
     if s.size == 0:
         empty = np.zeros(0, np.int64)
         return RegionLinks(empty, empty, empty, empty)
-    key = np.stack([s, d, st])
-    uniq, count = np.unique(key, axis=1, return_counts=True)
-    return RegionLinks(uniq[0], uniq[1], uniq[2], count)
+    n = int(labels.max()) + 1
+    key, count = np.unique((s * n + d) * 2 + (st > 0), return_counts=True)
+    return RegionLinks(key // 2 // n, key // 2 % n, np.where(key % 2 == 1, 1, -1), count)
 
 
 def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndarray,
@@ -156,13 +150,25 @@ def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndar
     The fringe order is ``round((Phi_near - phi) / 2pi)``; target pixels farther than
     ``max_distance`` from any absolute phase stay NaN.
     """
-    known = np.isfinite(abs_phase)
     out = abs_phase.copy()
-    if not known.any() or not target.any():
+    ty, tx = np.nonzero(target & ~np.isfinite(abs_phase))
+    if ty.size == 0:
         return out
-    dist, (iy, ix) = ndimage.distance_transform_edt(~known, return_indices=True)
-    sel = target & ~known & (dist <= max_distance)
-    ref = abs_phase[iy[sel], ix[sel]]
-    k = np.round((ref - phi[sel]) / TWO_PI)
-    out[sel] = phi[sel] + TWO_PI * k
+    r = int(np.floor(max_distance))
+    dy, dx = np.mgrid[-r:r + 1, -r:r + 1]
+    dist = np.hypot(dy, dx).ravel()
+    near = np.argsort(dist, kind="stable")
+    near = near[(dist[near] > 0) & (dist[near] <= max_distance)]
+    dy, dx = dy.ravel()[near], dx.ravel()[near]
+    h, w = abs_phase.shape
+    yy = np.clip(ty[:, None] + dy[None, :], 0, h - 1)
+    xx = np.clip(tx[:, None] + dx[None, :], 0, w - 1)
+    cand = abs_phase[yy, xx]  # (targets, offsets), nearest offsets first
+    found = np.isfinite(cand)
+    first = found.argmax(axis=1)
+    has = found.any(axis=1)
+    ref = cand[np.arange(ty.size), first][has]
+    sel_y, sel_x = ty[has], tx[has]
+    k = np.round((ref - phi[sel_y, sel_x]) / TWO_PI)
+    out[sel_y, sel_x] = phi[sel_y, sel_x] + TWO_PI * k
     return out

@@ -46,7 +46,9 @@ from ..bands import (
     band_splits,
     group_heights,
     nearest_level,
+    profile_centroids,
     region_evidence,
+    row_profiles,
     row_runs,
     split_regions,
     union_levels,
@@ -163,16 +165,14 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
     core = np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
     weight = core * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
-    runs = row_runs(labels, theta, weight, ratio, levels)
+    prof = row_profiles(labels, theta, weight, ratio)
+    runs = row_runs(prof, levels)
     splits = band_splits(runs)
     if splits:  # surfaces stacked in one fringe region: decode them apart
         labels, n_reg = split_regions(labels, n_reg, splits)
-        runs = row_runs(labels, theta, weight, ratio, levels)
-    ys, xs = np.nonzero(labels)
-    count = np.maximum(np.bincount(labels[ys, xs], minlength=n_reg + 1), 1)
-    centroids = np.c_[np.bincount(labels[ys, xs], ys, n_reg + 1) / count,
-                      np.bincount(labels[ys, xs], xs, n_reg + 1) / count]
-    heights = group_heights(runs, n_reg, centroids)
+        prof = row_profiles(labels, theta, weight, ratio)
+        runs = row_runs(prof, levels)
+    heights = group_heights(runs, n_reg, profile_centroids(prof, n_reg))
     default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
     layout = BandLayout(spec.stairs, spec.partitions, spec.local_rows / spec.group_rows, default)
     evidence = region_evidence(runs, n_reg, heights, layout)
