@@ -19,7 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .regions import RegionLinks
+from .phase import TWO_PI
+from .regions import RegionLinks, fill_from_neighbours, region_links
 
 
 def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
@@ -86,3 +87,46 @@ def jump_violations(links: RegionLinks, region_order: np.ndarray) -> tuple[int, 
     both = (ks >= 0) & (kd >= 0)
     bad = both & (kd - ks != links.step)
     return int(links.count[bad].sum()), int(links.count[both].sum())
+
+
+def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
+                       evidence: np.ndarray, info: dict | None = None, min_score: float = 0.5,
+                       min_margin: float = 0.1) -> np.ndarray:
+    """Absolute phase from fringe regions and each region's evidence for every order.
+
+    Regions are resolved with their wrap links (:func:`resolve_regions`); a region whose
+    best order scores below ``min_score`` or leads the runner-up by less than ``min_margin``
+    stays invalid. Valid pixels outside any region (cut off at a wrap, or in a noise island)
+    take the order that makes their phase continuous with the nearest decoded pixel within
+    3 px. ``info`` receives the counts and the wrap-consistency check.
+    """
+    links = region_links(phi, labels)
+    k_reg, score, margin = resolve_regions(evidence, links)
+    k_reg[(score < min_score) | (margin < min_margin)] = -1
+    k_reg[0] = -1
+    bad, total = jump_violations(links, k_reg)
+    if info is not None:
+        info.update(regions=int(evidence.shape[0] - 1),
+                    regions_decoded=int((k_reg[1:] >= 0).sum()), jump_violations=bad,
+                    jump_links=total)
+    k_pix = k_reg[labels]
+    abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
+    return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
+
+
+def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes: int,
+                  weights: np.ndarray | None = None) -> np.ndarray:
+    """Each region's weighted share of pixels voting for each code (codes < 0 abstain)."""
+    flat = labels.ravel()
+    c = codes.ravel()
+    sel = (flat > 0) & (c >= 0)
+    w = None if weights is None else weights.ravel()[sel]
+    votes = np.bincount(flat[sel].astype(np.int64) * n_codes + c[sel], w,
+                        (n_regions + 1) * n_codes).reshape(n_regions + 1, n_codes)
+    total = np.bincount(flat[sel], w, n_regions + 1)
+    return votes / np.maximum(total, 1e-12)[:, None]
+
+
+def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Fringe order that brings ``phi`` nearest an absolute ``reference`` phase (same period)."""
+    return np.round((reference - phi) / TWO_PI)

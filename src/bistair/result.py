@@ -14,11 +14,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .phase import TWO_PI
+
+if TYPE_CHECKING:
+    from .fringes import FringeSet
 
 
 @dataclass
@@ -39,6 +42,7 @@ class DecodeResult:
     period : projector pixels per fringe of ``phase`` and ``order``.
     method : the codec's name.
     info : figures about the decode (thresholds, counts, consistency checks).
+    texture : the fully lit frame (fraction of full scale) when the spec has ``white``.
     """
 
     phase: np.ndarray
@@ -52,6 +56,7 @@ class DecodeResult:
     period: float
     method: str
     info: dict[str, Any] = field(default_factory=dict)
+    texture: np.ndarray | None = None  # the white frame if the spec has one (camera axes)
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays written as ``NAME.npy``."""
@@ -62,7 +67,8 @@ class DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
         swap = {name: np.ascontiguousarray(getattr(self, name).T) for name in
                 ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
-        return DecodeResult(**swap, period=self.period, method=self.method, info=self.info)
+        return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
+                            texture=self.texture)
 
     def save(self, folder: str | Path, previews: bool = True) -> None:
         """Write the arrays (and PNG previews) into an existing folder."""
@@ -100,3 +106,12 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
         mask=mask, code=(np.full(phase.shape, -1, np.int32) if code is None else code),
         period=float(period), method=method, info=dict(info or {}),
     )
+
+
+def result_from_phase(method: str, fs: FringeSet, abs_phase: np.ndarray, period: float,
+                      code: np.ndarray | None = None, info: dict[str, Any] | None = None
+                      ) -> DecodeResult:
+    """A result from a measured fringe set and its absolute phase (NaN = invalid)."""
+    order = np.where(np.isfinite(abs_phase), np.round((abs_phase - fs.phi) / TWO_PI), -1)
+    return make_result(method, fs.phi, order.astype(np.int64), period, fs.mod, fs.avg,
+                       code=code, wrapped=np.where(fs.valid, fs.phi, np.nan), info=info)

@@ -66,6 +66,8 @@ class BaseSpec:
     orientation: str = field(
         "columns", "coded axis: columns (vertical fringes) or rows", choices=("columns", "rows")
     )
+    white: int = field(0, "append a fully lit frame (1) for texture and board detection",
+                       choices=(0, 1))
     frame_order: tuple[str, ...] = field((), "frame names in capture order", cli=False)
 
     # -- derived ---------------------------------------------------------------------------
@@ -82,7 +84,11 @@ class BaseSpec:
     @property
     def frames(self) -> tuple[str, ...]:
         """Frame names in projection (and capture) order."""
-        return self.frame_order or self._frames()
+        return self.frame_order or self.default_frames()
+
+    def default_frames(self) -> tuple[str, ...]:
+        """The method's frames, then the white frame if asked for."""
+        return self._frames() + (("white",) if self.white else ())
 
     @property
     def frame_count(self) -> int:
@@ -112,9 +118,12 @@ class BaseSpec:
             )
         if not 0.2 <= self.gamma <= 5.0:
             raise BistairError(f"gamma must lie in [0.2, 5], got {self.gamma}")
-        if self.frame_order and sorted(self.frame_order) != sorted(self._frames()):
+        if self.white not in (0, 1):
+            raise BistairError(f"white must be 0 or 1, got {self.white}")
+        if self.frame_order and sorted(self.frame_order) != sorted(self.default_frames()):
             raise BistairError(
-                f"spec field 'frames' must list the frames {list(self._frames())} in any order"
+                f"spec field 'frames' must list the frames {list(self.default_frames())} "
+                "in any order"
             )
 
     # -- serialisation ---------------------------------------------------------------------
@@ -192,7 +201,7 @@ def spec_from_dict(data: Mapping[str, Any]) -> BaseSpec:
     kwargs = {name: _coerce(name, data[name], _field_kind(f)) for name, f in fields.items()
               if name in data}
     spec = cls(**kwargs)
-    if spec.frame_order == spec._frames():
+    if spec.frame_order == spec.default_frames():
         spec = dataclasses.replace(spec, frame_order=())
     return spec
 

@@ -39,11 +39,13 @@ class Codec:
         """Patterns as float32 in [0, 1], shape (frames, height, width), gamma pre-compensated."""
         pats = np.asarray(self.encode_columns(spec), dtype=np.float64)
         pats = np.clip(pats, 0.0, 1.0)
+        if spec.white:
+            pats = np.concatenate([pats, np.ones((1, *pats.shape[1:]))])
         if spec.gamma != 1.0:
             pats = pats ** (1.0 / spec.gamma)
         if spec.orientation == "rows":
             pats = pats.transpose(0, 2, 1)
-        order = [spec._frames().index(name) for name in spec.frames]
+        order = [spec.default_frames().index(name) for name in spec.frames]
         return np.ascontiguousarray(pats[order], dtype=np.float32)
 
     def decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
@@ -53,7 +55,7 @@ class Codec:
                 f"the {self.name} decoder has no option(s) {', '.join(sorted(unknown))}"
             )
         prepared = prepare(images, spec.frame_count, self.name)
-        order = [spec.frames.index(name) for name in spec._frames()]
+        order = [spec.frames.index(name) for name in spec._frames()]  # the method's own
         frames = prepared.frames[order]
         clipped = prepared.clipped
         if spec.orientation == "rows":
@@ -62,7 +64,11 @@ class Codec:
         result = self.decode_columns(Prepared(frames, clipped, prepared.full_scale), spec,
                                      **options)
         result.info.setdefault("full_scale", prepared.full_scale)
-        return result.transposed() if spec.orientation == "rows" else result
+        if spec.orientation == "rows":
+            result = result.transposed()
+        if spec.white:
+            result.texture = prepared.frames[spec.frames.index("white")]
+        return result
 
 
 def quantize_patterns(patterns: np.ndarray, bits: int) -> np.ndarray:

@@ -53,12 +53,13 @@ from ..bands import (
     split_regions,
     union_levels,
 )
-from ..captures import Prepared, check_decodable, noise_level, saturation, validity
+from ..captures import Prepared
 from ..errors import BistairError
-from ..order import jump_violations, mode_by_label, resolve_regions
-from ..phase import TWO_PI, phase_shift_patterns, wrapped_phase
-from ..regions import fill_from_neighbours, fringe_regions, region_links
-from ..result import DecodeResult, make_result
+from ..fringes import measure
+from ..order import mode_by_label, phase_from_regions
+from ..phase import TWO_PI, phase_shift_patterns
+from ..regions import fringe_regions
+from ..result import DecodeResult, result_from_phase
 from ..spec import BaseSpec, field, register_spec
 from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
 from .base import Codec
@@ -136,26 +137,20 @@ def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
 def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = "region",
                    min_modulation: float | None = None) -> DecodeResult:
     """Decode a capture stack (vertical fringes) into absolute phase."""
+    if strategy not in ("region", "paper"):
+        raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
+    fs = measure(prepared, 0, spec.steps, min_modulation)
+    phi, valid = fs.phi, fs.valid
     frames = prepared.frames
-    n = spec.steps
-    phi, avg, mod = wrapped_phase(frames[:n])
-    noise = noise_level(frames[:n], phi, avg, mod)
-    saturated = saturation(prepared.clipped, avg, mod)
-    valid = validity(mod, saturated, noise, min_modulation)
-    check_decodable(valid, prepared.clipped)
-    theta, stair_mod = stair_phase(frames[n], frames[n + 1], avg)
+    theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
     ks = np.where(valid, quantize(theta, spec.stairs), -1).astype(np.int32)
-    info = {"strategy": strategy, "noise": noise, "valid_modulation": int(valid.sum())}
+    info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(valid.sum())}
     if strategy == "paper":
         order = _paper_orders(ks, theta, valid, phi, spec)
         abs_phase = np.where(order >= 0, phi + TWO_PI * order, np.nan)
-    elif strategy == "region":
-        abs_phase = _region_phase(phi, mod, theta, stair_mod, valid, spec, info)
     else:
-        raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
-    order = np.where(np.isfinite(abs_phase), np.round((abs_phase - phi) / TWO_PI), -1)
-    return make_result("bidirectional", phi, order.astype(np.int64), spec.period, mod, avg,
-                       code=ks, wrapped=np.where(valid, phi, np.nan), info=info)
+        abs_phase = _region_phase(phi, fs.mod, theta, stair_mod, valid, spec, info)
+    return result_from_phase("bidirectional", fs, abs_phase, spec.period, code=ks, info=info)
 
 
 def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod: np.ndarray,
@@ -176,17 +171,8 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
     default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
     layout = BandLayout(spec.stairs, spec.partitions, spec.local_rows / spec.group_rows, default)
     evidence = region_evidence(runs, n_reg, heights, layout)
-    links = region_links(phi, labels)
-    k_reg, score, margin = resolve_regions(evidence, links)
-    k_reg[(score < 0.5) | (margin < 0.1)] = -1
-    k_reg[0] = -1
-    bad, total = jump_violations(links, k_reg)
-    info.update(regions=n_reg, region_splits=len(splits),
-                regions_decoded=int((k_reg[1:] >= 0).sum()), jump_violations=bad,
-                jump_links=total, group_height=default)
-    k_pix = k_reg[labels]
-    abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
-    return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
+    info.update(region_splits=len(splits), group_height=default)
+    return phase_from_regions(phi, valid, labels, evidence, info)
 
 
 def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.ndarray,
