@@ -20,7 +20,7 @@ import numpy as np
 from scipy import stats
 
 from .errors import BistairError
-from .phase import residual_noise
+from .phase import residuals
 
 
 @dataclass(frozen=True)
@@ -73,19 +73,28 @@ def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
 def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> float:
     """Camera noise sigma (fraction of full scale) from an N-step set's fit residual.
 
-    The median residual over pixels that no frame clips at 0 or full scale, scaled by the
-    median of a chi distribution with N - 3 degrees of freedom. Zero for N = 3.
+    The residual also holds the projector's harmonics (an uncompensated gamma), but those
+    change slowly along a fringe while noise does not: the residuals of vertically adjacent
+    pixels are differenced, and the median of their squared norm is scaled by the chi-square
+    median of N - 3 degrees of freedom. Pixels that a frame clips are left out. Zero for N = 3.
     """
     steps = frames.shape[0]
     if steps <= 3:
         return 0.0
-    sub = (slice(None), slice(None, None, 4), slice(None, None, 4))  # plenty for a median
-    frames, phi, avg, mod = frames[sub], phi[sub[1:]], avg[sub[1:]], mod[sub[1:]]
-    res = residual_noise(frames, phi, avg, mod)
-    unclipped = (frames.min(axis=0) > 0.0) & (frames.max(axis=0) < 1.0)
-    sample = res[unclipped] if unclipped.sum() >= 100 else res.ravel()
+    top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
+    low = (slice(None), slice(1, None, 4), slice(None, None, 4))
+    n_rows = min(frames[top].shape[1], frames[low].shape[1])
+    pair = []
+    for sub in (top, low):
+        f = frames[sub][:, :n_rows]
+        p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
+        pair.append((residuals(f, p, a, m), (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
+    (r0, ok0), (r1, ok1) = pair
+    energy = ((r1 - r0) ** 2).sum(axis=0)
+    ok = ok0 & ok1
+    sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
     dof = steps - 3
-    return float(np.median(sample) / np.sqrt(stats.chi2.ppf(0.5, dof) / dof))
+    return float(np.sqrt(np.median(sample) / (2.0 * stats.chi2.ppf(0.5, dof))))
 
 
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
@@ -99,9 +108,10 @@ def validity(mod: np.ndarray, saturated: np.ndarray, noise: float,
              min_modulation: float | None = None) -> np.ndarray:
     """Pixels with enough modulation and no saturation.
 
-    ``min_modulation`` (fraction of full scale) defaults to ``max(0.01, 5 * noise)``.
+    ``min_modulation`` (fraction of full scale) defaults to ``max(0.01, 4 * noise)``: pure
+    noise exceeds four sigma in about one pixel in ten million.
     """
-    threshold = max(0.01, 5.0 * noise) if min_modulation is None else min_modulation
+    threshold = max(0.01, 4.0 * noise) if min_modulation is None else min_modulation
     return (mod >= threshold) & ~saturated
 
 

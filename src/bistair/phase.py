@@ -63,15 +63,22 @@ def wrapped_phase(frames: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return phi.astype(np.float32), avg.astype(np.float32), mod.astype(np.float32)
 
 
+def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
+              mod: np.ndarray) -> np.ndarray:
+    """The N-step stack minus its fitted sinusoid, shape (N, ...)."""
+    stack = np.asarray(frames, dtype=np.float32)
+    steps = stack.shape[0]
+    shifts = (TWO_PI * np.arange(steps) / steps).astype(np.float32)
+    shifts = shifts.reshape((steps,) + (1,) * (stack.ndim - 1))
+    return stack - (avg[None] + mod[None] * np.cos(phi[None] + shifts))
+
+
 def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
                    mod: np.ndarray) -> np.ndarray:
     """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy)."""
-    stack = np.asarray(frames, dtype=np.float32)
-    steps = stack.shape[0]
-    shifts = (TWO_PI * np.arange(steps) / steps).astype(np.float32)[:, None, None]
-    model = avg[None] + mod[None] * np.cos(phi[None] + shifts)
-    dof = max(steps - 3, 1)
-    return np.sqrt(((stack - model) ** 2).sum(axis=0) / dof).astype(np.float32)
+    dof = max(np.shape(frames)[0] - 3, 1)
+    res = residuals(frames, phi, avg, mod)
+    return np.sqrt((res**2).sum(axis=0) / dof).astype(np.float32)
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:

@@ -106,6 +106,16 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     return labels, int(n)
 
 
+def core_weight(phi: np.ndarray) -> np.ndarray:
+    """How far a pixel sits from its fringe's edges, as a vote weight in [0.1, 1].
+
+    Codes change at the fringe edges, where the wrapped phase jumps; blur and the half-pixel
+    offset of a projector's stair edge put a neighbouring fringe's code on the first and last
+    pixels of a fringe, so those vote least.
+    """
+    return np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
+
+
 @dataclass(frozen=True)
 class RegionLinks:
     """Wrap links between regions: going from ``src`` to ``dst`` the order changes by ``step``.

@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 from ..errors import BistairError
-from . import bidirectional
+from . import bidirectional, graycode, lv, multifreq, phase_coding
 from .base import Codec
 
-CODECS: dict[str, Codec] = {c.name: c for c in (bidirectional.CODEC,)}
+CODECS: dict[str, Codec] = {
+    c.name: c
+    for c in (bidirectional.CODEC, multifreq.CODEC, phase_coding.CODEC, lv.CODEC, graycode.CODEC)
+}
 
 
 def get_codec(method: str) -> Codec:

@@ -58,7 +58,7 @@ from ..errors import BistairError
 from ..fringes import measure
 from ..order import mode_by_label, phase_from_regions
 from ..phase import TWO_PI, phase_shift_patterns
-from ..regions import fringe_regions
+from ..regions import core_weight, fringe_regions
 from ..result import DecodeResult, result_from_phase
 from ..spec import BaseSpec, field, register_spec
 from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
@@ -157,8 +157,7 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
                   valid: np.ndarray, spec: BidirectionalSpec, info: dict) -> np.ndarray:
     labels, n_reg = fringe_regions(phi, valid)
     ratio = np.clip(stair_mod / np.maximum(mod, 1e-6), 0.0, 2.0)
-    core = np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
-    weight = core * np.minimum(ratio, 1.0)
+    weight = core_weight(phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
     prof = row_profiles(labels, theta, weight, ratio)
     runs = row_runs(prof, levels)

@@ -1,0 +1,188 @@
+"""Four-adjacent-codeword phase coding after Lv et al. (Applied Optics 58(32), 2019).
+
+N phase shifts plus a coded pair (frames ``shift-n``, ``code-cos``, ``code-sin``) carrying
+one code per fringe from a few stair levels; the order of a fringe is found by looking up
+the codes of ``window`` adjacent fringes in the code sequence, so many fringes (36 in the
+paper's comparison) need only a few levels.
+
+The exact published code sequence is not available to us. This codec builds the documented
+design: a sequence over ``levels`` stair levels (4 by default) in which neighbouring codes
+differ and every window of four adjacent codes is unique (:func:`code_sequence`, a
+deterministic depth-first search). Decoding: each fringe region (2-D stripe between phase
+jumps) takes the code most of its pixels read; regions are chained to their right-hand
+neighbours across wraps; every chain of ``window`` regions is looked up in the sequence and
+votes for the orders of its members; the votes are checked against each other and against
+the one-order step across every wrap (:func:`bistair.order.phase_from_regions`). A region
+in an object narrower than ``window`` fringes gets no window and stays invalid: that is the
+method's known limit, which the bidirectional coding removes.
+
+Examples
+--------
+>>> code_sequence(12, levels=4, window=4)
+(0, 1, 2, 3, 0, 1, 2, 0, 1, 2, 1, 2)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import lru_cache
+
+import numpy as np
+
+from ..captures import Prepared
+from ..errors import BistairError
+from ..fringes import measure
+from ..order import code_evidence, phase_from_regions
+from ..phase import phase_shift_patterns
+from ..regions import RegionLinks, core_weight, fringe_regions, region_links
+from ..result import DecodeResult, result_from_phase
+from ..spec import BaseSpec, field, register_spec
+from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
+from .base import Codec
+
+
+@lru_cache(maxsize=64)
+def code_sequence(length: int, levels: int, window: int) -> tuple[int, ...]:
+    """A code sequence whose neighbours differ and whose ``window``-long windows are unique.
+
+    Depth-first search that tries the next level up first, which spreads the levels evenly.
+    Raises :class:`BistairError` when no such sequence exists.
+    """
+    seq: list[int] = []
+    seen: set[tuple[int, ...]] = set()
+
+    def extend() -> bool:
+        if len(seq) == length:
+            return True
+        last = seq[-1] if seq else -1
+        for i in range(levels):
+            c = (last + 1 + i) % levels
+            if c == last:
+                continue
+            key = (*seq[len(seq) - window + 1:], c) if len(seq) >= window - 1 else None
+            if key in seen:
+                continue
+            seq.append(c)
+            if key:
+                seen.add(key)
+            if extend():
+                return True
+            seq.pop()
+            seen.discard(key)
+        return False
+
+    if length > 900 or not extend():
+        raise BistairError(
+            f"no sequence of {length} codes over {levels} levels has unique {window}-code windows"
+        )
+    return tuple(seq)
+
+
+@register_spec
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class LvSpec(BaseSpec):
+    method = "lv"
+    required = ("period",)
+
+    period: int = field(30, "fringe period T in projector pixels")
+    levels: int = field(4, "stair levels of the code")
+    window: int = field(4, "adjacent fringes whose codes fix an order")
+
+    @property
+    def fringes(self) -> int:
+        return -(-self.coded_length // self.period)
+
+    @property
+    def sequence(self) -> tuple[int, ...]:
+        return code_sequence(self.fringes, self.levels, self.window)
+
+    def _frames(self) -> tuple[str, ...]:
+        return (*(f"shift-{n}" for n in range(self.steps)), "code-cos", "code-sin")
+
+    def validate(self) -> None:
+        super().validate()
+        if self.period < 4:
+            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
+        if self.levels < 2 or self.window < 2:
+            raise BistairError("levels and window must be at least 2")
+        if self.fringes > self.levels * (self.levels - 1) ** (self.window - 1) + self.window - 1:
+            raise BistairError(
+                f"{self.fringes} fringes need more than {self.levels} levels for unique "
+                f"{self.window}-code windows"
+            )
+        self.sequence  # noqa: B018 - raises if the search finds none
+
+
+def encode_columns(spec: LvSpec) -> np.ndarray:
+    x = np.arange(spec.coded_length)
+    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
+    codes = np.asarray(spec.sequence)[x // spec.period]
+    pair = stair_pair(stair_level_phase(codes, spec.levels), spec.offset, spec.amplitude)
+    rows = np.concatenate([shifts, pair])[:, None, :]
+    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+
+
+def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:
+    """Each region's strongest neighbour one order up (-1 where none)."""
+    src = np.concatenate([links.src, links.dst])
+    dst = np.concatenate([links.dst, links.src])
+    step = np.concatenate([links.step, -links.step])
+    count = np.concatenate([links.count, links.count])
+    up = step == 1
+    succ = np.full(n_regions + 1, -1, np.int64)
+    order = np.argsort(count[up], kind="stable")  # strongest written last
+    succ[src[up][order]] = dst[up][order]
+    return succ
+
+
+def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.ndarray,
+                    spec: LvSpec) -> np.ndarray:
+    """Votes of every chain of ``window`` adjacent regions for its members' orders."""
+    n_reg = region_code.size - 1
+    lookup = {tuple(spec.sequence[i:i + spec.window]): i
+              for i in range(spec.fringes - spec.window + 1)}
+    members = [np.arange(n_reg + 1)]
+    for _ in range(spec.window - 1):
+        prev = members[-1]
+        members.append(np.where(prev >= 0, succ[np.maximum(prev, 0)], -1))
+    chain = np.stack(members, axis=1)[1:]  # rows: regions 1..n as window starts
+    ok = (chain >= 0).all(axis=1) & (region_code[np.maximum(chain, 0)] >= 0).all(axis=1)
+    votes = np.zeros((n_reg + 1, spec.fringes))
+    seen = np.zeros(n_reg + 1)
+    for row in chain[ok]:
+        if np.unique(row).size < spec.window:
+            continue
+        weight = confidence[row].min()
+        np.add.at(seen, row, 1.0)
+        start = lookup.get(tuple(region_code[row]))
+        if start is not None:
+            np.add.at(votes, (row, start + np.arange(spec.window)), weight)
+    return votes / np.maximum(seen, 1.0)[:, None]
+
+
+def decode_columns(prepared: Prepared, spec: LvSpec,
+                   min_modulation: float | None = None) -> DecodeResult:
+    fs = measure(prepared, 0, spec.steps, min_modulation)
+    frames = prepared.frames[spec.steps:]
+    theta = stair_phase(frames[0], frames[1], fs.avg)[0]
+    codes = np.where(fs.valid, quantize(theta, spec.levels), -1)
+    labels, n_reg = fringe_regions(fs.phi, fs.valid)
+    shares = code_evidence(labels, n_reg, codes, spec.levels, core_weight(fs.phi))
+    region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
+    region_code[0] = -1
+    succ = _successors(region_links(fs.phi, labels), n_reg)
+    evidence = window_evidence(region_code, shares.max(axis=1), succ, spec)
+    info = {"noise": fs.noise, "fringes": spec.fringes}
+    abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence, info)
+    return result_from_phase("lv", fs, abs_phase, spec.period, code=codes.astype(np.int32),
+                             info=info)
+
+
+CODEC = Codec(
+    name="lv",
+    spec_class=LvSpec,
+    encode_columns=encode_columns,
+    decode_columns=decode_columns,
+    summary="N phase shifts + a few-level code read over four adjacent fringes (after Lv 2019)",
+    options=("min_modulation",),
+)

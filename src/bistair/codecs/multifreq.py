@@ -1,0 +1,172 @@
+"""Multi-frequency temporal phase unwrapping: one N-step set per period, frames period by period.
+
+Frames ``T{period}-shift-{n}`` in the order the periods are listed. Two rules:
+
+``hierarchical``
+    Coarse to fine (the paper's three-frequency twelve-step reference: 1080/180/30 on a
+    1080-wide projector, 1920/240/30 in its third experiment). The longest period must cover
+    the coded axis, so its phase is absolute; each finer phase takes the order that brings
+    it nearest the coarser one scaled by the period ratio.
+``heterodyne``
+    For sets whose longest period does not cover the projector: the phase differences of
+    neighbouring periods are the phases of their beat periods ``Ta*Tb/|Tb-Ta|``, and of
+    those beats again, until one beat covers the coded axis; the phases are then unwrapped
+    back down (e.g. 42/45/48: beats 630 and 720, and 5040 above them).
+
+``phase.npy`` and ``order.npy`` refer to the shortest period; ``coord.npy`` is the projector
+column. At every unwrapping step the coarser phase, scaled to the finer period, must land
+within a quarter fringe of the finer phase; a pixel where any step misses is invalid
+(``info["period_agreement"]`` is the share of well-modulated pixels where all steps agree).
+
+Examples
+--------
+>>> import numpy as np
+>>> from bistair import decode, encode, make_spec
+>>> spec = make_spec("multifreq", width=300, height=40, periods=(42, 45, 48), steps=4)
+>>> spec.unwrap, spec.frame_count
+('heterodyne', 12)
+>>> res = decode(encode(spec), spec)
+>>> bool(np.abs(res.coord - np.arange(300)).max() < 1e-3), res.period
+(True, 42.0)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..captures import Prepared
+from ..errors import BistairError
+from ..fringes import measure
+from ..order import order_from_reference
+from ..phase import TWO_PI, phase_shift_patterns
+from ..result import DecodeResult, result_from_phase
+from ..spec import BaseSpec, field, register_spec
+from .base import Codec
+
+
+def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
+    """Levels of beat periods: level 0 the periods ascending, each next the beats of
+    neighbours of the one below, up to a single period."""
+    levels = [sorted(float(p) for p in periods)]
+    while len(levels[-1]) > 1:
+        low = levels[-1]
+        levels.append([a * b / (b - a) for a, b in zip(low[:-1], low[1:], strict=True)])
+    return levels
+
+
+@register_spec
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class MultiFreqSpec(BaseSpec):
+    method = "multifreq"
+    required = ("periods",)
+
+    periods: tuple[int, ...] = field((1080, 180, 30), "fringe periods in projector pixels, "
+                                     "projected in this order")
+    unwrap: str = field("auto", "hierarchical, heterodyne, or auto (hierarchical when the "
+                        "longest period covers the axis)",
+                        choices=("auto", "hierarchical", "heterodyne"))
+
+    def __post_init__(self) -> None:
+        if self.unwrap == "auto" and self.periods:
+            rule = "hierarchical" if max(self.periods) >= self.coded_length else "heterodyne"
+            object.__setattr__(self, "unwrap", rule)
+        super().__post_init__()
+
+    def _frames(self) -> tuple[str, ...]:
+        return tuple(f"T{t}-shift-{n}" for t in self.periods for n in range(self.steps))
+
+    def validate(self) -> None:
+        super().validate()
+        if not self.periods or min(self.periods) < 4:
+            raise BistairError(f"periods must be at least 4 projector pixels, got {self.periods}")
+        if len(set(self.periods)) != len(self.periods):
+            raise BistairError(f"periods must differ, got {self.periods}")
+        if self.unwrap not in ("hierarchical", "heterodyne"):
+            raise BistairError(f"unwrap must be hierarchical or heterodyne, got {self.unwrap!r}")
+        if self.unwrap == "hierarchical" and max(self.periods) < self.coded_length:
+            raise BistairError(
+                f"hierarchical unwrapping needs a period covering the {self.coded_length}-px "
+                f"axis; the longest is {max(self.periods)} (use heterodyne)"
+            )
+        if self.unwrap == "heterodyne":
+            top = beat_tree(self.periods)[-1][0]
+            if top < self.coded_length:
+                raise BistairError(
+                    f"the beat of periods {self.periods} is {top:.0f} px, narrower than the "
+                    f"{self.coded_length}-px coded axis"
+                )
+
+    @property
+    def period(self) -> int:
+        """The shortest period, which ``phase`` and ``order`` refer to."""
+        return min(self.periods)
+
+
+def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
+    x = np.arange(spec.coded_length)
+    sets = [phase_shift_patterns(x, t, spec.steps, spec.offset, spec.amplitude)
+            for t in spec.periods]
+    rows = np.concatenate(sets)[:, None, :]
+    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+
+
+class _Unwrapper:
+    """Unwraps a phase from a coarser absolute one, keeping the worst residual per pixel."""
+
+    def __init__(self) -> None:
+        self.worst: np.ndarray | float = 0.0
+
+    def __call__(self, phi: np.ndarray, coarse: np.ndarray, ratio: float) -> np.ndarray:
+        ref = coarse * ratio
+        k = order_from_reference(phi, ref)
+        self.worst = np.maximum(self.worst, np.abs((ref - phi) / TWO_PI - k))
+        return phi + TWO_PI * k
+
+
+def decode_columns(prepared: Prepared, spec: MultiFreqSpec,
+                   min_modulation: float | None = None) -> DecodeResult:
+    n = spec.steps
+    sets = {float(t): measure(prepared, i * n, n, min_modulation, check=(i == 0))
+            for i, t in enumerate(spec.periods)}
+    valid = np.logical_and.reduce([fs.valid for fs in sets.values()])
+    phase_of = {t: fs.phi.astype(np.float64) for t, fs in sets.items()}
+    unwrap = _Unwrapper()
+    if spec.unwrap == "hierarchical":
+        chain = sorted(phase_of, reverse=True)
+        absolute = {chain[0]: phase_of[chain[0]]}
+        for coarse, fine in zip(chain[:-1], chain[1:], strict=True):
+            absolute[fine] = unwrap(phase_of[fine], absolute[coarse], coarse / fine)
+    else:
+        levels = beat_tree(tuple(phase_of))
+        for lvl in range(1, len(levels)):
+            for i, t in enumerate(levels[lvl]):
+                a, b = levels[lvl - 1][i], levels[lvl - 1][i + 1]
+                phase_of[t] = (phase_of[a] - phase_of[b]) % TWO_PI
+        absolute = {levels[-1][0]: phase_of[levels[-1][0]]}
+        for lvl in range(len(levels) - 2, -1, -1):
+            above = levels[lvl + 1]
+            for i, t in enumerate(levels[lvl]):
+                parent = above[min(i, len(above) - 1)]
+                absolute[t] = unwrap(phase_of[t], absolute[parent], parent / t)
+    shortest = float(spec.period)
+    # Every step agrees when the coarser phase lands within a quarter fringe of the finer.
+    agree = unwrap.worst < 0.25
+    lit = valid.sum()
+    info = {"unwrap": spec.unwrap, "noise": sets[shortest].noise,
+            "valid_modulation": int(lit),
+            "period_agreement": float((agree & valid).sum() / max(lit, 1))}
+    ok = valid & agree & (absolute[shortest] >= 0)
+    abs_phase = np.where(ok, absolute[shortest], np.nan)
+    return result_from_phase("multifreq", sets[shortest], abs_phase, shortest, info=info)
+
+
+CODEC = Codec(
+    name="multifreq",
+    spec_class=MultiFreqSpec,
+    encode_columns=encode_columns,
+    decode_columns=decode_columns,
+    summary="N-step sets at several periods, unwrapped hierarchically or by heterodyne beats",
+    options=("min_modulation",),
+)
