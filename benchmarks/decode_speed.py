@@ -52,6 +52,14 @@ def cases() -> list[tuple[str, dict, dict]]:
         ("bidirectional 8x8 (paper)",
          dict(method="bidirectional", width=1920, height=1080, period=30, partitions=8,
               stairs=8), {"strategy": "paper"}),
+        ("multifreq 1920/240/30 x4",
+         dict(method="multifreq", width=1920, height=1080, periods=(1920, 240, 30)), {}),
+        ("phase-coding 64 levels",
+         dict(method="phase-coding", width=1920, height=1080, period=30), {}),
+        ("lv 64 fringes, 4 levels",
+         dict(method="lv", width=1920, height=1080, period=30), {}),
+        ("graycode complementary",
+         dict(method="graycode", width=1920, height=1080, period=30, complementary=1), {}),
     ]
 
 

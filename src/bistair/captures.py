@@ -63,10 +63,13 @@ def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
     if not (np.issubdtype(stack.dtype, np.number) and not np.iscomplexobj(stack)):
         raise BistairError(f"captures must be numeric images, got dtype {stack.dtype}")
     scale = full_scale_of(stack)
-    frames = stack.astype(np.float32) / np.float32(scale)
-    if not np.isfinite(frames).all():
-        raise BistairError("captures contain NaN or infinite values")
-    clipped = (frames >= 1.0 - 1e-6).any(axis=0)
+    if np.issubdtype(stack.dtype, np.integer):
+        clipped = (stack >= scale).any(axis=0)
+    else:
+        if not np.isfinite(stack).all():
+            raise BistairError("captures contain NaN or infinite values")
+        clipped = (stack >= scale * (1.0 - 1e-6)).any(axis=0)
+    frames = np.multiply(stack, np.float32(1.0 / scale), dtype=np.float32)
     return Prepared(frames, clipped, scale)
 
 

@@ -87,16 +87,15 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
                 info: dict[str, Any] | None = None) -> DecodeResult:
     """Assemble a result from the wrapped phase and the fringe order (``< 0`` = invalid).
 
-    ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly; phase and
-    coordinate are computed in float64 and stored as float32.
+    ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly.
     """
-    order = np.asarray(order)
-    phi64 = np.asarray(phi, dtype=np.float64)
-    mask = (order >= 0) & np.isfinite(phi64)
-    full = np.where(mask, phi64 + TWO_PI * order, np.nan)
-    phase = full.astype(np.float32)
-    coord = (full * (period / TWO_PI)).astype(np.float32)
-    out_order = np.where(mask, order, -1).astype(np.int32)
+    phi = np.asarray(phi, dtype=np.float32)
+    out_order = np.asarray(order).astype(np.int32)
+    mask = (out_order >= 0) & np.isfinite(phi)
+    out_order[~mask] = -1
+    phase = phi + np.float32(TWO_PI) * out_order.astype(np.float32)
+    phase[~mask] = np.nan
+    coord = phase * np.float32(period / TWO_PI)
     if wrapped is None:
         wrapped = phi
     return DecodeResult(
@@ -112,6 +111,8 @@ def result_from_phase(method: str, fs: FringeSet, abs_phase: np.ndarray, period:
                       code: np.ndarray | None = None, info: dict[str, Any] | None = None
                       ) -> DecodeResult:
     """A result from a measured fringe set and its absolute phase (NaN = invalid)."""
-    order = np.where(np.isfinite(abs_phase), np.round((abs_phase - fs.phi) / TWO_PI), -1)
-    return make_result(method, fs.phi, order.astype(np.int64), period, fs.mod, fs.avg,
-                       code=code, wrapped=np.where(fs.valid, fs.phi, np.nan), info=info)
+    order = np.rint((abs_phase - fs.phi) * (1.0 / TWO_PI))
+    order[~np.isfinite(order)] = -1
+    return make_result(method, fs.phi, order, period, fs.mod, fs.avg,
+                       code=code, wrapped=np.where(fs.valid, fs.phi, np.float32(np.nan)),
+                       info=info)

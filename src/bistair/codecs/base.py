@@ -56,7 +56,8 @@ class Codec:
             )
         prepared = prepare(images, spec.frame_count, self.name)
         order = [spec.frames.index(name) for name in spec._frames()]  # the method's own
-        frames = prepared.frames[order]
+        same = order == list(range(len(order)))
+        frames = prepared.frames[:len(order)] if same else prepared.frames[order]
         clipped = prepared.clipped
         if spec.orientation == "rows":
             frames = frames.transpose(0, 2, 1)

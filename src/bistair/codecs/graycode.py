@@ -49,9 +49,9 @@ def gray_to_binary(gray: np.ndarray) -> np.ndarray:
     >>> gray_to_binary(np.array([0, 1, 3, 2, 6, 7, 5, 4])).tolist()
     [0, 1, 2, 3, 4, 5, 6, 7]
     """
-    binary = np.array(gray, dtype=np.int64, copy=True)
-    shift = 1
-    while shift < 63:
+    binary = np.array(gray, copy=True)
+    shift, top = 1, int(np.max(binary, initial=0)).bit_length()
+    while shift < top:
         binary ^= binary >> shift
         shift <<= 1
     return binary
@@ -111,10 +111,10 @@ def decode_columns(prepared: Prepared, spec: GrayCodeSpec,
     n_bits = spec.code_bits + spec.complementary
     code = prepared.frames[spec.steps:spec.steps + n_bits]
     ref = prepared.frames[spec.steps + n_bits:] if spec.inverse else fs.avg[None]
-    bits = (code > ref).astype(np.int64)
-    gray = np.zeros(fs.phi.shape, np.int64)
-    for b in bits:
-        gray = (gray << 1) | b
+    gray = np.zeros(fs.phi.shape, np.int32)
+    for frame, against in zip(code, np.broadcast_to(ref, code.shape), strict=True):
+        gray <<= 1
+        gray |= frame > against
     if spec.complementary:
         k1 = gray_to_binary(gray >> 1)
         k2 = (gray_to_binary(gray) + 1) // 2
