@@ -7,11 +7,11 @@ code pattern's inverse ``gray-i-inv`` after them.
 Plain: the code gives ``k = floor(x/T)`` directly; its edges sit exactly on the phase wraps,
 so blur and noise put pixels beside every edge one order off (the method's known limit).
 
-Complementary (Wu et al.'s complementary Gray code): the ``B+1`` patterns form a Gray code of
-half-period resolution whose last bit has its edges mid-fringe. With ``k1`` from the first
-``B`` bits and ``k2 = floor((K2 + 1)/2)`` from all of them, the three-zone rule picks the code
-whose edges are far from the pixel: ``k2`` where ``phi < pi/2``, ``k2 - 1`` where
-``phi >= 3*pi/2``, ``k1`` in between.
+Complementary (Zhang Q. et al., Opt. Lasers Eng. 50(4), 2012): the ``B+1`` patterns form a
+Gray code of half-period resolution whose last bit has its edges mid-fringe. With ``k1``
+from the first ``B`` bits and ``k2 = floor((K2 + 1)/2)`` from all of them, the three-zone
+rule picks the code whose edges are far from the pixel: ``k2`` where ``phi < pi/2``,
+``k2 - 1`` where ``phi >= 3*pi/2``, ``k1`` in between.
 
 Bits are binarised against the fringes' average intensity, or against the inverse patterns
 when the spec has them (robust to albedo and ambient light).
