@@ -144,6 +144,28 @@ class BaseSpec:
         return self.frames.index(name)
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class PeriodSpec(BaseSpec):
+    """A spec with one fringe period T and an N-step set ``shift-0 .. shift-(N-1)``."""
+
+    required: ClassVar[tuple[str, ...]] = ("period",)
+
+    period: int = field(30, "fringe period T in projector pixels")
+
+    @property
+    def fringes(self) -> int:
+        """Fringes across the coded axis, ``ceil(coded_length / period)``."""
+        return -(-self.coded_length // self.period)
+
+    def shift_frames(self) -> tuple[str, ...]:
+        return tuple(f"shift-{n}" for n in range(self.steps))
+
+    def validate(self) -> None:
+        super().validate()
+        if self.period < 4:
+            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
+
+
 def _coerce(name: str, value: Any, kind: type) -> Any:
     if kind is int:
         if isinstance(value, bool) or not isinstance(value, int | float) or int(value) != value:

@@ -77,3 +77,9 @@ def quantize_patterns(patterns: np.ndarray, bits: int) -> np.ndarray:
     top = (1 << bits) - 1
     data = np.round(np.clip(patterns, 0.0, 1.0) * top)
     return data.astype(np.uint8 if bits == 8 else np.uint16)
+
+
+def along_columns(profiles: np.ndarray, spec: BaseSpec) -> np.ndarray:
+    """Patterns that vary along the coded axis only: (frames, coded) -> (frames, other, coded)."""
+    rows = np.asarray(profiles, dtype=np.float32)[:, None, :]
+    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, rows.shape[2]))

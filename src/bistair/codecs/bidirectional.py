@@ -60,34 +60,26 @@ from ..order import mode_by_label, phase_from_regions
 from ..phase import TWO_PI, phase_shift_patterns
 from ..regions import core_weight, fringe_regions
 from ..result import DecodeResult, result_from_phase
-from ..spec import BaseSpec, field, register_spec
+from ..spec import PeriodSpec, field, register_spec
 from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
 from .base import Codec
 
 
 @register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class BidirectionalSpec(BaseSpec):
+class BidirectionalSpec(PeriodSpec):
     method = "bidirectional"
-    required = ("period",)
 
-    period: int = field(30, "fringe period T in projector pixels")
     partitions: int = field(6, "partition stair levels P")
     stairs: int = field(6, "local stair levels S (fringes per partition)")
     group_rows: int = field(30, "projector rows per group (local + partition rows)")
     local_rows: int = field(20, "rows of each group that carry the local stair")
 
     def _frames(self) -> tuple[str, ...]:
-        return (*(f"shift-{n}" for n in range(self.steps)), "stair-cos", "stair-sin")
-
-    @property
-    def fringes(self) -> int:
-        return self.partitions * self.stairs
+        return (*self.shift_frames(), "stair-cos", "stair-sin")
 
     def validate(self) -> None:
         super().validate()
-        if self.period < 4:
-            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
         if self.stairs < 2:
             raise BistairError(f"stairs must be at least 2, got {self.stairs}")
         if self.partitions < 2:
@@ -97,7 +89,7 @@ class BidirectionalSpec(BaseSpec):
             )
         if max(self.stairs, self.partitions) > 32:
             raise BistairError("stairs and partitions above 32 leave too little phase per level")
-        span = self.fringes * self.period
+        span = self.partitions * self.stairs * self.period
         if span < self.coded_length:
             raise BistairError(
                 f"partitions*stairs*period = {self.partitions}*{self.stairs}*{self.period} = "

@@ -39,8 +39,8 @@ from ..errors import BistairError
 from ..fringes import measure
 from ..phase import TWO_PI, phase_shift_patterns
 from ..result import DecodeResult, result_from_phase
-from ..spec import BaseSpec, field, register_spec
-from .base import Codec
+from ..spec import PeriodSpec, field, register_spec
+from .base import Codec, along_columns
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -59,19 +59,13 @@ def gray_to_binary(gray: np.ndarray) -> np.ndarray:
 
 @register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class GrayCodeSpec(BaseSpec):
+class GrayCodeSpec(PeriodSpec):
     method = "graycode"
-    required = ("period",)
 
-    period: int = field(30, "fringe period T in projector pixels")
     complementary: int = field(0, "add the complementary pattern (three-zone rule)",
                                choices=(0, 1))
     inverse: int = field(0, "also project each code pattern's inverse to binarise against",
                          choices=(0, 1))
-
-    @property
-    def fringes(self) -> int:
-        return -(-self.coded_length // self.period)
 
     @property
     def code_bits(self) -> int:
@@ -81,12 +75,10 @@ class GrayCodeSpec(BaseSpec):
     def _frames(self) -> tuple[str, ...]:
         codes = tuple(f"gray-{i}" for i in range(self.code_bits + self.complementary))
         inverse = tuple(f"{c}-inv" for c in codes) if self.inverse else ()
-        return (*(f"shift-{n}" for n in range(self.steps)), *codes, *inverse)
+        return (*self.shift_frames(), *codes, *inverse)
 
     def validate(self) -> None:
         super().validate()
-        if self.period < 4:
-            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
         if self.complementary not in (0, 1) or self.inverse not in (0, 1):
             raise BistairError("complementary and inverse must be 0 or 1")
 
@@ -101,8 +93,7 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     codes = spec.offset + spec.amplitude * (2.0 * bits - 1.0)
     if spec.inverse:
         codes = np.concatenate([codes, 2 * spec.offset - codes])
-    rows = np.concatenate([shifts, codes])[:, None, :]
-    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+    return along_columns(np.concatenate([shifts, codes]), spec)
 
 
 def decode_columns(prepared: Prepared, spec: GrayCodeSpec,

@@ -36,9 +36,9 @@ from ..order import code_evidence, phase_from_regions
 from ..phase import phase_shift_patterns
 from ..regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..result import DecodeResult, result_from_phase
-from ..spec import BaseSpec, field, register_spec
+from ..spec import PeriodSpec, field, register_spec
 from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
-from .base import Codec
+from .base import Codec, along_columns
 
 
 @lru_cache(maxsize=64)
@@ -80,29 +80,21 @@ def code_sequence(length: int, levels: int, window: int) -> tuple[int, ...]:
 
 @register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class LvSpec(BaseSpec):
+class LvSpec(PeriodSpec):
     method = "lv"
-    required = ("period",)
 
-    period: int = field(30, "fringe period T in projector pixels")
     levels: int = field(4, "stair levels of the code")
     window: int = field(4, "adjacent fringes whose codes fix an order")
-
-    @property
-    def fringes(self) -> int:
-        return -(-self.coded_length // self.period)
 
     @property
     def sequence(self) -> tuple[int, ...]:
         return code_sequence(self.fringes, self.levels, self.window)
 
     def _frames(self) -> tuple[str, ...]:
-        return (*(f"shift-{n}" for n in range(self.steps)), "code-cos", "code-sin")
+        return (*self.shift_frames(), "code-cos", "code-sin")
 
     def validate(self) -> None:
         super().validate()
-        if self.period < 4:
-            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
         if self.levels < 2 or self.window < 2:
             raise BistairError("levels and window must be at least 2")
         if self.fringes > self.levels * (self.levels - 1) ** (self.window - 1) + self.window - 1:
@@ -118,8 +110,7 @@ def encode_columns(spec: LvSpec) -> np.ndarray:
     shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
     codes = np.asarray(spec.sequence)[x // spec.period]
     pair = stair_pair(stair_level_phase(codes, spec.levels), spec.offset, spec.amplitude)
-    rows = np.concatenate([shifts, pair])[:, None, :]
-    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+    return along_columns(np.concatenate([shifts, pair]), spec)
 
 
 def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:

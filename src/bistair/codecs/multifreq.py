@@ -43,7 +43,7 @@ from ..order import order_from_reference
 from ..phase import TWO_PI, phase_shift_patterns
 from ..result import DecodeResult, result_from_phase
 from ..spec import BaseSpec, field, register_spec
-from .base import Codec
+from .base import Codec, along_columns
 
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
@@ -108,8 +108,7 @@ def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
     x = np.arange(spec.coded_length)
     sets = [phase_shift_patterns(x, t, spec.steps, spec.offset, spec.amplitude)
             for t in spec.periods]
-    rows = np.concatenate(sets)[:, None, :]
-    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+    return along_columns(np.concatenate(sets), spec)
 
 
 class _Unwrapper:

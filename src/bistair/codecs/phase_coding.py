@@ -44,36 +44,32 @@ from ..order import code_evidence, phase_from_regions
 from ..phase import TWO_PI, phase_shift_patterns, wrapped_phase
 from ..regions import core_weight, fringe_regions
 from ..result import DecodeResult, result_from_phase
-from ..spec import BaseSpec, field, register_spec
+from ..spec import PeriodSpec, field, register_spec
 from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
-from .base import Codec
+from .base import Codec, along_columns
 
 
 @register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
-class PhaseCodingSpec(BaseSpec):
+class PhaseCodingSpec(PeriodSpec):
     method = "phase-coding"
-    required = ("period",)
 
-    period: int = field(30, "fringe period T in projector pixels")
     form: str = field("pair", "pair: a cos/sin coded pair; shifted: N-step coded patterns",
                       choices=("pair", "shifted"))
 
     @property
     def levels(self) -> int:
         """Stair levels: one per fringe across the coded axis."""
-        return -(-self.coded_length // self.period)
+        return self.fringes
 
     def _frames(self) -> tuple[str, ...]:
-        shifts = tuple(f"shift-{n}" for n in range(self.steps))
+        shifts = self.shift_frames()
         if self.form == "pair":
             return (*shifts, "code-cos", "code-sin")
         return (*shifts, *(f"code-{n}" for n in range(self.steps)))
 
     def validate(self) -> None:
         super().validate()
-        if self.period < 4:
-            raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
         if self.form not in ("pair", "shifted"):
             raise BistairError(f"form must be pair or shifted, got {self.form!r}")
         if self.levels < 2:
@@ -89,8 +85,7 @@ def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:
     else:
         steps = TWO_PI * np.arange(spec.steps)[:, None] / spec.steps
         coded = spec.offset + spec.amplitude * np.cos(code[None, :] + steps)
-    rows = np.concatenate([shifts, coded])[:, None, :]
-    return np.broadcast_to(rows, (rows.shape[0], spec.other_length, x.size)).astype(np.float32)
+    return along_columns(np.concatenate([shifts, coded]), spec)
 
 
 def code_phase(prepared: Prepared, spec: PhaseCodingSpec, avg: np.ndarray) -> np.ndarray:
