@@ -34,6 +34,13 @@ class FringeSet:
     mod: np.ndarray  # modulation B
     valid: np.ndarray  # enough modulation, not saturated
     noise: float  # camera noise sigma estimated from the fit residual
+    steps: int | None = None  # N
+
+    @property
+    def phase_noise(self) -> np.ndarray:
+        """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``."""
+        steps = 4 if self.steps is None else self.steps
+        return self.noise / (np.maximum(self.mod, 1e-6) * np.sqrt(steps / 2.0))
 
 
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,
@@ -48,4 +55,4 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     valid = validity(mod, saturation(prepared.clipped, avg, mod), noise, min_modulation)
     if check:
         check_decodable(valid, prepared.clipped)
-    return FringeSet(phi, avg, mod, valid, noise)
+    return FringeSet(phi, avg, mod, valid, noise, steps)

@@ -28,19 +28,61 @@ from scipy import ndimage
 from .phase import TWO_PI
 
 
-def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray,
-               cut: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray, cut: float,
+               sigma: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For the links between pixels ``a`` and ``b``: (connected, drop_a, drop_b).
 
     A wrap link drops its high-phase end, a phase step both ends, so that 4-connected
-    components of the pixels kept never cross a cut link.
+    components of the pixels kept never cross a cut link. With ``sigma`` (the noise of each
+    link's phase difference, for links along the rows), a run of links whose phase falls
+    by more than four sigma is a step too.
     """
     raw = b - a
     both = va & vb
     wrap = both & (np.abs(raw) > np.pi)
     step = both & ~wrap & (np.abs(raw) > cut)
+    if sigma is not None:
+        step |= _backward_runs(raw, both & ~wrap & ~step, sigma)
     connected = both & ~wrap & ~step
     return connected, (wrap & (raw <= 0)) | step, (wrap & (raw > 0)) | step
+
+
+def _backward_runs(raw: np.ndarray, ok: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """Links in runs (along each row) where the phase falls by more than noise explains.
+
+    Blur spreads the fall where two surfaces meet over a few pixels, so the test is on the
+    whole run of falling links, not on each. A run's fall is the difference of its end
+    pixels, whose noise does not grow with the run's length.
+    """
+    falling = (ok & (raw < 0)).ravel()
+    start = falling.copy()
+    start[1:] &= ~falling[:-1]
+    start[::raw.shape[1]] = falling[::raw.shape[1]]  # runs do not cross rows
+    run = np.cumsum(start) - 1
+    idx = np.flatnonzero(falling)
+    if idx.size == 0:
+        return np.zeros(raw.shape, bool)
+    n_runs = int(run[idx[-1]]) + 1
+    drop = np.bincount(run[idx], -raw.ravel()[idx], n_runs)
+    noise = np.zeros(n_runs)
+    np.maximum.at(noise, run[idx], np.broadcast_to(sigma, raw.shape).ravel()[idx])
+    bad = drop > np.maximum(0.15, 4.0 * noise)
+    out = np.zeros(falling.size, bool)
+    out[idx] = bad[run[idx]]
+    return out.reshape(raw.shape)
+
+
+def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
+    """+1 if the phase mostly grows along rows (left to right), -1 if it falls.
+
+    Along the coded axis the phase of one lit surface is monotonic (the projector and camera
+    see its points in the same order); a reversal marks where two surfaces meet.
+    """
+    a, b = phi[::4, :-1], phi[::4, 1:]
+    ok = valid[::4, :-1] & valid[::4, 1:]
+    diff = (b - a)[ok]
+    diff = (diff + np.pi) % TWO_PI - np.pi
+    return 1 if diff.size == 0 or np.median(diff) >= 0 else -1
 
 
 def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
@@ -58,8 +100,14 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
-                   min_size: int = 20) -> tuple[np.ndarray, int]:
+                   min_size: int = 20, phase_noise: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
+
+    Links are cut at wraps, at steps above ``cut`` and, along the rows, where the phase runs
+    backwards (against :func:`fringe_direction`) by more than noise explains
+    (``phase_noise``: per-pixel phase noise in radians, 0.02 when not given): that is where
+    one surface meets another.
 
     Returns ``(labels, n)``: int32 labels 1..n, 0 outside any region. Regions smaller than
     ``min_size`` pixels are dropped (left 0) so that noise islands never vote.
@@ -67,9 +115,19 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     valid = np.asarray(valid, dtype=bool)
     if cut is None:
         cut = default_cut(phi, valid)
+    if phase_noise is None:
+        sigma = np.full((phi.shape[0], phi.shape[1] - 1), 0.02 * np.sqrt(2.0))
+    else:  # noise of the difference of two neighbours
+        sigma = np.sqrt(2.0) * np.maximum(phase_noise[:, :-1], phase_noise[:, 1:])
+    sign = fringe_direction(phi, valid)
     vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
-    horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
-                                              valid[:, 1:], cut)
+    if sign > 0:
+        horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
+                                                  valid[:, 1:], cut, sigma)
+    else:  # walk the rows the other way
+        horiz, drop_right, drop_left = _link_cuts(phi[:, 1:], phi[:, :-1], valid[:, 1:],
+                                                  valid[:, :-1], cut, sigma[:, ::-1])
+        horiz, drop_right, drop_left = horiz[:, ::-1], drop_right[:, ::-1], drop_left[:, ::-1]
     keep = valid.copy()
     keep[:-1] &= ~drop_up
     keep[1:] &= ~drop_down
@@ -133,17 +191,22 @@ def region_links(phi: np.ndarray, labels: np.ndarray) -> RegionLinks:
     """Pairs of regions that touch across a phase wrap, with the expected order step.
 
     Walking from a pixel to its right or lower neighbour, a wrap from high to low phase means
-    the order grows by one, a wrap from low to high that it falls by one. Each touching pair
-    is reported once per direction of walk (``src`` before ``dst``).
+    the order grows by one, a wrap from low to high that it falls by one. Along the rows, a
+    wrap against the phase's direction (:func:`fringe_direction`) joins two surfaces, not two
+    fringes, and is left out. Each touching pair is reported once per direction of walk
+    (``src`` before ``dst``).
     """
+    sign = fringe_direction(phi, labels > 0)
     src, dst, step = [], [], []
-    for a, b, la, lb in ((phi[:-1], phi[1:], labels[:-1], labels[1:]),
-                         (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:])):
+    for a, b, la, lb, along in ((phi[:-1], phi[1:], labels[:-1], labels[1:], False),
+                                (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:], True)):
         sel = (la != lb) & (la > 0) & (lb > 0)
         sel[sel] = np.abs(b[sel] - a[sel]) > np.pi
-        src.append(la[sel])
-        dst.append(lb[sel])
-        step.append(np.where(a[sel] > b[sel], 1, -1))
+        st = np.where(a[sel] > b[sel], 1, -1)
+        keep = st == sign if along else np.ones(st.size, bool)
+        src.append(la[sel][keep])
+        dst.append(lb[sel][keep])
+        step.append(st[keep])
     s, d, st = (np.concatenate(v).astype(np.int64) for v in (src, dst, step))
     if s.size == 0:
         empty = np.zeros(0, np.int64)

@@ -55,7 +55,7 @@ from ..bands import (
 )
 from ..captures import Prepared
 from ..errors import BistairError
-from ..fringes import measure
+from ..fringes import FringeSet, measure
 from ..order import mode_by_label, phase_from_regions
 from ..phase import TWO_PI, phase_shift_patterns
 from ..regions import core_weight, fringe_regions
@@ -138,17 +138,18 @@ def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = 
     ks = np.where(valid, quantize(theta, spec.stairs), -1).astype(np.int32)
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(valid.sum())}
     if strategy == "paper":
-        order = _paper_orders(ks, theta, valid, phi, spec)
+        order = _paper_orders(ks, theta, fs, spec)
         abs_phase = np.where(order >= 0, phi + TWO_PI * order, np.nan)
     else:
-        abs_phase = _region_phase(phi, fs.mod, theta, stair_mod, valid, spec, info)
+        abs_phase = _region_phase(fs, theta, stair_mod, spec, info)
     return result_from_phase("bidirectional", fs, abs_phase, spec.period, code=ks, info=info)
 
 
-def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod: np.ndarray,
-                  valid: np.ndarray, spec: BidirectionalSpec, info: dict) -> np.ndarray:
-    labels, n_reg = fringe_regions(phi, valid)
-    ratio = np.clip(stair_mod / np.maximum(mod, 1e-6), 0.0, 2.0)
+def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray,
+                  spec: BidirectionalSpec, info: dict) -> np.ndarray:
+    phi, valid = fs.phi, fs.valid
+    labels, n_reg = fringe_regions(phi, valid, phase_noise=fs.phase_noise)
+    ratio = np.clip(stair_mod / np.maximum(fs.mod, 1e-6), 0.0, 2.0)
     weight = core_weight(phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
     prof = row_profiles(labels, theta, weight, ratio)
@@ -166,12 +167,12 @@ def _region_phase(phi: np.ndarray, mod: np.ndarray, theta: np.ndarray, stair_mod
     return phase_from_regions(phi, valid, labels, evidence, info)
 
 
-def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.ndarray,
+def _paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
                   spec: BidirectionalSpec) -> np.ndarray:
     """The paper's column scan (Sec. 2.3) and per-fringe mode (Sec. 3)."""
     S, P = spec.stairs, spec.partitions
     h, w = ks.shape
-    v = valid.T.ravel()
+    v = fs.valid.T.ravel()
     t = theta.T.ravel()
     # Runs of equal k_s; with P != S the levels of both stairs are told apart.
     q = ks.T.ravel() if P == S else nearest_level(t, union_levels(P, S))
@@ -209,7 +210,8 @@ def _paper_orders(ks: np.ndarray, theta: np.ndarray, valid: np.ndarray, phi: np.
     order = np.full(v.size, -1, np.int64)
     order[pix] = k_group[group[run_of]]
     order = order.reshape(w, h).T
-    fringes, n_fringes = fringe_regions(phi, valid, min_size=1)
+    fringes, n_fringes = fringe_regions(fs.phi, fs.valid, min_size=1,
+                                        phase_noise=fs.phase_noise)
     mode, _ = mode_by_label(fringes, order, n_fringes, S * P)
     return np.where(fringes > 0, mode[fringes], -1)
 

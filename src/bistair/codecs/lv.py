@@ -157,7 +157,7 @@ def decode_columns(prepared: Prepared, spec: LvSpec,
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1)
-    labels, n_reg = fringe_regions(fs.phi, fs.valid)
+    labels, n_reg = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     shares = code_evidence(labels, n_reg, codes, spec.levels, core_weight(fs.phi))
     region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
     region_code[0] = -1

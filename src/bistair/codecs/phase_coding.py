@@ -106,7 +106,7 @@ def decode_columns(prepared: Prepared, spec: PhaseCodingSpec, strategy: str = "r
     if strategy == "pixel":
         abs_phase = np.where(codes >= 0, fs.phi + TWO_PI * codes, np.nan)
     else:
-        labels, n_reg = fringe_regions(fs.phi, fs.valid)
+        labels, n_reg = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
         evidence = code_evidence(labels, n_reg, codes, spec.levels, core_weight(fs.phi))
         abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence, info)
     return result_from_phase("phase-coding", fs, abs_phase, spec.period,
