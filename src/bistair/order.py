@@ -17,7 +17,10 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
+from scipy import ndimage
 
 from .phase import TWO_PI
 from .regions import RegionLinks, fill_from_neighbours, region_links
@@ -89,29 +92,82 @@ def jump_violations(links: RegionLinks, region_order: np.ndarray) -> tuple[int, 
     return int(links.count[bad].sum()), int(links.count[both].sum())
 
 
+Evidence = Callable[[np.ndarray, int], tuple[np.ndarray, int, np.ndarray]]
+Agreement = Callable[[np.ndarray], np.ndarray]
+
+
 def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
-                       evidence: np.ndarray, info: dict | None = None, min_score: float = 0.5,
+                       evidence_of: Evidence, agrees: Agreement | None = None,
+                       info: dict | None = None, min_score: float = 0.5,
                        min_margin: float = 0.1) -> np.ndarray:
     """Absolute phase from fringe regions and each region's evidence for every order.
 
-    Regions are resolved with their wrap links (:func:`resolve_regions`); a region whose
-    best order scores below ``min_score`` or leads the runner-up by less than ``min_margin``
-    stays invalid. Valid pixels outside any region (cut off at a wrap, or in a noise island)
-    take the order that makes their phase continuous with the nearest decoded pixel within
-    3 px. ``info`` receives the counts and the wrap-consistency check.
+    ``evidence_of(labels, n)`` returns ``(labels, n, evidence)``, the codec's evidence for
+    every order per region (it may refine the labels). Regions are resolved with their wrap
+    links (:func:`resolve_regions`); a region whose best order scores below ``min_score`` or
+    leads the runner-up by less than ``min_margin`` stays invalid. With ``agrees`` (which
+    pixels' own codes fit a given per-pixel order), parts of regions whose codes contradict
+    their region's order are detached and decoded on their own (:func:`split_disagreeing`).
+    Valid pixels outside any region (cut off at a wrap, or in a noise island) take the order
+    that makes their phase continuous with the nearest decoded pixel within 3 px. ``info``
+    receives the counts and the wrap-consistency check.
     """
-    links = region_links(phi, labels)
-    k_reg, score, margin = resolve_regions(evidence, links)
-    k_reg[(score < min_score) | (margin < min_margin)] = -1
-    k_reg[0] = -1
-    bad, total = jump_violations(links, k_reg)
+    labels, n, evidence = evidence_of(labels, int(labels.max()))
+    k_reg = _decide(phi, labels, evidence, min_score, min_margin)
+    detached = 0
+    if agrees is not None:
+        labels, n, detached = split_disagreeing(labels, n, k_reg, agrees)
+    if detached:
+        labels, n, evidence = evidence_of(labels, n)
+        k_reg = _decide(phi, labels, evidence, min_score, min_margin)
     if info is not None:
-        info.update(regions=int(evidence.shape[0] - 1),
-                    regions_decoded=int((k_reg[1:] >= 0).sum()), jump_violations=bad,
-                    jump_links=total)
+        bad, total = jump_violations(region_links(phi, labels), k_reg)
+        info.update(regions=n, regions_decoded=int((k_reg[1:] >= 0).sum()),
+                    regions_detached=detached, jump_violations=bad, jump_links=total)
     k_pix = k_reg[labels]
     abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
     return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
+
+
+def _decide(phi: np.ndarray, labels: np.ndarray, evidence: np.ndarray, min_score: float,
+            min_margin: float) -> np.ndarray:
+    k_reg, score, margin = resolve_regions(evidence, region_links(phi, labels))
+    k_reg[(score < min_score) | (margin < min_margin)] = -1
+    k_reg[0] = -1
+    return k_reg
+
+
+def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agreement,
+                      window: int = 7, share: float = 0.7, min_size: int = 30
+                      ) -> tuple[np.ndarray, int, int]:
+    """Detach the parts of regions whose pixels' codes contradict the region's order.
+
+    Where two surfaces meet with a phase step close to a whole number of fringes, a fringe
+    of one joins a fringe of the other into one region, and the larger part's order wins.
+    The smaller part's codes then disagree with it: pixels in a neighbourhood
+    (``window`` x ``window``) where more than ``share`` of the decided pixels disagree seed a
+    part, which grows over the region's other disagreeing pixels. Parts of at least
+    ``min_size`` pixels become regions of their own; smaller ones are left undecided.
+    Returns ``(labels, n, parts detached)``.
+    """
+    k_pix = np.where(labels > 0, k_reg[labels], -1)
+    decided = k_pix >= 0
+    bad = decided & ~agrees(k_pix)
+    if not bad.any():
+        return labels, n, 0
+    num = ndimage.uniform_filter(bad.astype(np.float32), window)
+    den = ndimage.uniform_filter(decided.astype(np.float32), window)
+    seeds = bad & (num > share * den)
+    if not seeds.any():
+        return labels, n, 0
+    grown = ndimage.binary_propagation(seeds, mask=bad)
+    parts, m = ndimage.label(grown)
+    key = parts.astype(np.int64) * (n + 1) + labels
+    uniq, inv, size = np.unique(key[grown], return_inverse=True, return_counts=True)
+    new = np.where(size >= min_size, n + 1 + np.cumsum(size >= min_size) - 1, 0)
+    labels = labels.copy()
+    labels[grown] = new[inv]
+    return labels, n + int((size >= min_size).sum()), int((size >= min_size).sum())
 
 
 def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes: int,

@@ -147,24 +147,35 @@ def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = 
 
 def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray,
                   spec: BidirectionalSpec, info: dict) -> np.ndarray:
-    phi, valid = fs.phi, fs.valid
-    labels, n_reg = fringe_regions(phi, valid, phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     ratio = np.clip(stair_mod / np.maximum(fs.mod, 1e-6), 0.0, 2.0)
-    weight = core_weight(phi) * np.minimum(ratio, 1.0)
+    weight = core_weight(fs.phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
-    prof = row_profiles(labels, theta, weight, ratio)
-    runs = row_runs(prof, levels)
-    splits = band_splits(runs)
-    if splits:  # surfaces stacked in one fringe region: decode them apart
-        labels, n_reg = split_regions(labels, n_reg, splits)
+
+    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         prof = row_profiles(labels, theta, weight, ratio)
         runs = row_runs(prof, levels)
-    heights = group_heights(runs, n_reg, profile_centroids(prof, n_reg))
-    default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
-    layout = BandLayout(spec.stairs, spec.partitions, spec.local_rows / spec.group_rows, default)
-    evidence = region_evidence(runs, n_reg, heights, layout)
-    info.update(region_splits=len(splits), group_height=default)
-    return phase_from_regions(phi, valid, labels, evidence, info)
+        splits = band_splits(runs)
+        if splits:  # surfaces stacked in one fringe region: decode them apart
+            labels, n = split_regions(labels, n, splits)
+            prof = row_profiles(labels, theta, weight, ratio)
+            runs = row_runs(prof, levels)
+        heights = group_heights(runs, n, profile_centroids(prof, n))
+        default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
+        layout = BandLayout(spec.stairs, spec.partitions, spec.local_rows / spec.group_rows,
+                            default)
+        info.update(region_splits=info.get("region_splits", 0) + len(splits),
+                    group_height=default)
+        return labels, n, region_evidence(runs, n, heights, layout)
+
+    q_local = quantize(theta, spec.stairs)
+    q_part = quantize(theta, spec.partitions)
+
+    def agrees(k: np.ndarray) -> np.ndarray:
+        """A pixel reads its order's local or partition level (its row decides which)."""
+        return (q_local == k % spec.stairs) | (q_part == k // spec.stairs)
+
+    return phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
 
 
 def _paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,

@@ -128,27 +128,53 @@ def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:
 
 def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.ndarray,
                     spec: LvSpec) -> np.ndarray:
-    """Votes of every chain of ``window`` adjacent regions for its members' orders."""
+    """Votes of every chain of ``window`` adjacent regions for its members' orders.
+
+    Each region starts a window (itself and the next ``window - 1`` regions up); the window's
+    codes are looked up in the sequence. Overlapping windows check each other: a window
+    whose neighbour (starting one region before or after) was found elsewhere than one place
+    before or after it is contradicted and does not vote; one with neighbours must be
+    confirmed by one of them. A region's evidence is the share of its windows voting for
+    each order, weighted by the least sure code in the window.
+    """
     n_reg = region_code.size - 1
-    lookup = {tuple(spec.sequence[i:i + spec.window]): i
-              for i in range(spec.fringes - spec.window + 1)}
+    table = np.full(spec.levels ** spec.window, -1, np.int64)
+    seq = np.asarray(spec.sequence)
+    for i in range(spec.fringes - spec.window + 1):
+        table[_window_key(seq[i:i + spec.window][None], spec.levels)[0]] = i
     members = [np.arange(n_reg + 1)]
     for _ in range(spec.window - 1):
         prev = members[-1]
         members.append(np.where(prev >= 0, succ[np.maximum(prev, 0)], -1))
-    chain = np.stack(members, axis=1)[1:]  # rows: regions 1..n as window starts
-    ok = (chain >= 0).all(axis=1) & (region_code[np.maximum(chain, 0)] >= 0).all(axis=1)
-    votes = np.zeros((n_reg + 1, spec.fringes))
+    chain = np.stack(members, axis=1)
+    safe = np.maximum(chain, 0)
+    distinct = np.array([np.unique(row).size == spec.window for row in chain])
+    ok = (chain >= 0).all(axis=1) & (region_code[safe] >= 0).all(axis=1) & distinct
+    ok[0] = False
+    start = np.where(ok, table[_window_key(region_code[safe], spec.levels)], -1)
+    ok &= start >= 0
+    pred = np.full(n_reg + 1, -1, np.int64)
+    has_succ = succ >= 0
+    pred[succ[has_succ]] = np.flatnonzero(has_succ)
+    after = np.where(succ >= 0, start[np.maximum(succ, 0)], -1)
+    before = np.where(pred >= 0, start[np.maximum(pred, 0)], -1)
+    contradicted = ((after >= 0) & (after != start + 1)) | ((before >= 0) & (before != start - 1))
+    confirmed = (after == start + 1) | (before == start - 1)
+    neighbours = (after >= 0) | (before >= 0)
+    vote = ok & ~contradicted & (confirmed | ~neighbours)
     seen = np.zeros(n_reg + 1)
-    for row in chain[ok]:
-        if np.unique(row).size < spec.window:
-            continue
-        weight = confidence[row].min()
-        np.add.at(seen, row, 1.0)
-        start = lookup.get(tuple(region_code[row]))
-        if start is not None:
-            np.add.at(votes, (row, start + np.arange(spec.window)), weight)
+    np.add.at(seen, chain[ok | (start < 0) & (chain >= 0).all(axis=1)].ravel(), 1.0)
+    votes = np.zeros((n_reg + 1, spec.fringes))
+    rows = np.flatnonzero(vote)
+    weight = confidence[chain[rows]].min(axis=1)
+    for j in range(spec.window):
+        np.add.at(votes, (chain[rows, j], start[rows] + j), weight)
     return votes / np.maximum(seen, 1.0)[:, None]
+
+
+def _window_key(codes: np.ndarray, levels: int) -> np.ndarray:
+    """One integer per row of window codes."""
+    return (codes * levels ** np.arange(codes.shape[1] - 1, -1, -1)).sum(axis=1)
 
 
 def decode_columns(prepared: Prepared, spec: LvSpec,
@@ -157,14 +183,21 @@ def decode_columns(prepared: Prepared, spec: LvSpec,
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1)
-    labels, n_reg = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-    shares = code_evidence(labels, n_reg, codes, spec.levels, core_weight(fs.phi))
-    region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
-    region_code[0] = -1
-    succ = _successors(region_links(fs.phi, labels), n_reg)
-    evidence = window_evidence(region_code, shares.max(axis=1), succ, spec)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    weight = core_weight(fs.phi)
+
+    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+        shares = code_evidence(labels, n, codes, spec.levels, weight)
+        region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
+        region_code[0] = -1
+        succ = _successors(region_links(fs.phi, labels), n)
+        return labels, n, window_evidence(region_code, shares.max(axis=1), succ, spec)
+
+    sequence = np.asarray(spec.sequence)
     info = {"noise": fs.noise, "fringes": spec.fringes}
-    abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence, info)
+    abs_phase = phase_from_regions(
+        fs.phi, fs.valid, labels, evidence_of, info=info,
+        agrees=lambda k: (codes == sequence[np.clip(k, 0, None)]) | (codes < 0))
     return result_from_phase("lv", fs, abs_phase, spec.period, code=codes.astype(np.int32),
                              info=info)
 

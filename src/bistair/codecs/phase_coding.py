@@ -106,9 +106,18 @@ def decode_columns(prepared: Prepared, spec: PhaseCodingSpec, strategy: str = "r
     if strategy == "pixel":
         abs_phase = np.where(codes >= 0, fs.phi + TWO_PI * codes, np.nan)
     else:
-        labels, n_reg = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-        evidence = code_evidence(labels, n_reg, codes, spec.levels, core_weight(fs.phi))
-        abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence, info)
+        labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+        weight = core_weight(fs.phi)
+
+        def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+            return labels, n, code_evidence(labels, n, codes, spec.levels, weight)
+
+        def agrees(k: np.ndarray) -> np.ndarray:
+            """Noise moves a code a level or so; another surface's fringe moves it more."""
+            off = np.abs(codes - k) % spec.levels
+            return (np.minimum(off, spec.levels - off) <= 1) | (codes < 0)
+
+        abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
     return result_from_phase("phase-coding", fs, abs_phase, spec.period,
                              code=codes.astype(np.int32), info=info)
 
