@@ -1,0 +1,324 @@
+"""Calibration: the maths on exact correspondences, board detection, the calibration file,
+the whole chain on the virtual rig (calibrate -> reconstruct) and every bad-input path."""
+
+from __future__ import annotations
+
+import json
+import shutil
+
+import cv2
+import numpy as np
+import pytest
+
+import bistair
+from bistair.board import Board
+from bistair.calib import (
+    Calibration,
+    Device,
+    PoseCapture,
+    calibrate_folder,
+    calibrate_points,
+    calibrate_poses,
+    load_calibration,
+    sample_local,
+    save_calibration,
+    synthetic_views,
+)
+from bistair.errors import BistairError
+from bistair.io import write_image
+from bistair.reconstruct import reconstruct_folder
+from bistair.sim import Imaging, Plane, Rig, Scene, Sphere, euler, expose, trace
+
+BOARD = Board("checkerboard", 9, 6, 20.0)
+# board poses (degrees about x, y, z; feature centre in mm): tilted up to 25 degrees and spread
+# toward the image corners, all inside both devices' views
+POSES = [(0, 0, 0, 0, 0, 600), (20, 0, 0, -50, -35, 620), (-20, 0, 5, 50, 35, 580),
+         (0, 25, 0, 50, -35, 600), (0, -25, -5, -50, 35, 640), (15, 15, 10, -50, 0, 560),
+         (-15, -15, -10, 50, 0, 650), (10, -20, 0, 0, 40, 600)]
+
+
+def one_line(exc: pytest.ExceptionInfo) -> str:
+    message = str(exc.value)
+    assert "\n" not in message
+    return message
+
+
+def toy_truth() -> Calibration:
+    cam = Device(640, 480, [[800.0, 0, 322], [0, 805, 236], [0, 0, 1]],
+                 [-0.1, 0.05, 0.001, -0.0005, 0])
+    proj = Device(800, 600, [[1000.0, 0, 405], [0, 1002, 420], [0, 0, 1]], [0.04, 0, 0, 0, 0])
+    rot = cv2.Rodrigues(np.array([0.02, 0.3, -0.01]))[0]
+    return Calibration(cam, proj, rot, np.array([-150.0, 3.0, 45.0]))
+
+
+def assert_close(cal: Calibration, truth: Calibration, focal: float, centre: float,
+                 baseline: float, angle_deg: float) -> None:
+    for name in ("camera", "projector"):
+        got, want = getattr(cal, name), getattr(truth, name)
+        assert np.abs(np.diag(got.K)[:2] / np.diag(want.K)[:2] - 1).max() < focal, name
+        assert np.abs(got.K[:2, 2] - want.K[:2, 2]).max() < centre, name
+    assert abs(cal.baseline - truth.baseline) < baseline
+    assert np.rad2deg(np.linalg.norm(cv2.Rodrigues(cal.R @ truth.R.T)[0])) < angle_deg
+
+
+# -- maths ---------------------------------------------------------------------------------
+def test_exact_correspondences_give_the_exact_rig():
+    truth = toy_truth()
+    views = synthetic_views(truth, BOARD, 8, np.random.default_rng(1))
+    cal = calibrate_points(*views, truth.camera.size, truth.projector.size)
+    assert_close(cal, truth, focal=1e-6, centre=1e-3, baseline=1e-4, angle_deg=1e-5)
+    assert np.allclose(cal.camera.dist, truth.camera.dist, atol=1e-4)  # float32 points
+    assert np.allclose(cal.T, truth.T, atol=1e-4) and cal.rms < 1e-4
+    assert len(cal.poses) == 8 and cal.poses[0]["features"] == 54
+
+
+def test_noisy_correspondences_stay_close():
+    truth = toy_truth()
+    views = synthetic_views(truth, BOARD, 10, np.random.default_rng(2), noise=0.1)
+    cal = calibrate_points(*views, truth.camera.size, truth.projector.size)
+    # measured: focal lengths within 0.09%, principal points 1.4 px, baseline 0.24 mm,
+    # rotation 0.09 deg, RMS 0.14 px
+    assert_close(cal, truth, focal=0.003, centre=3.0, baseline=0.6, angle_deg=0.25)
+    assert 0.05 < cal.rms < 0.2
+
+
+def test_sample_local_needs_pixels_on_every_side():
+    v, u = np.mgrid[0:30, 0:30].astype(float)
+    maps = np.stack([u + 0.5 * v, 2 * v])
+    maps[:, :, 16:] = np.nan  # the point's right-hand side is invalid
+    out = sample_local(maps, np.array([[10.2, 12.7], [15.5, 15.0]]), 4)
+    assert np.allclose(out[:, 0], [10.2 + 0.5 * 12.7, 25.4])
+    assert np.isnan(out[:, 1]).all()
+
+
+# -- boards --------------------------------------------------------------------------------
+def board_image(board: Board, cam: np.ndarray, rot: np.ndarray, t: np.ndarray,
+                size=(640, 480)) -> np.ndarray:
+    """The board's albedo seen by a pinhole camera (3 x 3 samples per pixel)."""
+    hom = np.linalg.inv(cam @ np.column_stack([rot[:, 0], rot[:, 1], t]))  # image -> board
+    v, u = np.mgrid[0:size[1], 0:size[0]].astype(float)
+    acc = np.zeros(u.shape)
+    for du in (np.arange(3) + 0.5) / 3 - 0.5:
+        for dv in (np.arange(3) + 0.5) / 3 - 0.5:
+            p = np.stack([u + du, v + dv, np.ones_like(u)], -1).reshape(-1, 3) @ hom.T
+            acc += board.albedo(p[:, :2] / p[:, 2:]).reshape(u.shape) / 9
+    return acc
+
+
+@pytest.mark.parametrize("kind", ["checkerboard", "circles", "asymmetric-circles"])
+def test_board_detection_on_a_tilted_view(kind):
+    board = Board(kind, 7, 5, 20.0)
+    cam = np.array([[900.0, 0, 320], [0, 900, 240], [0, 0, 1]])
+    rot = cv2.Rodrigues(np.deg2rad([15.0, -20.0, 8.0]))[0]
+    obj = board.object_points().astype(float)
+    t = np.array([0.0, 0.0, 700.0]) - rot @ obj.mean(axis=0)
+    found = board.detect(board_image(board, cam, rot, t))
+    want = cv2.projectPoints(obj, cv2.Rodrigues(rot)[0], t, cam, None)[0].reshape(-1, 2)
+    if np.linalg.norm(found[0] - want[0]) > np.linalg.norm(found[0] - want[-1]):
+        found = found[::-1]  # a half-turn of the labels is a rigid relabelling
+    assert np.abs(found - want).max() < (0.2 if kind == "checkerboard" else 0.5)
+    assert board.detect(np.full((480, 640), 0.5)) is None
+
+
+def test_boards_without_phases_are_refused():
+    cam = np.array([[900.0, 0, 320], [0, 900, 240], [0, 0, 1]])
+    t = np.array([0.0, 0.0, 700.0]) - BOARD.object_points().mean(axis=0)
+    white = board_image(BOARD, cam, np.eye(3), t)
+    nowhere = np.full(white.shape, np.nan)
+    poses = [PoseCapture(f"p{i}", white, nowhere, nowhere) for i in range(3)]
+    with pytest.raises(BistairError) as exc:
+        calibrate_poses(poses, BOARD, (96, 64))
+    assert one_line(exc).startswith("board features mapped to the projector in 0 of 3 poses")
+
+
+def test_board_description_errors():
+    with pytest.raises(BistairError, match="misses field"):
+        Board.from_dict({"type": "checkerboard", "columns": 9})
+    with pytest.raises(BistairError, match="board type"):
+        Board.from_dict({"type": "hexagons", "columns": 9, "rows": 6, "spacing": 20})
+    with pytest.raises(BistairError, match="integers"):
+        Board.from_dict({"type": "circles", "columns": 9.5, "rows": 6, "spacing": 20})
+
+
+# -- the calibration file --------------------------------------------------------------------
+def test_calibration_file_round_trip_and_errors(tmp_path):
+    cal = toy_truth()
+    path = save_calibration(cal, tmp_path / "calib.json")
+    back = load_calibration(path)
+    assert np.allclose(back.R, cal.R) and np.allclose(back.projector.K, cal.projector.K)
+    assert back.camera.size == (640, 480) and back.baseline == pytest.approx(cal.baseline)
+    data = json.loads(path.read_text())
+    bad = {"not json": "{", "no camera": {**data, "camera": None},
+           "bad K": {**data, "projector": {**data["projector"], "K": [[1, 2], [3, 4]]}},
+           "not a rotation": {**data, "R": (2 * np.eye(3)).tolist()},
+           "no T": {k: v for k, v in data.items() if k != "T"},
+           "other format": {**data, "format": "something"}}
+    for name, content in bad.items():
+        p = tmp_path / f"{name}.json"
+        p.write_text(content if isinstance(content, str) else json.dumps(content))
+        with pytest.raises(BistairError) as exc:
+            load_calibration(p)
+        assert one_line(exc).startswith(f"calibration file {p}"), name
+    with pytest.raises(BistairError, match="not found"):
+        load_calibration(tmp_path / "missing.json")
+
+
+# -- the whole chain on the virtual rig -----------------------------------------------------------
+def sim_rig() -> Rig:
+    return Rig.default(camera_size=(640, 512), projector_size=(960, 540), projector_focal=1000,
+                       camera_dist=(-0.08, 0.05, 0, 0, 0), projector_dist=(0.03, 0, 0, 0, 0))
+
+
+def sim_spec(orientation: str) -> bistair.spec.BaseSpec:
+    return bistair.make_spec("multifreq", width=960, height=540, periods=(960, 120, 15),
+                             orientation=orientation, white=1, gamma=2.2)
+
+
+def board_plane(board: Board, rx: float, ry: float, rz: float, *centre: float) -> Plane:
+    """The printed board as a plane with its albedo, its features centred on ``centre``."""
+    rot = euler(rx, ry, rz)
+    x0, y0, x1, y1 = board.extent()
+    t = np.array(centre) - rot @ board.object_points().mean(axis=0)
+    return Plane(center=rot @ [(x0 + x1) / 2, (y0 + y1) / 2, 0] + t, normal=rot[:, 2],
+                 x_axis=rot[:, 0], size=(x1 - x0, y1 - y0),
+                 albedo=lambda p: board.albedo((p - t) @ rot[:, :2]))
+
+
+def write_pose(folder, images, spec) -> None:
+    folder.mkdir(parents=True)
+    for i, img in enumerate(images):
+        write_image(folder / f"{i:02d}.tif", img)  # uncompressed: quicker than PNG
+    (folder / "spec.json").write_text(spec.to_json())
+
+
+@pytest.fixture(scope="module")
+def captures(tmp_path_factory):
+    """Eight board poses in the capture layout, and the rig that took them."""
+    rig, root = sim_rig(), tmp_path_factory.mktemp("calib")
+    (root / "board.json").write_text(json.dumps(BOARD.to_dict()))
+    specs = {o: sim_spec(o) for o in ("columns", "rows")}
+    patterns = {o: bistair.encode(s) for o, s in specs.items()}
+    for i, pose in enumerate(POSES):
+        traced = trace(rig, Scene([board_plane(BOARD, *pose)]), Imaging(seed=i))
+        for o in specs:
+            write_pose(root / f"pose-{i:02d}" / o, expose(traced, patterns[o]), specs[o])
+    return root, rig
+
+
+def test_calibrate_then_reconstruct_on_the_virtual_rig(captures, tmp_path):
+    root, rig = captures
+    cal = calibrate_folder(root, out=tmp_path / "calib.json")
+    truth = Calibration.from_rig(rig)
+    # measured: focal lengths +0.18% (camera) and +0.14% (projector), principal points
+    # within 0.9 px, baseline +0.02 mm of 200 mm, rotation 0.08 deg, stereo RMS 0.08 px
+    assert_close(cal, truth, focal=0.005, centre=3.0, baseline=1.0, angle_deg=0.2)
+    assert cal.rms < 0.2 and len(cal.poses) == len(POSES)
+    saved = load_calibration(tmp_path / "calib.json")
+    assert saved.board == BOARD.to_dict() and saved.poses_total == len(POSES)
+    assert np.allclose(saved.camera.K, cal.camera.K) and np.allclose(saved.T, cal.T)
+
+    # a sphere measured with the recovered calibration
+    scene = Scene([Sphere(center=(10, -5, 560), radius=45, albedo=0.8)])
+    traced = trace(rig, scene, Imaging(seed=11))
+    spec = sim_spec("columns")
+    np.save(tmp_path / "sphere.npy", expose(traced, bistair.encode(spec)))
+    rec = reconstruct_folder(tmp_path / "sphere.npy", spec, tmp_path / "calib.json",
+                             tmp_path / "sphere.ply")
+    pts = rec.points[rec.mask & traced.truth.mask].astype(float)
+    centre, radius = fit_sphere(pts)
+    # measured: radius -0.03 mm, centre 0.9 mm (0.8 mm along the camera axis: the focal
+    # lengths' error); with the rig's true calibration 0.001 mm and 0.02 mm
+    assert abs(radius - 45) < 0.3
+    assert np.linalg.norm(centre - [10, -5, 560]) < 2.0
+
+
+def fit_sphere(pts: np.ndarray) -> tuple[np.ndarray, float]:
+    sol = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), (pts**2).sum(1),
+                          rcond=None)[0]
+    return sol[:3], float(np.sqrt(sol[3] + sol[:3] @ sol[:3]))
+
+
+# -- bad input ---------------------------------------------------------------------------------
+def small_pose_set(root, poses: int = 3):
+    """Capture folders that decode but show no board: the 96 x 64 patterns themselves."""
+    specs = {o: bistair.make_spec("multifreq", width=96, height=64, periods=(96, 16),
+                                  orientation=o, white=1) for o in ("columns", "rows")}
+    (root / "board.json").write_text(json.dumps(BOARD.to_dict()))
+    for i in range(poses):
+        for o, s in specs.items():
+            images = np.round(bistair.encode(s) * 200 + 20).astype(np.uint8)
+            write_pose(root / f"pose-{i:02d}" / o, images, s)
+    return specs
+
+
+def test_too_few_boards(tmp_path):
+    small_pose_set(tmp_path, 3)
+    with pytest.raises(BistairError) as exc:
+        calibrate_folder(tmp_path, out=tmp_path / "calib.json")
+    assert one_line(exc) == "board found in 0 of 3 poses, need at least 3"
+    assert not (tmp_path / "calib.json").exists()
+
+
+def test_too_few_boards_in_real_poses(captures, tmp_path):
+    root, _ = captures
+    shutil.copy(root / "board.json", tmp_path)
+    for i in range(3):
+        shutil.copytree(root / f"pose-0{i}", tmp_path / f"pose-0{i}")
+    white = sorted((tmp_path / "pose-02" / "columns").glob("*.tif"))[-1]
+    write_image(white, np.full((512, 640), 128, np.uint8))  # a white frame without the board
+    with pytest.raises(BistairError) as exc:
+        calibrate_folder(tmp_path, out=tmp_path / "calib.json")
+    assert one_line(exc) == "board found in 2 of 3 poses, need at least 3"
+    assert not (tmp_path / "calib.json").exists()
+    assert len(calibrate_folder(tmp_path, min_poses=2).poses) == 2
+
+
+def test_spec_orientation_must_fit_the_folder(tmp_path):
+    specs = small_pose_set(tmp_path, 3)
+    (tmp_path / "pose-01" / "columns" / "spec.json").write_text(specs["rows"].to_json())
+    with pytest.raises(BistairError) as exc:
+        calibrate_folder(tmp_path)
+    assert one_line(exc) == "pose-01/columns/spec.json codes rows, the folder is for columns"
+
+
+def test_image_sizes_must_agree(tmp_path):
+    specs = small_pose_set(tmp_path, 3)
+    shutil.rmtree(tmp_path / "pose-01" / "rows")
+    images = np.round(bistair.encode(specs["rows"])[:, :, :90] * 200 + 20).astype(np.uint8)
+    write_pose(tmp_path / "pose-01" / "rows", images, specs["rows"])
+    with pytest.raises(BistairError) as exc:
+        calibrate_folder(tmp_path)
+    assert one_line(exc) == "pose-01/rows images are 90x64, earlier ones 96x64"
+    wide = specs["rows"].replace(width=128, periods=(128, 16))
+    images = np.round(bistair.encode(wide)[:, :, :96] * 200 + 20).astype(np.uint8)
+    shutil.rmtree(tmp_path / "pose-01" / "rows")
+    write_pose(tmp_path / "pose-01" / "rows", images, wide)
+    with pytest.raises(BistairError) as exc:
+        calibrate_folder(tmp_path)
+    assert one_line(exc) == ("pose-01/rows/spec.json is for a 128x64 projector, earlier specs "
+                             "for 96x64")
+
+
+def test_other_layout_errors(tmp_path):
+    specs = small_pose_set(tmp_path, 3)
+    shutil.rmtree(tmp_path / "pose-02" / "rows")
+    with pytest.raises(BistairError, match="pose pose-02 has no rows/ folder"):
+        calibrate_folder(tmp_path)
+    shutil.rmtree(tmp_path / "pose-02")
+    (tmp_path / "pose-01" / "rows" / "spec.json").write_text(
+        specs["rows"].replace(white=0, frame_order=()).to_json())
+    with pytest.raises(BistairError, match="no white frame"):
+        calibrate_folder(tmp_path)
+    (tmp_path / "board.json").unlink()
+    with pytest.raises(BistairError, match="board description .* not found"):
+        calibrate_folder(tmp_path)
+    with pytest.raises(BistairError, match="not found"):
+        calibrate_folder(tmp_path / "nowhere")
+
+
+def test_in_memory_poses_must_share_one_size():
+    a = np.zeros((48, 64))
+    poses = [PoseCapture("p0", a, a, a), PoseCapture("p1", a, a, np.zeros((40, 64)))]
+    with pytest.raises(BistairError) as exc:
+        calibrate_poses(poses, BOARD, (96, 64))
+    assert one_line(exc) == "p1: y is 64x40 but p0 images are 64x48"
