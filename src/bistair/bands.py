@@ -33,6 +33,7 @@ class Runs:
     uid: np.ndarray  # stair level (on the union of both stairs' levels)
     top_ok: np.ndarray  # bounded above by another run of the same region
     bottom_ok: np.ndarray
+    misfit: np.ndarray  # mean distance of its rows' phases from its level, in half steps
 
     def take(self, sel: np.ndarray) -> Runs:
         return Runs(**{k: v[sel] for k, v in self.__dict__.items()})
@@ -67,7 +68,7 @@ class RowProfiles:
     cos: np.ndarray  # sum of weight * cos(theta)
     sin: np.ndarray
     weight: np.ndarray
-    ratio: np.ndarray  # mean stair-pair / fringe modulation
+    level: np.ndarray  # mean stair-pair modulation over the fringe modulation
     count: np.ndarray
     col_sum: np.ndarray  # sum of the pixels' column indices
 
@@ -97,6 +98,17 @@ def row_profiles(labels: np.ndarray, theta: np.ndarray, weight: np.ndarray,
     return RowProfiles(used // h, used % h, c, s, wsum, rsum / np.maximum(count, 1), count, cols)
 
 
+def _region_percentile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndarray:
+    """The ``q`` quantile of ``values`` within each entry's region, per entry."""
+    if region.size == 0:
+        return values
+    order = np.lexsort((values, region))
+    starts = np.flatnonzero(np.r_[True, region[order][1:] != region[order][:-1]])
+    counts = np.diff(np.r_[starts, region.size])
+    pick = values[order][starts + np.floor(q * (counts - 1)).astype(np.int64)]
+    return np.repeat(pick, counts)[np.argsort(order, kind="stable")]
+
+
 def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
     """(row, column) centroid of each region 0..n_regions from its row profiles."""
     count = np.maximum(np.bincount(prof.region, prof.count, n_regions + 1), 1)
@@ -108,17 +120,15 @@ def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
 def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     """Runs of constant stair level in the row profiles of every region.
 
-    Rows where the stair pair's modulation collapses relative to the fringes' (``ratio``)
-    are blurred band transitions and are skipped.
+    Rows where the stair pair's modulation (over the fringes', which takes out albedo and
+    shading) falls below 0.7 of the region's band cores (its 80th percentile row) are
+    blurred band transitions and are skipped: two band phasors mixed cancel in part, and
+    their mixed phase would read as a stair level in between.
     """
-    c, s, wsum, rsum = prof.cos, prof.sin, prof.weight, prof.ratio
+    c, s, wsum = prof.cos, prof.sin, prof.weight
     region, row = prof.region, prof.row
     row_theta = np.arctan2(s, c)
-    # Transitional rows: the stair pair's modulation drops where two bands blur together.
-    n_reg = int(region.max()) + 1 if region.size else 1
-    ref = np.bincount(region, rsum * wsum, n_reg) / np.maximum(np.bincount(region, wsum, n_reg),
-                                                               1e-12)
-    kept = rsum >= 0.7 * ref[region]
+    kept = prof.level >= 0.7 * _region_percentile(region, prof.level, 0.8)
     dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
     idx = np.flatnonzero(kept)
     region_k, row_k = region[idx], row[idx]
@@ -147,11 +157,15 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     half_bottom[:-1] = np.where(bottom_ok[:-1], gap[first[1:]] / 2.0, 0.0)
     cw = np.bincount(run_id, c[idx])
     sw = np.bincount(run_id, s[idx])
+    half_step = 0.5 * np.min(np.abs(wrap(np.diff(np.r_[levels, levels[0] + TWO_PI]))))
+    off = np.abs(wrap(row_theta[idx] - levels[uid])) / half_step
+    misfit = np.bincount(run_id, off * wsum[idx]) / np.maximum(np.bincount(run_id, wsum[idx]),
+                                                               1e-12)
     runs = Runs(
         region=region_k[first], y0=row_k[first], y1=row_k[last],
         length=(row_k[last] - row_k[first] + 1) + half_top + half_bottom,
         theta=np.arctan2(sw, cw), weight=np.bincount(run_id, wsum[idx]),
-        uid=uid[first], top_ok=top_ok, bottom_ok=bottom_ok,
+        uid=uid[first], top_ok=top_ok, bottom_ok=bottom_ok, misfit=misfit,
     )
     return _drop_transitions(runs)
 
@@ -291,6 +305,8 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         h = heights[r] if np.isfinite(heights[r]) else layout.default_height
         total = wgt.sum()
         row_weight = total / max(length.sum(), 1.0)
+        if (runs.misfit[lo:hi] * wgt).sum() > 0.32 * total:
+            continue  # rows read between levels: the bands are blurred together, no order
         vals, inv = np.unique(uid, return_inverse=True)
         cls_w = np.bincount(inv, wgt)
         rank = np.argsort(cls_w)[::-1]

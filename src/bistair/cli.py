@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import numpy as np
 
 from . import __version__
 from .codecs import CODECS
@@ -122,16 +123,124 @@ def decode(captures: Path, spec_path: Path | None, out: Path, strategy: str | No
                f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}")
 
 
+def _size(ctx: click.Context, param: click.Parameter, value: str | None) -> Any:
+    if value is None:
+        return None
+    try:
+        width, height = (int(v) for v in value.lower().split("x"))
+    except ValueError:
+        raise click.BadParameter("expected WIDTHxHEIGHT, e.g. 1280x1024") from None
+    return width, height
+
+
 @cli.command()
 @click.option("--out", "-o", type=click.Path(path_type=Path), default=Path("demo-out"),
               show_default=True, help="output folder")
 @click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--camera", callback=_size, default="1280x1024", show_default=True,
+              help="camera size WIDTHxHEIGHT")
 @reports_errors
-def demo(out: Path, seed: int) -> None:
-    """Generate patterns, synthesise isolated objects, decode and score against the truth."""
+def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
+    """The paper's simulation on the virtual rig: every method, one table, a report."""
     from .demo import run_demo
 
-    run_demo(out, seed=seed)
+    run_demo(out, seed=seed, camera_size=camera)
+
+
+@cli.command()
+@click.option("--scene", required=True, help="preset scene (paper-sim, two-masks, mask-prism, "
+              "two-sculptures, plane, sphere-on-plane)")
+@click.option("--method", "methods", required=True, multiple=True,
+              help="method to render (repeatable), or all")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
+@click.option("--camera", callback=_size, default=None, help="camera size WIDTHxHEIGHT "
+              "[default: 1280x1024]")
+@click.option("--noise", type=float, default=0.01, show_default=True,
+              help="read noise, fraction of full scale")
+@click.option("--blur", type=float, default=1.0, show_default=True,
+              help="camera defocus, Gaussian sigma in pixels")
+@click.option("--gamma", type=float, default=2.2, show_default=True, help="projector gamma")
+@click.option("--compensated/--uncompensated", default=True, show_default=True,
+              help="patterns pre-compensate the projector gamma")
+@click.option("--ambient", type=float, default=0.05, show_default=True)
+@click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
+              show_default=True, help="camera bit depth")
+@click.option("--seed", type=int, default=0, show_default=True)
+@reports_errors
+def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int, int] | None,
+             noise: float, blur: float, gamma: float, compensated: bool, ambient: float,
+             bits: str, seed: int) -> None:
+    """Render a preset scene on the virtual rig: one capture folder per method + the truth."""
+    from .simulate import METHODS
+    from .simulate import simulate as run
+
+    chosen = list(METHODS) if "all" in methods else list(dict.fromkeys(methods))
+    run(scene, chosen, out, camera_size=camera, compensated=compensated, gamma=gamma,
+        read_noise=noise, camera_blur=blur, ambient=ambient, bits=int(bits), seed=seed)
+    click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth to {out}")
+
+
+@cli.command()
+@click.argument("captures", type=click.Path(path_type=Path))
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="calibration file to write (JSON)")
+@click.option("--board", type=click.Path(path_type=Path), default=None,
+              help="board description [default: CAPTURES/board.json]")
+@click.option("--min-poses", type=int, default=3, show_default=True)
+@reports_errors
+def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> None:
+    """Calibrate camera and projector from board captures (both orientations per pose)."""
+    from .calib import calibrate_folder
+
+    cal = calibrate_folder(captures, out, board=board, min_poses=min_poses)
+    click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
+               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} mm, "
+               f"{len(cal.poses)} of {cal.poses_total} poses; wrote {out}")
+    for pose in cal.poses:
+        click.echo(f"  {pose['name']}: {pose['features']} features, camera "
+                   f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
+
+
+@cli.command()
+@click.argument("captures", type=click.Path(path_type=Path))
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set [default: CAPTURES/spec.json]")
+@click.option("--calibration", required=True, type=click.Path(path_type=Path))
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="point cloud to write (.ply)")
+@click.option("--depth", type=click.Path(path_type=Path), default=None,
+              help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
+@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@reports_errors
+def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
+                depth: Path | None, strategy: str | None) -> None:
+    """Decode, triangulate with a calibration, write a coloured PLY and a depth map."""
+    from .reconstruct import reconstruct_folder
+
+    depth = depth or out.with_name(out.stem + "-depth")
+    options = {} if strategy is None else {"strategy": strategy}
+    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth, **options)
+    click.echo(f"{int(rec.mask.sum())} points; wrote {out} and {depth}/depth.npy")
+
+
+@cli.command()
+@click.argument("captures", type=click.Path(path_type=Path))
+@click.option("--reference", required=True, type=click.Path(path_type=Path),
+              help="captures of the flat reference plane (same spec)")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None)
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
+@click.option("--plane", "planes", multiple=True, help="FOLDER:HEIGHT_MM of a plane parallel "
+              "to the reference (two or more calibrate the height per pixel)")
+@click.option("--geometry", default=None, help="DISTANCE,BASELINE,FREQUENCY (mm, mm, fringes "
+              "per mm on the reference) for the classical formula instead of planes")
+@reports_errors
+def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
+           planes: tuple[str, ...], geometry: str | None) -> None:
+    """Height above a reference plane without a calibration (phase-to-height)."""
+    from .workflow import height_folder
+
+    h = height_folder(captures, reference, out, spec_path, planes, geometry)
+    click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
 def main() -> None:

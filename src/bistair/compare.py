@@ -95,8 +95,9 @@ class Comparison:
 
 
 def run(trace: Any, specs: dict[str, tuple[BaseSpec, dict[str, Any]]],
-        progress: Callable[[str], None] | None = None) -> Comparison:
-    """Expose ``trace`` with every spec's patterns, decode and score."""
+        progress: Callable[[str], None] | None = None, imaging: Any = None) -> Comparison:
+    """Expose ``trace`` with every spec's patterns (under ``imaging``, default the trace's
+    own: noise, blur, gamma and light do not change the geometry), decode and score."""
     from .sim import expose
 
     truth = trace.truth
@@ -104,7 +105,7 @@ def run(trace: Any, specs: dict[str, tuple[BaseSpec, dict[str, Any]]],
     for label, (spec, options) in specs.items():
         if progress:
             progress(label)
-        images = expose(trace, encode(spec), trace.imaging)
+        images = expose(trace, encode(spec), imaging or trace.imaging)
         result = decode(images, spec, **options)
         scores = compare(result, truth.coord(spec), truth.mask, truth.object_id)
         rows.append(Row(label, spec, result, scores))

@@ -67,3 +67,51 @@ def _jsonable(value: Any) -> Any:
     if isinstance(value, np.generic):
         return value.item()
     return value
+
+
+def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
+                  spec: BaseSpec | str | Path | None = None, planes: tuple[str, ...] = (),
+                  geometry: str | None = None) -> np.ndarray:
+    """Height above a reference plane (mm) from the captures of the object, of the plane and
+    either of planes at known heights (``"FOLDER:HEIGHT"``, two or more) or of the geometry
+    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``."""
+    from .preview import colorize
+    from .reconstruct import HeightModel
+
+    captures = Path(captures)
+    if spec is None:
+        spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
+    if not isinstance(spec, BaseSpec):
+        spec = load_spec(spec)
+    if bool(planes) == bool(geometry):
+        raise BistairError("give either two or more --plane FOLDER:HEIGHT or --geometry")
+
+    def coord(folder: str | Path) -> np.ndarray:
+        return decode(read_captures(folder), spec).coord.astype(np.float64)
+
+    ref = coord(reference)
+    if geometry:
+        try:
+            distance, baseline, frequency = (float(v) for v in geometry.split(","))
+        except ValueError:
+            raise BistairError(f"--geometry must be DISTANCE,BASELINE,FREQUENCY, got "
+                               f"{geometry!r}") from None
+        model = HeightModel.classical(ref, distance, baseline, frequency, spec.period)
+    else:
+        pairs = []
+        for item in planes:
+            folder, _, value = item.rpartition(":")
+            try:
+                pairs.append((coord(folder), float(value)))
+            except ValueError:
+                raise BistairError(f"--plane must be FOLDER:HEIGHT, got {item!r}") from None
+        model = HeightModel.fit(ref, [p for p, _ in pairs], [h for _, h in pairs])
+    obj = coord(captures)
+    if obj.shape != ref.shape:
+        raise BistairError(f"captures are {obj.shape[1]}x{obj.shape[0]}, the reference "
+                           f"{ref.shape[1]}x{ref.shape[0]}")
+    heights = model.height(obj).astype(np.float32)
+    with output_folder(out) as tmp:
+        np.save(tmp / "height.npy", heights)
+        write_image(tmp / "height.png", colorize(heights, "viridis"))
+    return heights
