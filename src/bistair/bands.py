@@ -117,6 +117,21 @@ def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
     return np.c_[rows / count, cols / count]
 
 
+def observed_levels(theta: np.ndarray, weight: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """Where the stair levels actually read in this capture.
+
+    A projector's nonlinearity (an uncompensated gamma) moves every level's decoded phase
+    by the same amount everywhere in the image; each level's observed phase is the weighted
+    circular mean of the rows read nearest to it (levels seen in under 1% of the weight keep
+    their nominal phase), so band rows are judged against it rather than the nominal one.
+    """
+    uid = nearest_level(theta, levels)
+    c = np.bincount(uid, weight * np.cos(theta), levels.size)
+    s = np.bincount(uid, weight * np.sin(theta), levels.size)
+    seen = np.bincount(uid, weight, levels.size) > 0.01 * weight.sum()
+    return np.where(seen, np.arctan2(s, c), levels)
+
+
 def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     """Runs of constant stair level in the row profiles of every region.
 
@@ -132,6 +147,7 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
     idx = np.flatnonzero(kept)
     region_k, row_k = region[idx], row[idx]
+    levels = observed_levels(row_theta[idx], wsum[idx], levels)
     uid = nearest_level(row_theta[idx], levels)
     same = np.zeros(idx.size, bool)
     same[1:] = region_k[1:] == region_k[:-1]
@@ -157,14 +173,17 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     half_bottom[:-1] = np.where(bottom_ok[:-1], gap[first[1:]] / 2.0, 0.0)
     cw = np.bincount(run_id, c[idx])
     sw = np.bincount(run_id, s[idx])
-    half_step = 0.5 * np.min(np.abs(wrap(np.diff(np.r_[levels, levels[0] + TWO_PI]))))
-    off = np.abs(wrap(row_theta[idx] - levels[uid])) / half_step
+    run_theta = np.arctan2(sw, cw)
+    # Distance of the rows from their level, in half the distance to the nearest other level
+    # (where a reading would change level): blur mixing two bands puts rows in between.
+    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
+    off = np.abs(wrap(row_theta[idx] - levels[uid])) / (0.5 * gaps.min(axis=1)[uid])
     misfit = np.bincount(run_id, off * wsum[idx]) / np.maximum(np.bincount(run_id, wsum[idx]),
                                                                1e-12)
     runs = Runs(
         region=region_k[first], y0=row_k[first], y1=row_k[last],
         length=(row_k[last] - row_k[first] + 1) + half_top + half_bottom,
-        theta=np.arctan2(sw, cw), weight=np.bincount(run_id, wsum[idx]),
+        theta=run_theta, weight=np.bincount(run_id, wsum[idx]),
         uid=uid[first], top_ok=top_ok, bottom_ok=bottom_ok, misfit=misfit,
     )
     return _drop_transitions(runs)

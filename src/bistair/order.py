@@ -98,7 +98,7 @@ Agreement = Callable[[np.ndarray], np.ndarray]
 
 def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
                        evidence_of: Evidence, agrees: Agreement | None = None,
-                       info: dict | None = None, min_score: float = 0.5,
+                       info: dict | None = None, min_score: float = 0.45,
                        min_margin: float = 0.1) -> np.ndarray:
     """Absolute phase from fringe regions and each region's evidence for every order.
 
