@@ -111,6 +111,7 @@ def output_folder(out: str | Path) -> Iterator[Path]:
     try:
         parent.mkdir(parents=True, exist_ok=True)
         tmp = Path(tempfile.mkdtemp(prefix=".bistair-", dir=parent))
+        tmp.chmod(0o777 & ~_umask())  # mkdtemp makes it private; outputs are not
     except OSError as exc:
         raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
     try:
@@ -142,8 +143,15 @@ def output_file(path: str | Path) -> Iterator[Path]:
     tmp = Path(name)
     try:
         yield tmp
+        tmp.chmod(0o666 & ~_umask())
         os.replace(tmp, path)
     except OSError as exc:
         raise BistairError(f"cannot write {path}: {exc.strerror}") from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask

@@ -39,8 +39,7 @@ def method_figure(row: Row, truth: Any, path: str | Path) -> Path:
         if cmap is None:
             ax.imshow(img)
         else:
-            cm = plt.get_cmap(cmap).copy()
-            cm.set_bad("black")
+            cm = plt.get_cmap(cmap).with_extremes(bad="black")
             kw = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
             ax.imshow(np.ma.masked_invalid(img), cmap=cm, interpolation="nearest", **kw)
         ax.set_title(title, fontsize=10)
