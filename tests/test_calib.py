@@ -26,15 +26,12 @@ from bistair.calib import (
 )
 from bistair.errors import BistairError
 from bistair.io import write_image
+from bistair.metrics import fit_sphere
 from bistair.reconstruct import reconstruct_folder
-from bistair.sim import Imaging, Plane, Rig, Scene, Sphere, euler, expose, trace
+from bistair.sim import Imaging, Rig, Scene, Sphere, expose, trace
+from bistair.sim.boards import POSES, write_board_captures
 
 BOARD = Board("checkerboard", 9, 6, 20.0)
-# board poses (degrees about x, y, z; feature centre in mm): tilted up to 25 degrees and spread
-# toward the image corners, all inside both devices' views
-POSES = [(0, 0, 0, 0, 0, 600), (20, 0, 0, -50, -35, 620), (-20, 0, 5, 50, 35, 580),
-         (0, 25, 0, 50, -35, 600), (0, -25, -5, -50, 35, 640), (15, 15, 10, -50, 0, 560),
-         (-15, -15, -10, 50, 0, 650), (10, -20, 0, 0, 40, 600)]
 
 
 def one_line(exc: pytest.ExceptionInfo) -> str:
@@ -174,16 +171,6 @@ def sim_spec(orientation: str) -> bistair.spec.BaseSpec:
                              orientation=orientation, white=1, gamma=2.2)
 
 
-def board_plane(board: Board, rx: float, ry: float, rz: float, *centre: float) -> Plane:
-    """The printed board as a plane with its albedo, its features centred on ``centre``."""
-    rot = euler(rx, ry, rz)
-    x0, y0, x1, y1 = board.extent()
-    t = np.array(centre) - rot @ board.object_points().mean(axis=0)
-    return Plane(center=rot @ [(x0 + x1) / 2, (y0 + y1) / 2, 0] + t, normal=rot[:, 2],
-                 x_axis=rot[:, 0], size=(x1 - x0, y1 - y0),
-                 albedo=lambda p: board.albedo((p - t) @ rot[:, :2]))
-
-
 def write_pose(folder, images, spec) -> None:
     folder.mkdir(parents=True)
     for i, img in enumerate(images):
@@ -194,14 +181,9 @@ def write_pose(folder, images, spec) -> None:
 @pytest.fixture(scope="module")
 def captures(tmp_path_factory):
     """Eight board poses in the capture layout, and the rig that took them."""
-    rig, root = sim_rig(), tmp_path_factory.mktemp("calib")
-    (root / "board.json").write_text(json.dumps(BOARD.to_dict()))
+    rig, root = sim_rig(), tmp_path_factory.mktemp("calib") / "captures"
     specs = {o: sim_spec(o) for o in ("columns", "rows")}
-    patterns = {o: bistair.encode(s) for o, s in specs.items()}
-    for i, pose in enumerate(POSES):
-        traced = trace(rig, Scene([board_plane(BOARD, *pose)]), Imaging(seed=i))
-        for o in specs:
-            write_pose(root / f"pose-{i:02d}" / o, expose(traced, patterns[o]), specs[o])
+    write_board_captures(rig, BOARD, specs, root, imaging=Imaging(seed=0), suffix=".tif")
     return root, rig
 
 
@@ -230,12 +212,6 @@ def test_calibrate_then_reconstruct_on_the_virtual_rig(captures, tmp_path):
     # lengths' error); with the rig's true calibration 0.001 mm and 0.02 mm
     assert abs(radius - 45) < 0.3
     assert np.linalg.norm(centre - [10, -5, 560]) < 2.0
-
-
-def fit_sphere(pts: np.ndarray) -> tuple[np.ndarray, float]:
-    sol = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), (pts**2).sum(1),
-                          rcond=None)[0]
-    return sol[:3], float(np.sqrt(sol[3] + sol[:3] @ sol[:3]))
 
 
 # -- bad input ---------------------------------------------------------------------------------

@@ -16,6 +16,7 @@ from plyfile import PlyData
 import bistair
 from bistair.calib import Calibration, Device, save_calibration
 from bistair.errors import BistairError
+from bistair.metrics import fit_plane, fit_sphere
 from bistair.reconstruct import (
     HeightModel,
     reconstruct,
@@ -54,18 +55,6 @@ def spec_for(method: str, orientation: str = "columns") -> bistair.spec.BaseSpec
 def one_line(exc: pytest.ExceptionInfo) -> str:
     assert "\n" not in str(exc.value)
     return str(exc.value)
-
-
-def fit_sphere(pts: np.ndarray) -> tuple[np.ndarray, float]:
-    sol = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), (pts**2).sum(1),
-                          rcond=None)[0]
-    return sol[:3], float(np.sqrt(sol[3] + sol[:3] @ sol[:3]))
-
-
-def fit_plane(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    centre = pts.mean(axis=0)
-    normal = np.linalg.svd(pts - centre, full_matrices=False)[2][2]
-    return centre, normal, (pts - centre) @ normal
 
 
 # -- exactness ------------------------------------------------------------------------------

@@ -123,7 +123,8 @@ def observed_levels(theta: np.ndarray, weight: np.ndarray, levels: np.ndarray) -
     A projector's nonlinearity (an uncompensated gamma) moves every level's decoded phase
     by the same amount everywhere in the image; each level's observed phase is the weighted
     circular mean of the rows read nearest to it (levels seen in under 1% of the weight keep
-    their nominal phase), so band rows are judged against it rather than the nominal one.
+    their nominal phase), so band rows are read and judged against it rather than the
+    nominal one.
     """
     uid = nearest_level(theta, levels)
     c = np.bincount(uid, weight * np.cos(theta), levels.size)
@@ -268,6 +269,11 @@ class BandLayout:
     local_share: float  # local rows / group rows
     default_height: float  # group height in camera rows when nothing better is known
 
+    @property
+    def levels(self) -> np.ndarray:
+        """Nominal phases of the union of both stairs' levels (what run ``uid`` indexes)."""
+        return union_levels(self.partitions, self.stairs)
+
 
 def group_heights(runs: Runs, n_regions: int, centroids: np.ndarray) -> np.ndarray:
     """Group height (camera rows) per region: its own bands where two complete ones show,
@@ -319,7 +325,6 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
     for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
         r = int(runs.region[lo])
         uid, wgt, length = runs.uid[lo:hi], runs.weight[lo:hi], runs.length[lo:hi]
-        theta = runs.theta[lo:hi]
         complete = runs.top_ok[lo:hi] & runs.bottom_ok[lo:hi]
         h = heights[r] if np.isfinite(heights[r]) else layout.default_height
         total = wgt.sum()
@@ -333,7 +338,9 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         y = rank[1] if vals.size > 1 else -1
         if y >= 0 and (cls_w[y] < 0.05 * total or length[inv == y].max() < 2):
             y = -1
-        th_x = _circmean(theta[inv == x], wgt[inv == x])
+        # A class's level is the one its rows were read as (against the levels observed in
+        # this capture); its nominal phase says which stair index that is.
+        th_x = layout.levels[vals[x]]
         if y < 0:
             a, b = quantize(th_x, S), quantize(th_x, P)
             if length.max() >= 1.3 * max(f_loc, f_par) * h:
@@ -344,7 +351,7 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
                 ev[r, a_of_k == a] = share
                 ev[r, b_of_k == b] = share
             continue
-        th_y = _circmean(theta[inv == y], wgt[inv == y])
+        th_y = layout.levels[vals[y]]
         options = []
         for loc, par in ((x, y), (y, x)):
             th_l, th_p = (th_x, th_y) if loc == x else (th_y, th_x)
@@ -362,10 +369,6 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         low = min(cost for _, cost in options)
         ev[r] = np.max([score - 0.5 * min(1.0, cost - low) for score, cost in options], axis=0)
     return ev
-
-
-def _circmean(theta: np.ndarray, weight: np.ndarray) -> float:
-    return float(np.arctan2((weight * np.sin(theta)).sum(), (weight * np.cos(theta)).sum()))
 
 
 def _fit(theta: float, level: int, levels: int) -> float:

@@ -177,7 +177,10 @@ def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int,
     chosen = list(METHODS) if "all" in methods else list(dict.fromkeys(methods))
     run(scene, chosen, out, camera_size=camera, compensated=compensated, gamma=gamma,
         read_noise=noise, camera_blur=blur, ambient=ambient, bits=int(bits), seed=seed)
-    click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth to {out}")
+    if scene == "calibration":
+        click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to {out}")
+    else:
+        click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth to {out}")
 
 
 @cli.command()

@@ -38,6 +38,14 @@ def stairs_for(fringes: int) -> tuple[int, int]:
     return math.ceil(fringes / stairs), stairs
 
 
+def lv_levels(fringes: int, window: int = 4) -> int:
+    """The fewest stair levels (at least the paper's 4) whose windows can tell the fringes."""
+    levels = 4
+    while levels * (levels - 1) ** (window - 1) + window - 1 < fringes:
+        levels += 1
+    return levels
+
+
 def method_specs(projector_size: tuple[int, int], period: int = 30, gamma: float = 1.0,
                  steps: int = 4, methods: Iterable[str] | None = None
                  ) -> dict[str, tuple[BaseSpec, dict[str, Any]]]:
@@ -59,7 +67,7 @@ def method_specs(projector_size: tuple[int, int], period: int = 30, gamma: float
                                                 stairs=stairs, steps=steps), {}),
         "bidirectional (paper decoder)": ("bidirectional", dict(
             period=period, partitions=parts, stairs=stairs, steps=steps), {"strategy": "paper"}),
-        "lv": ("lv", dict(period=period, steps=steps), {}),
+        "lv": ("lv", dict(period=period, steps=steps, levels=lv_levels(fringes)), {}),
         "phase-coding": ("phase-coding", dict(period=period, steps=steps), {}),
         "graycode": ("graycode", dict(period=period, complementary=1, steps=steps), {}),
         "multifreq": ("multifreq", dict(periods=(width, middle, period), steps=12), {}),

@@ -54,3 +54,26 @@ def compare(result: DecodeResult, coord: np.ndarray, mask: np.ndarray,
             for i in np.unique(object_id[mask])
         }
     return out
+
+
+def fit_sphere(points: np.ndarray) -> tuple[np.ndarray, float]:
+    """Least-squares sphere through ``(N, 3)`` points: ``(centre, radius)``.
+
+    >>> u = np.random.default_rng(0).normal(size=(200, 3))
+    >>> pts = 40 * u / np.linalg.norm(u, axis=1, keepdims=True) + [1.0, 2.0, 500.0]
+    >>> c, r = fit_sphere(pts)
+    >>> np.round(c, 6).tolist(), round(r, 6)
+    ([1.0, 2.0, 500.0], 40.0)
+    """
+    pts = np.asarray(points, float)
+    sol = np.linalg.lstsq(np.column_stack([2 * pts, np.ones(len(pts))]), (pts**2).sum(1),
+                          rcond=None)[0]
+    return sol[:3], float(np.sqrt(sol[3] + sol[:3] @ sol[:3]))
+
+
+def fit_plane(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Least-squares plane through ``(N, 3)`` points: ``(centre, unit normal, residuals)``."""
+    pts = np.asarray(points, float)
+    centre = pts.mean(axis=0)
+    normal = np.linalg.svd(pts - centre, full_matrices=False)[2][2]
+    return centre, normal, (pts - centre) @ normal

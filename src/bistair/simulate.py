@@ -7,6 +7,9 @@ For a preset scene and one method (or all) it writes::
     OUT/truth/                coord_x.npy, coord_y.npy, depth.npy, object_id.npy, mask.npy
     OUT/scene.json            the scene, rig (intrinsics, distortion, pose) and imaging
 
+The scene ``calibration`` writes a checkerboard in eight poses instead, in the layout
+``bistair calibrate`` reads (``board.json``, ``pose-NN/columns``, ``pose-NN/rows``).
+
 Examples
 --------
 >>> import tempfile, pathlib
@@ -46,8 +49,9 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     """
     from .sim import Imaging, expose, preset, scene_names, trace
 
-    if scene not in scene_names():
-        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())})")
+    if scene not in (*scene_names(), "calibration"):
+        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
+                           "calibration)")
     methods = list(methods)
     unknown = set(methods) - set(METHODS)
     if unknown:
@@ -57,6 +61,8 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
         im = Imaging(**imaging)
     except (TypeError, ValueError) as exc:
         raise BistairError(f"bad imaging parameters: {exc}") from None
+    if scene == "calibration":
+        return _calibration(methods, out, camera_size, compensated, im)
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
     specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
                          methods=methods)
@@ -89,3 +95,19 @@ def _rig_dict(rig: Any) -> dict[str, Any]:
                 "R": np.asarray(d.R).tolist(), "t": np.asarray(d.t).ravel().tolist()}
 
     return {"camera": device(rig.camera), "projector": device(rig.projector)}
+
+
+def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, int] | None,
+                 compensated: bool, imaging: Any) -> Path:
+    """A 9 x 6 checkerboard (20 mm) in eight poses, both orientations with a white frame, in
+    the layout ``bistair calibrate`` reads (one method: the first named)."""
+    from .board import Board
+    from .sim import Rig
+    from .sim.boards import write_board_captures
+
+    rig = Rig.default(**({} if camera_size is None else {"camera_size": camera_size}))
+    base = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
+                        methods=methods[:1])[methods[0]][0]
+    specs = {o: base.replace(orientation=o, white=1) for o in ("columns", "rows")}
+    return write_board_captures(rig, Board("checkerboard", 9, 6, 20.0), specs, out,
+                                imaging=imaging)
