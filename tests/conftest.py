@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -57,3 +58,17 @@ def score(spec, scene, **decode_options):
 @pytest.fixture(scope="session")
 def spec36():
     return bistair.make_spec("bidirectional", width=1080, height=1080, period=30)
+
+
+def cli_run(monkeypatch, capsys, *args) -> tuple[int, str, str]:
+    """Run the ``bistair`` entry point in-process: (exit code, stdout, stderr)."""
+    from bistair.cli import main
+
+    monkeypatch.setattr(sys, "argv", ["bistair", *map(str, args)])
+    code = 0
+    try:
+        main()
+    except SystemExit as exc:
+        code = exc.code or 0
+    out = capsys.readouterr()
+    return code, out.out, out.err

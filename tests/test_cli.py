@@ -9,21 +9,11 @@ import sys
 import imageio.v3 as iio
 import numpy as np
 import pytest
-from conftest import warped_scene
+from conftest import cli_run, warped_scene
 
-from bistair.cli import main
 from bistair.synth import render_warp
 
-
-def run(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["bistair", *map(str, args)])
-    code = 0
-    try:
-        main()
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
+run = cli_run
 
 
 @pytest.fixture()

@@ -2,25 +2,15 @@
 the command line, with their bad-input paths (one line, exit 2, nothing written)."""
 
 import json
-import sys
 
 import numpy as np
 import pytest
+from conftest import cli_run
 
 from bistair.calib import Calibration, save_calibration
-from bistair.cli import main
 from bistair.sim import preset
 
-
-def run(monkeypatch, capsys, *args):
-    monkeypatch.setattr(sys, "argv", ["bistair", *map(str, args)])
-    code = 0
-    try:
-        main()
-    except SystemExit as exc:
-        code = exc.code or 0
-    out = capsys.readouterr()
-    return code, out.out, out.err
+run = cli_run
 
 
 def refused(monkeypatch, capsys, message, *args):

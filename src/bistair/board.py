@@ -18,7 +18,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -28,6 +27,7 @@ import cv2
 import numpy as np
 
 from .errors import BistairError
+from .jsonfile import read_json
 
 BOARD_TYPES = ("checkerboard", "circles", "asymmetric-circles")
 
@@ -70,17 +70,7 @@ class Board:
     @classmethod
     def load(cls, path: str | Path) -> Board:
         """Read ``board.json``."""
-        path = Path(path)
-        try:
-            data = json.loads(path.read_text())
-        except FileNotFoundError:
-            raise BistairError(f"board description {path} not found") from None
-        except (OSError, UnicodeDecodeError) as exc:
-            raise BistairError(f"cannot read board description {path}: {exc}") from None
-        except json.JSONDecodeError as exc:
-            raise BistairError(f"board description {path} is not valid JSON ({exc.msg}, "
-                               f"line {exc.lineno})") from None
-        return cls.from_dict(data)
+        return cls.from_dict(read_json(path, "board description"))
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)

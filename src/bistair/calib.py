@@ -59,6 +59,7 @@ import numpy as np
 from .board import Board
 from .errors import BistairError
 from .io import natural_key, output_file, read_captures
+from .jsonfile import read_json
 from .spec import BaseSpec, load_spec
 
 FORMAT, VERSION = "bistair-calibration", 1
@@ -187,15 +188,7 @@ def save_calibration(calibration: Calibration, path: str | Path) -> Path:
 def load_calibration(path: str | Path) -> Calibration:
     """Read and validate a calibration file (one-line :class:`BistairError` if it cannot)."""
     path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise BistairError(f"calibration file {path} not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise BistairError(f"cannot read calibration file {path}: {exc}") from None
-    except json.JSONDecodeError as exc:
-        raise BistairError(f"calibration file {path} is not valid JSON ({exc.msg}, line "
-                           f"{exc.lineno})") from None
+    data = read_json(path, "calibration file")
     try:
         return Calibration.from_dict(data)
     except BistairError as exc:

@@ -44,10 +44,10 @@ import numpy as np
 
 from .calib import Calibration, Device, load_calibration
 from .errors import BistairError
-from .io import output_file, output_folder, read_captures
+from .io import output_file, output_folder
 from .preview import colorize
 from .result import DecodeResult
-from .spec import BaseSpec, load_spec
+from .spec import BaseSpec
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
 
@@ -238,17 +238,11 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
     ``CAPTURES/spec.json``; ``options`` go to the decoder. Nothing is written on error."""
     from . import decode
+    from .workflow import read_with_spec
 
-    captures = Path(captures)
-    if not captures.exists():
-        raise BistairError(f"captures {captures} not found")
-    if spec is None:
-        spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
-    if not isinstance(spec, BaseSpec):
-        spec = load_spec(spec)
+    stack, spec = read_with_spec(captures, spec)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)
-    stack = read_captures(captures)
     blank = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8, period=1.0, method="")
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
     rec = reconstruct(decode(stack, spec, **options), calibration, spec, orientation,

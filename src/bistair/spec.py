@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from .errors import BistairError
+from .jsonfile import read_json
 
 SPEC_VERSION = 1
 _REGISTRY: dict[str, type[BaseSpec]] = {}
@@ -230,17 +231,4 @@ def spec_from_dict(data: Mapping[str, Any]) -> BaseSpec:
 
 def load_spec(path: str | Path) -> BaseSpec:
     """Read and validate a ``spec.json``."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise BistairError(f"spec file {path} not found") from None
-    except OSError as exc:
-        raise BistairError(f"cannot read spec file {path}: {exc.strerror}") from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise BistairError(
-            f"spec file {path} is not valid JSON ({exc.msg}, line {exc.lineno})"
-        ) from None
-    return spec_from_dict(data)
+    return spec_from_dict(read_json(path, "spec file"))

@@ -44,6 +44,18 @@ def decode_folder(captures: str | Path, out: str | Path, spec: BaseSpec | str | 
 
     ``spec`` defaults to ``CAPTURES/spec.json``.
     """
+    stack, spec = read_with_spec(captures, spec)
+    result = decode(stack, spec, **options)
+    with output_folder(out) as tmp:
+        result.save(tmp, previews=previews)
+        (tmp / "info.json").write_text(json.dumps(_jsonable(result.info), indent=2) + "\n")
+    return result
+
+
+def read_with_spec(captures: str | Path, spec: BaseSpec | str | Path | None
+                   ) -> tuple[np.ndarray, BaseSpec]:
+    """The capture stack and its spec (``CAPTURES/spec.json``, or beside a ``.npy`` stack,
+    unless given)."""
     captures = Path(captures)
     if not captures.exists():
         raise BistairError(f"captures {captures} not found")
@@ -51,12 +63,7 @@ def decode_folder(captures: str | Path, out: str | Path, spec: BaseSpec | str | 
         spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
     if not isinstance(spec, BaseSpec):
         spec = load_spec(spec)
-    stack = read_captures(captures)
-    result = decode(stack, spec, **options)
-    with output_folder(out) as tmp:
-        result.save(tmp, previews=previews)
-        (tmp / "info.json").write_text(json.dumps(_jsonable(result.info), indent=2) + "\n")
-    return result
+    return read_captures(captures), spec
 
 
 def _jsonable(value: Any) -> Any:
@@ -78,11 +85,7 @@ def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
     from .preview import colorize
     from .reconstruct import HeightModel
 
-    captures = Path(captures)
-    if spec is None:
-        spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
-    if not isinstance(spec, BaseSpec):
-        spec = load_spec(spec)
+    stack, spec = read_with_spec(captures, spec)
     if bool(planes) == bool(geometry):
         raise BistairError("give either two or more --plane FOLDER:HEIGHT or --geometry")
 
@@ -106,7 +109,7 @@ def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
             except ValueError:
                 raise BistairError(f"--plane must be FOLDER:HEIGHT, got {item!r}") from None
         model = HeightModel.fit(ref, [p for p, _ in pairs], [h for _, h in pairs])
-    obj = coord(captures)
+    obj = decode(stack, spec).coord.astype(np.float64)
     if obj.shape != ref.shape:
         raise BistairError(f"captures are {obj.shape[1]}x{obj.shape[0]}, the reference "
                            f"{ref.shape[1]}x{ref.shape[0]}")
