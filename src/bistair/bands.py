@@ -11,13 +11,15 @@ tell, the evidence says so and the neighbours decide (see :func:`bistair.order.r
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from .phase import TWO_PI, wrap
-from .stair import level_distance, quantize, stair_level_phase
+from .stair import stair_level_phase
 
 
 @dataclass
@@ -39,8 +41,9 @@ class Runs:
         return Runs(**{k: v[sel] for k, v in self.__dict__.items()})
 
 
+@lru_cache(maxsize=32)
 def union_levels(partitions: int, stairs: int) -> np.ndarray:
-    """Phases of all stair levels of both stairs, near-coincident ones merged."""
+    """Phases of all stair levels of both stairs, near-coincident ones merged (read-only)."""
     phases = np.concatenate([stair_level_phase(np.arange(stairs), stairs),
                              stair_level_phase(np.arange(partitions), partitions)])
     phases = np.sort(wrap(phases))
@@ -51,7 +54,9 @@ def union_levels(partitions: int, stairs: int) -> np.ndarray:
             keep.append(p)
     if len(keep) > 1 and abs(wrap(keep[0] - keep[-1])) <= tol:
         keep.pop()
-    return np.array(keep)
+    out = np.array(keep)
+    out.flags.writeable = False
+    return out
 
 
 def nearest_level(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
@@ -342,7 +347,7 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         # this capture); its nominal phase says which stair index that is.
         th_x = layout.levels[vals[x]]
         if y < 0:
-            a, b = quantize(th_x, S), quantize(th_x, P)
+            a, b = _index(th_x, S), _index(th_x, P)
             if length.max() >= 1.3 * max(f_loc, f_par) * h:
                 fit = _fit(th_x, a, S) + _fit(th_x, b, P)
                 ev[r, a + S * b] = cls_w[x] / total - 0.5 * fit
@@ -355,7 +360,7 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         options = []
         for loc, par in ((x, y), (y, x)):
             th_l, th_p = (th_x, th_y) if loc == x else (th_y, th_x)
-            a, b = quantize(th_l, S), quantize(th_p, P)
+            a, b = _index(th_l, S), _index(th_p, P)
             expect = np.where(inv == loc, f_loc * h, np.where(inv == par, f_par * h, np.nan))
             cost = _length_cost(length, expect, complete)
             fit = _fit(th_l, a, S) + _fit(th_p, b, P)
@@ -371,9 +376,15 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
     return ev
 
 
+def _index(theta: float, levels: int) -> int:
+    """:func:`bistair.stair.quantize` of one phase, without array overhead."""
+    return int(math.floor(((theta + math.pi) % TWO_PI) * levels / TWO_PI)) % levels
+
+
 def _fit(theta: float, level: int, levels: int) -> float:
     """Squared distance to a stair level, in half-steps (0 on the level, 1 at the border)."""
-    return float((level_distance(theta, level, levels) / (np.pi / levels)) ** 2)
+    d = (theta - (-math.pi + math.pi / levels + TWO_PI * level / levels) + math.pi) % TWO_PI
+    return ((d - math.pi) / (math.pi / levels)) ** 2
 
 
 def _length_cost(length: np.ndarray, expect: np.ndarray, complete: np.ndarray) -> float:

@@ -23,7 +23,7 @@ import numpy as np
 from scipy import ndimage
 
 from .phase import TWO_PI
-from .regions import RegionLinks, fill_from_neighbours, region_links
+from .regions import RegionLinks, fill_from_neighbours, fringe_direction, region_links
 
 
 def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
@@ -112,16 +112,19 @@ def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     that makes their phase continuous with the nearest decoded pixel within 3 px. ``info``
     receives the counts and the wrap-consistency check.
     """
+    direction = fringe_direction(phi, valid)
     labels, n, evidence = evidence_of(labels, int(labels.max()))
-    k_reg = _decide(phi, labels, evidence, min_score, min_margin)
+    links = region_links(phi, labels, direction)
+    k_reg = _decide(evidence, links, min_score, min_margin)
     detached = 0
     if agrees is not None:
         labels, n, detached = split_disagreeing(labels, n, k_reg, agrees)
     if detached:
         labels, n, evidence = evidence_of(labels, n)
-        k_reg = _decide(phi, labels, evidence, min_score, min_margin)
+        links = region_links(phi, labels, direction)
+        k_reg = _decide(evidence, links, min_score, min_margin)
     if info is not None:
-        bad, total = jump_violations(region_links(phi, labels), k_reg)
+        bad, total = jump_violations(links, k_reg)
         info.update(regions=n, regions_decoded=int((k_reg[1:] >= 0).sum()),
                     regions_detached=detached, jump_violations=bad, jump_links=total)
     k_pix = k_reg[labels]
@@ -129,9 +132,9 @@ def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
 
 
-def _decide(phi: np.ndarray, labels: np.ndarray, evidence: np.ndarray, min_score: float,
+def _decide(evidence: np.ndarray, links: RegionLinks, min_score: float,
             min_margin: float) -> np.ndarray:
-    k_reg, score, margin = resolve_regions(evidence, region_links(phi, labels))
+    k_reg, score, margin = resolve_regions(evidence, links)
     k_reg[(score < min_score) | (margin < min_margin)] = -1
     k_reg[0] = -1
     return k_reg
@@ -153,7 +156,7 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     k_pix = np.where(labels > 0, k_reg[labels], -1)
     decided = k_pix >= 0
     bad = decided & ~agrees(k_pix)
-    if not bad.any():
+    if not _dense_somewhere(bad, decided, share):
         return labels, n, 0
     num = ndimage.uniform_filter(bad.astype(np.float32), window)
     den = ndimage.uniform_filter(decided.astype(np.float32), window)
@@ -186,3 +189,15 @@ def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes
 def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Fringe order that brings ``phi`` nearest an absolute ``reference`` phase (same period)."""
     return np.round((reference - phi) / TWO_PI)
+
+
+def _dense_somewhere(bad: np.ndarray, decided: np.ndarray, share: float,
+                     block: int = 8) -> bool:
+    """Whether some ``block`` x ``block`` tile has nearly ``share`` of its decided pixels bad:
+    a cheap test that lets images without any disagreeing part skip the filters."""
+    pad = ((0, -bad.shape[0] % block), (0, -bad.shape[1] % block))
+    tiles = ((bad.shape[0] + pad[0][1]) // block, block, (bad.shape[1] + pad[1][1]) // block,
+             block)
+    nbad = np.pad(bad, pad).reshape(tiles).sum(axis=(1, 3))
+    ndec = np.pad(decided, pad).reshape(tiles).sum(axis=(1, 3))
+    return bool((nbad > 0.9 * share * np.maximum(ndec, 1)).any())

@@ -78,8 +78,8 @@ def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
     Along the coded axis the phase of one lit surface is monotonic (the projector and camera
     see its points in the same order); a reversal marks where two surfaces meet.
     """
-    a, b = phi[::4, :-1], phi[::4, 1:]
-    ok = valid[::4, :-1] & valid[::4, 1:]
+    a, b = phi[::8, :-1], phi[::8, 1:]
+    ok = valid[::8, :-1] & valid[::8, 1:]
     diff = (b - a)[ok]
     diff = (diff + np.pi) % TWO_PI - np.pi
     return 1 if diff.size == 0 or np.median(diff) >= 0 else -1
@@ -187,16 +187,17 @@ class RegionLinks:
     count: np.ndarray
 
 
-def region_links(phi: np.ndarray, labels: np.ndarray) -> RegionLinks:
+def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = None
+                 ) -> RegionLinks:
     """Pairs of regions that touch across a phase wrap, with the expected order step.
 
     Walking from a pixel to its right or lower neighbour, a wrap from high to low phase means
     the order grows by one, a wrap from low to high that it falls by one. Along the rows, a
     wrap against the phase's direction (:func:`fringe_direction`) joins two surfaces, not two
     fringes, and is left out. Each touching pair is reported once per direction of walk
-    (``src`` before ``dst``).
+    (``src`` before ``dst``). ``direction`` is :func:`fringe_direction`, computed if not given.
     """
-    sign = fringe_direction(phi, labels > 0)
+    sign = fringe_direction(phi, labels > 0) if direction is None else direction
     src, dst, step = [], [], []
     for a, b, la, lb, along in ((phi[:-1], phi[1:], labels[:-1], labels[1:], False),
                                 (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:], True)):

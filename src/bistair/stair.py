@@ -45,8 +45,10 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
 
 def quantize(theta: np.ndarray, levels: int) -> np.ndarray:
     """Stair level index of the phase ``theta`` (Eq. 20), modulo ``levels``; int32."""
-    scaled = (np.asarray(theta) + np.pi) * (levels / TWO_PI)
-    return (np.floor(scaled).astype(np.int64) % levels).astype(np.int32)
+    theta = np.asarray(theta)
+    scale = (levels / TWO_PI) if theta.dtype != np.float32 else np.float32(levels / TWO_PI)
+    scaled = (theta + (np.pi if theta.dtype != np.float32 else np.float32(np.pi))) * scale
+    return np.floor(scaled).astype(np.int32) % np.int32(levels)
 
 
 def level_distance(theta: np.ndarray, level: np.ndarray, levels: int) -> np.ndarray:
