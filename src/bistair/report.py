@@ -34,8 +34,11 @@ def method_figure(row: Row, truth: Any, path: str | Path) -> Path:
         ("|error| (rad, 0-0.3)", np.minimum(err, 0.3), "magma", (0, 0.3)),
         ("order errors (red)", _order_errors(err, res.mask, truth.mask), None, None),
     ]
+    step = max(1, min(err.shape) // 400)  # the panels are about 400 px tall anyway
     fig, axes = plt.subplots(2, 3, figsize=(12, 7.2), constrained_layout=True)
     for ax, (title, img, cmap, lim) in zip(axes.ravel(), panels, strict=True):
+        # Downsample by taking every step-th pixel, but keep every order error visible.
+        img = _block_max(img, step) if img.ndim == 3 else img[::step, ::step]
         if cmap is None:
             ax.imshow(img)
         else:
@@ -62,6 +65,11 @@ def _order_errors(err: np.ndarray, mask: np.ndarray, truth_mask: np.ndarray) -> 
     rgb[ok & (err > np.pi)] = (255, 0, 0)
     rgb[truth_mask & ~mask] = (40, 80, 255)
     return rgb
+
+
+def _block_max(rgb: np.ndarray, step: int) -> np.ndarray:
+    h, w = (rgb.shape[0] // step) * step, (rgb.shape[1] // step) * step
+    return rgb[:h, :w].reshape(h // step, step, w // step, step, 3).max(axis=(1, 3))
 
 
 def _embed(path: Path) -> str:
