@@ -49,9 +49,3 @@ def quantize(theta: np.ndarray, levels: int) -> np.ndarray:
     scale = (levels / TWO_PI) if theta.dtype != np.float32 else np.float32(levels / TWO_PI)
     scaled = (theta + (np.pi if theta.dtype != np.float32 else np.float32(np.pi))) * scale
     return np.floor(scaled).astype(np.int32) % np.int32(levels)
-
-
-def level_distance(theta: np.ndarray, level: np.ndarray, levels: int) -> np.ndarray:
-    """Circular distance (radians) from ``theta`` to the phase of ``level``."""
-    d = np.asarray(theta) - stair_level_phase(level, levels)
-    return np.abs((d + np.pi) % TWO_PI - np.pi)

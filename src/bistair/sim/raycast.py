@@ -31,15 +31,6 @@ _EDGE_TOL = 1e-7  # slack of the (float32) edge test, so rays never slip between
 _RAYS_PER_CELL = 1.0
 
 
-def intersect_triangles(origin: np.ndarray, dirs: np.ndarray, triangles: np.ndarray,
-                        tmin: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Nearest hit with ``t > tmin`` of rays ``origin + t * dirs`` with triangles.
-
-    A one-off :meth:`Triangles.intersect` (keep a :class:`Triangles` to reuse its set-up).
-    """
-    return Triangles(triangles).intersect(origin, dirs, tmin)
-
-
 class Triangles:
     """A triangle set, with its per-centre set-up cached for repeated bundles.
 
