@@ -218,6 +218,17 @@ def test_patterns_refuse_parameters_that_cannot_work(tmp_path, monkeypatch, caps
     assert not out.exists()
 
 
+def test_switches_work_alone_or_with_a_value(tmp_path, monkeypatch, capsys):
+    for args, expect in ((["--complementary", "--white"], (1, 1)),
+                         (["--complementary", "0", "--white", "1"], (0, 1))):
+        out = tmp_path / "-".join(args)
+        code, _, err = run(monkeypatch, capsys, "patterns", "graycode", "--period", 30, *args,
+                           "--out", out)
+        assert code == 0, err
+        spec = json.loads((out / "spec.json").read_text())
+        assert (spec["complementary"], spec["white"]) == expect
+
+
 def test_bad_option_value_exits_2(tmp_path, monkeypatch, capsys):
     code, _, err = run(monkeypatch, capsys, "patterns", "bidirectional", "--bits", 12,
                        "--out", tmp_path / "p")

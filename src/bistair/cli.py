@@ -70,6 +70,8 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
         if "choices" in f.metadata:
             opt["type"] = click.Choice([str(c) for c in f.metadata["choices"]])
             opt["default"] = str(f.default)
+            if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
+                opt.update(is_flag=False, flag_value="1")
         elif kind is tuple:
             opt["type"] = str
             opt["default"] = ",".join(map(str, f.default))
