@@ -186,11 +186,6 @@ def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes
     return votes / np.maximum(total, 1e-12)[:, None]
 
 
-def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
-    """Fringe order that brings ``phi`` nearest an absolute ``reference`` phase (same period)."""
-    return np.round((reference - phi) / TWO_PI)
-
-
 def _dense_somewhere(bad: np.ndarray, decided: np.ndarray, share: float,
                      block: int = 8) -> bool:
     """Whether some ``block`` x ``block`` tile has nearly ``share`` of its decided pixels bad:

@@ -84,3 +84,12 @@ def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
 def wrap(angle: np.ndarray) -> np.ndarray:
     """Wrap angles into ``[-pi, pi)``."""
     return (np.asarray(angle) + np.pi) % TWO_PI - np.pi
+
+
+def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Fringe order that brings ``phi`` nearest an absolute ``reference`` phase (same period).
+
+    >>> order_from_reference(np.array([0.1, 6.2]), np.array([12.7, 12.5])).tolist()
+    [2.0, 1.0]
+    """
+    return np.rint((np.asarray(reference) - phi) * (1.0 / TWO_PI))

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .phase import TWO_PI
+from .phase import TWO_PI, order_from_reference
 
 
 def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray, cut: float,
@@ -243,6 +243,6 @@ def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndar
     has = found.any(axis=1)
     ref = cand[np.arange(ty.size), first][has]
     sel_y, sel_x = ty[has], tx[has]
-    k = np.round((ref - phi[sel_y, sel_x]) / TWO_PI)
+    k = order_from_reference(phi[sel_y, sel_x], ref)
     out[sel_y, sel_x] = phi[sel_y, sel_x] + TWO_PI * k
     return out

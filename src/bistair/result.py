@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .phase import TWO_PI
+from .phase import TWO_PI, order_from_reference
 
 if TYPE_CHECKING:
     from .fringes import FringeSet
@@ -111,7 +111,7 @@ def result_from_phase(method: str, fs: FringeSet, abs_phase: np.ndarray, period:
                       code: np.ndarray | None = None, info: dict[str, Any] | None = None
                       ) -> DecodeResult:
     """A result from a measured fringe set and its absolute phase (NaN = invalid)."""
-    order = np.rint((abs_phase - fs.phi) * (1.0 / TWO_PI))
+    order = order_from_reference(fs.phi, abs_phase)
     order[~np.isfinite(order)] = -1
     return make_result(method, fs.phi, order, period, fs.mod, fs.avg,
                        code=code, wrapped=np.where(fs.valid, fs.phi, np.float32(np.nan)),

@@ -141,11 +141,11 @@ def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = 
         order = _paper_orders(ks, theta, fs, spec)
         abs_phase = np.where(order >= 0, phi + TWO_PI * order, np.nan)
     else:
-        abs_phase = _region_phase(fs, theta, stair_mod, spec, info)
+        abs_phase = _region_phase(fs, theta, stair_mod, ks, spec, info)
     return result_from_phase("bidirectional", fs, abs_phase, spec.period, code=ks, info=info)
 
 
-def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray,
+def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
                   spec: BidirectionalSpec, info: dict) -> np.ndarray:
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     ratio = np.clip(stair_mod / np.maximum(fs.mod, 1e-6), 0.0, 2.0)
@@ -168,12 +168,11 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray,
                     group_height=default)
         return labels, n, region_evidence(runs, n, heights, layout)
 
-    q_local = quantize(theta, spec.stairs)
     q_part = quantize(theta, spec.partitions)
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """A pixel reads its order's local or partition level (its row decides which)."""
-        return (q_local == k % spec.stairs) | (q_part == k // spec.stairs)
+        return (ks == k % spec.stairs) | (q_part == k // spec.stairs)
 
     return phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
 

@@ -39,8 +39,7 @@ import numpy as np
 from ..captures import Prepared
 from ..errors import BistairError
 from ..fringes import measure
-from ..order import order_from_reference
-from ..phase import TWO_PI, phase_shift_patterns
+from ..phase import TWO_PI, order_from_reference, phase_shift_patterns
 from ..result import DecodeResult, result_from_phase
 from ..spec import BaseSpec, field, register_spec
 from .base import Codec, along_columns
