@@ -22,12 +22,13 @@ from pathlib import Path
 import numpy as np
 
 import bistair
-from bistair.calib import Calibration, calibrate_folder
-from bistair.compare import method_specs
-from bistair.metrics import fit_plane, fit_sphere
-from bistair.reconstruct import reconstruct
+from bistair.app.jobs import calibrate_folder
+from bistair.app.simulate import simulate
+from bistair.evaluation.benchmark import method_specs
+from bistair.evaluation.metrics import fit_plane, fit_sphere
+from bistair.geometry.calibration import Calibration
+from bistair.geometry.triangulate import reconstruct
 from bistair.sim import Imaging, Rig, expose, preset, trace
-from bistair.simulate import simulate
 
 CODECS = ["bidirectional", "lv", "phase-coding", "graycode", "multifreq"]
 

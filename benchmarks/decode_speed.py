@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 import bistair
-from bistair.synth import Blob, WarpScene, render_warp
+from bistair.sim.warp import Blob, WarpScene, render_warp
 
 SIZE = (1024, 1280)
 

@@ -29,7 +29,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from bistair.compare import method_specs, run, stairs_for  # noqa: E402
+from bistair.codecs.bidirectional import stairs_for  # noqa: E402
+from bistair.evaluation.benchmark import method_specs, run  # noqa: E402
 from bistair.sim import Ellipsoid, Imaging, Rig, Scene, preset, trace  # noqa: E402
 
 PROJECTOR = (1080, 1080)

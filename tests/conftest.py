@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 import bistair
-from bistair.metrics import compare
-from bistair.synth import Blob, WarpScene, render_warp
+from bistair.evaluation.metrics import score as score_of
+from bistair.sim.warp import Blob, WarpScene, render_warp
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 CFPE = SHARED / "data" / "cfpe"
@@ -52,7 +52,7 @@ def warped_scene(seed: int, noise: float, blur: float, **overrides) -> WarpScene
 def score(spec, scene, **decode_options):
     images, truth = render_warp(spec, scene)
     result = bistair.decode(images, spec, **decode_options)
-    return result, truth, compare(result, truth.coord, truth.mask, truth.object_id)
+    return result, truth, score_of(result, truth.coord(spec), truth.mask, truth.object_id)
 
 
 @pytest.fixture(scope="session")
@@ -62,7 +62,7 @@ def spec36():
 
 def cli_run(monkeypatch, capsys, *args) -> tuple[int, str, str]:
     """Run the ``bistair`` entry point in-process: (exit code, stdout, stderr)."""
-    from bistair.cli import main
+    from bistair.app.cli import main
 
     monkeypatch.setattr(sys, "argv", ["bistair", *map(str, args)])
     code = 0

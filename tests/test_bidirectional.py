@@ -13,8 +13,8 @@ from scipy import ndimage
 
 import bistair
 from bistair.errors import BistairError
-from bistair.metrics import compare
-from bistair.synth import Blob, WarpScene, render_warp
+from bistair.evaluation import metrics
+from bistair.sim.warp import Blob, WarpScene, render_warp
 
 VARIANTS = [
     dict(width=1080, height=1080, period=30),
@@ -100,7 +100,7 @@ def test_default_beats_the_paper_decoder(spec36, seed):
 
 def _wrong(res, truth, period=30.0):
     ok = res.mask & truth.mask
-    err = np.abs(res.phase - 2 * np.pi * truth.coord / period)
+    err = np.abs(res.phase - 2 * np.pi * truth.coord("columns") / period)
     return ok & (err > np.pi)
 
 
@@ -108,7 +108,7 @@ def test_stair_edges_are_not_misordered(spec36):
     """Pixels within 2 camera pixels of a fringe edge, where code and phase change together."""
     scene = warped_scene(1, noise=0.02, blur=1.5)
     res, truth, _ = score(spec36, scene)
-    frac = (truth.coord / 30) % 1.0
+    frac = (truth.coord(spec36) / 30) % 1.0
     near_edge = truth.mask & (np.minimum(frac, 1 - frac) * 30 / scene.stretch < 2.0)
     assert near_edge.sum() > 2000
     assert _wrong(res, truth)[near_edge].sum() == 0
@@ -186,5 +186,5 @@ def test_saturated_pixels_are_invalid(spec36):
     heavily = (exposed[:4] > 1.05).sum(axis=0) >= 2  # two phase samples cut well short
     assert heavily.sum() > 1000
     assert not res.mask[heavily].any()
-    m = compare(res, truth.coord, truth.mask)
+    m = metrics.score(res, truth.coord(spec36), truth.mask)
     assert m["order_errors"] == 0 and m["phase_rmse"] < 0.05

@@ -11,25 +11,25 @@ import numpy as np
 import pytest
 
 import bistair
-from bistair.board import Board
-from bistair.calib import (
-    Calibration,
-    Device,
+from bistair.app.jobs import calibrate_folder, reconstruct_folder
+from bistair.errors import BistairError
+from bistair.evaluation.metrics import fit_sphere
+from bistair.geometry.board import Board
+from bistair.geometry.calibrate import (
     PoseCapture,
-    calibrate_folder,
     calibrate_points,
     calibrate_poses,
-    load_calibration,
     sample_local,
-    save_calibration,
-    synthetic_views,
 )
-from bistair.errors import BistairError
-from bistair.io import write_image
-from bistair.metrics import fit_sphere
-from bistair.reconstruct import reconstruct_folder
+from bistair.geometry.calibration import (
+    Calibration,
+    Device,
+    load_calibration,
+    save_calibration,
+)
+from bistair.io.files import write_image
 from bistair.sim import Imaging, Rig, Scene, Sphere, expose, trace
-from bistair.sim.boards import POSES, write_board_captures
+from bistair.sim.boards import POSES, synthetic_views, write_board_captures
 
 BOARD = Board("checkerboard", 9, 6, 20.0)
 

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 from conftest import cli_run, warped_scene
 
-from bistair.synth import render_warp
+from bistair.sim.warp import render_warp
 
 run = cli_run
 
@@ -76,7 +76,7 @@ def test_decode_a_synthetic_npy_stack_with_explicit_spec(tmp_path, monkeypatch, 
     phase = np.load(tmp_path / "res" / "phase.npy")
     ok = truth.mask & np.isfinite(phase)
     assert ok.sum() > 0.99 * truth.mask.sum()
-    assert np.abs(phase[ok] - 2 * np.pi * truth.coord[ok] / 30).max() < np.pi
+    assert np.abs(phase[ok] - 2 * np.pi * truth.coord(spec)[ok] / 30).max() < np.pi
     assert not (tmp_path / "res" / "phase.png").exists()
 
 

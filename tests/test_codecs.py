@@ -18,7 +18,7 @@ from bistair.codecs.graycode import gray_to_binary
 from bistair.codecs.lv import code_sequence
 from bistair.codecs.multifreq import beat_tree
 from bistair.errors import BistairError
-from bistair.synth import Blob, WarpScene
+from bistair.sim.warp import Blob, WarpScene
 
 EXACT = [
     ("multifreq", dict(periods=(1080, 180, 30))),
@@ -108,8 +108,9 @@ def test_complementary_gray_code_removes_the_edge_errors():
         spec = bistair.make_spec("graycode", width=1080, height=1080, period=30,
                                  complementary=comp)
         res, truth, m = score(spec, scene)
-        wrong = res.mask & truth.mask & (np.abs(res.phase - 2 * np.pi * truth.coord / 30) > np.pi)
-        frac = (truth.coord / 30) % 1.0
+        coord = truth.coord(spec)
+        wrong = res.mask & truth.mask & (np.abs(res.phase - 2 * np.pi * coord / 30) > np.pi)
+        frac = (coord / 30) % 1.0
         near_edge = np.minimum(frac, 1 - frac) * 30 / scene.stretch < 3.0
         found[comp] = (int(wrong.sum()), int((wrong & ~near_edge).sum()), m["order_error_rate"])
     plain, comp = found[0], found[1]
@@ -142,7 +143,7 @@ def test_parameters_that_cannot_work(method, params, reason):
 def test_every_codec_decodes_through_the_cli(tmp_path, monkeypatch):
     import sys
 
-    from bistair.cli import main
+    from bistair.app.cli import main
     for method, extra in [("multifreq", ["--periods", "1080,180,30"]),
                           ("phase-coding", ["--period", "30"]), ("lv", ["--period", "30"]),
                           ("graycode", ["--period", "30", "--complementary", "1"])]:

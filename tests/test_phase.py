@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from bistair.phase import TWO_PI, phase_shift_patterns, residual_noise, wrapped_phase
-from bistair.regions import fill_from_neighbours, fringe_regions, region_links
-from bistair.stair import quantize, stair_level_phase, stair_pair, stair_phase
+from bistair.core.phase import TWO_PI, phase_shift_patterns, residual_noise, wrapped_phase
+from bistair.core.regions import fill_from_neighbours, fringe_regions, region_links
+from bistair.core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 
 
 @pytest.mark.parametrize("steps", [3, 4, 5, 8, 12])

@@ -11,7 +11,7 @@ import pytest
 from conftest import CFPE
 
 import bistair
-from bistair.io import read_captures
+from bistair.io.files import read_captures
 
 pytestmark = pytest.mark.skipif(not CFPE.is_dir(), reason="../shared/data/cfpe not present")
 

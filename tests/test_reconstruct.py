@@ -14,17 +14,14 @@ import pytest
 from plyfile import PlyData
 
 import bistair
-from bistair.calib import Calibration, Device, save_calibration
+from bistair.app.jobs import reconstruct_folder
 from bistair.errors import BistairError
-from bistair.metrics import fit_plane, fit_sphere
-from bistair.reconstruct import (
-    HeightModel,
-    reconstruct,
-    reconstruct_folder,
-    render_cloud,
-    triangulate,
-    write_ply,
-)
+from bistair.evaluation.metrics import fit_plane, fit_sphere
+from bistair.evaluation.views import render_cloud
+from bistair.geometry.calibration import Calibration, Device, save_calibration
+from bistair.geometry.height import HeightModel
+from bistair.geometry.triangulate import reconstruct, triangulate
+from bistair.io.writers import write_ply
 from bistair.sim import Imaging, Plane, Rig, Scene, Sphere, expose, preset, trace
 
 FOV = 320.0  # mm across the camera's view at the working distance
@@ -91,7 +88,7 @@ def sphere_rig():
 
 
 def test_every_codec_has_a_pattern_set():
-    assert set(SPECS) == set(bistair.CODECS)
+    assert set(SPECS) == set(bistair.methods())
 
 
 @pytest.mark.parametrize("method", sorted(SPECS))

@@ -13,7 +13,7 @@ import pytest
 import trimesh
 
 import bistair
-from bistair.metrics import compare
+from bistair.evaluation.metrics import score
 from bistair.sim import (
     Box,
     Camera,
@@ -265,8 +265,8 @@ def test_truth_coord_follows_the_spec_orientation():
     rows = cols.replace(orientation="rows")
     images, truth = render(bistair.encode(rows), rig, scene, Imaging(seed=2))
     assert truth.coord(cols) is truth.coord_x and truth.coord(rows) is truth.coord_y
-    score = compare(bistair.decode(images, rows), truth.coord(rows), truth.mask)
-    assert score["order_errors"] == 0 and score["coverage"] > 0.99
+    m = score(bistair.decode(images, rows), truth.coord(rows), truth.mask)
+    assert m["order_errors"] == 0 and m["coverage"] > 0.99
 
 
 # -- end to end --------------------------------------------------------------------------------
@@ -276,8 +276,8 @@ def test_bidirectional_decodes_the_rendered_plane():
     spec = bistair.make_spec("bidirectional", width=1080, height=1080, period=30)
     images, truth = render(bistair.encode(spec), rig, scene, Imaging(seed=3))
     result = bistair.decode(images, spec)
-    score = compare(result, truth.coord(spec), truth.mask)
-    assert score["order_errors"] == 0 and score["coverage"] > 0.999
+    m = score(result, truth.coord(spec), truth.mask)
+    assert m["order_errors"] == 0 and m["coverage"] > 0.999
     both = result.mask & truth.mask
     err = result.coord[both] - truth.coord(spec)[both]
     assert np.sqrt(np.mean(err**2)) < 0.15 and np.percentile(np.abs(err), 99) < 0.4

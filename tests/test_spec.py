@@ -5,8 +5,8 @@ import json
 import pytest
 
 import bistair
+from bistair import load_spec, spec_from_dict
 from bistair.errors import BistairError
-from bistair.spec import load_spec, spec_from_dict
 
 
 def test_round_trip_through_json(tmp_path):

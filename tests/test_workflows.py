@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from conftest import cli_run
 
-from bistair.calib import Calibration, save_calibration
+from bistair.geometry.calibration import Calibration, save_calibration
 from bistair.sim import preset
 
 run = cli_run
@@ -76,7 +76,7 @@ def test_simulate_refuses_unknown_scene_and_method(tmp_path, monkeypatch, capsys
 @pytest.fixture(scope="module")
 def plane_captures(tmp_path_factory):
     """A plane rendered with graycode (fast) at 320x256, and the rig's exact calibration."""
-    from bistair.simulate import simulate
+    from bistair.app.simulate import simulate
 
     root = tmp_path_factory.mktemp("plane")
     simulate("plane", ["graycode"], root / "sim", camera_size=(320, 256))

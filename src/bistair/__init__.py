@@ -1,7 +1,11 @@
 """bistair: absolute phase measurement for fringe projection profilometry.
 
 The headline method is the bidirectional stair-phase coding of Qi, Zhou et al.; the methods
-it is compared with sit beside it behind the same interface.
+it is compared with sit beside it behind the same interface. ``ARCHITECTURE.md`` at the
+repository root maps the packages: :mod:`bistair.core` (building blocks on arrays),
+:mod:`bistair.codecs` (one per method, and the registry), :mod:`bistair.io`,
+:mod:`bistair.geometry`, :mod:`bistair.sim`, :mod:`bistair.evaluation` and
+:mod:`bistair.app` (jobs and the command line).
 
 Examples
 --------
@@ -15,34 +19,11 @@ Examples
 
 from __future__ import annotations
 
-from typing import Any
-
-import numpy as np
-
-from .codecs import CODECS, get_codec
+from .codecs import decode, encode, get_codec, make_spec, methods, spec_from_dict
+from .core.result import DecodeResult
 from .errors import BistairError
-from .result import DecodeResult
-from .spec import BaseSpec, load_spec, spec_from_dict
+from .io.files import load_spec
 
-__all__ = ["BistairError", "CODECS", "DecodeResult", "decode", "encode", "load_spec",
-           "make_spec", "spec_from_dict"]
+__all__ = ["BistairError", "DecodeResult", "decode", "encode", "get_codec", "load_spec",
+           "make_spec", "methods", "spec_from_dict"]
 __version__ = "0.1.0"
-
-
-def make_spec(method: str, **params: Any) -> BaseSpec:
-    """A validated spec for ``method`` with the given parameters (defaults elsewhere)."""
-    codec = get_codec(method)
-    try:
-        return codec.spec_class(**params)
-    except TypeError as exc:
-        raise BistairError(f"bad parameters for {method}: {exc}") from None
-
-
-def encode(spec: BaseSpec) -> np.ndarray:
-    """The patterns of a spec: float32 in [0, 1], shape (frames, height, width)."""
-    return get_codec(spec.method).encode(spec)
-
-
-def decode(images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
-    """Decode a capture stack (frames, height, width), any dtype, with the spec it was made by."""
-    return get_codec(spec.method).decode(images, spec, **options)

@@ -4,9 +4,13 @@ A spec names the method, every parameter and the frame order. It is written next
 patterns as ``spec.json`` and read back to decode the captures, so the set that was projected
 is the set that is decoded.
 
+The spec classes live with their codecs (:mod:`bistair.codecs`), which also keep the one
+registry of methods; this module holds what every spec shares: the base classes, field
+metadata for the command line, and the checks of a spec read from JSON.
+
 Examples
 --------
->>> from bistair.spec import spec_from_dict
+>>> from bistair.codecs import spec_from_dict
 >>> spec = spec_from_dict({"method": "bidirectional", "width": 1080, "height": 1080,
 ...                        "period": 30})
 >>> spec.frames[:2], spec.frame_count
@@ -20,25 +24,11 @@ from __future__ import annotations
 import dataclasses
 import json
 from collections.abc import Mapping
-from pathlib import Path
 from typing import Any, ClassVar
 
 from .errors import BistairError
-from .jsonfile import read_json
 
 SPEC_VERSION = 1
-_REGISTRY: dict[str, type[BaseSpec]] = {}
-
-
-def register_spec(cls: type[BaseSpec]) -> type[BaseSpec]:
-    """Class decorator: make ``cls`` loadable by its ``method`` name."""
-    _REGISTRY[cls.method] = cls
-    return cls
-
-
-def spec_methods() -> list[str]:
-    """The method names that have a spec class."""
-    return sorted(_REGISTRY)
 
 
 def field(default: Any, help: str, **cli: Any) -> Any:  # noqa: A002 - mirrors click's name
@@ -89,13 +79,14 @@ class BaseSpec:
 
     def default_frames(self) -> tuple[str, ...]:
         """The method's frames, then the white frame if asked for."""
-        return self._frames() + (("white",) if self.white else ())
+        return self.method_frames() + (("white",) if self.white else ())
 
     @property
     def frame_count(self) -> int:
         return len(self.frames)
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
+        """The frames the method decodes, in its own order (without extra frames)."""
         raise NotImplementedError
 
     # -- validation ------------------------------------------------------------------------
@@ -188,7 +179,8 @@ def _coerce(name: str, value: Any, kind: type) -> Any:
     raise TypeError(kind)  # pragma: no cover
 
 
-def _field_kind(f: dataclasses.Field) -> type:
+def field_kind(f: dataclasses.Field) -> type:
+    """The Python type of a spec field: int, float, str or tuple."""
     text = str(f.type)
     for kind in (int, float, str):
         if text == kind.__name__:
@@ -198,16 +190,12 @@ def _field_kind(f: dataclasses.Field) -> type:
     raise TypeError(f"unsupported spec field type {text}")  # pragma: no cover
 
 
-def spec_from_dict(data: Mapping[str, Any]) -> BaseSpec:
-    """Build and validate a spec from its dictionary (as in ``spec.json``)."""
-    if not isinstance(data, Mapping):
-        raise BistairError("spec must be a JSON object")
-    method = data.get("method")
-    if method is None:
-        raise BistairError("spec misses the field 'method'")
-    cls = _REGISTRY.get(method)
-    if cls is None:
-        raise BistairError(f"unknown method {method!r} (known: {', '.join(spec_methods())})")
+def check_fields(cls: type[BaseSpec], data: Mapping[str, Any]) -> BaseSpec:
+    """Build and validate a spec of class ``cls`` from its dictionary (as in ``spec.json``).
+
+    Field values are checked for type, unknown fields and fields the class requires are
+    refused with one line; ``frames`` becomes the capture order.
+    """
     version = data.get("version", SPEC_VERSION)
     if version != SPEC_VERSION:
         raise BistairError(f"spec version {version!r} is not supported (expected {SPEC_VERSION})")
@@ -221,14 +209,9 @@ def spec_from_dict(data: Mapping[str, Any]) -> BaseSpec:
     required = [name for name in ("width", "height", *cls.required) if name not in data]
     if required:
         raise BistairError(f"spec misses field(s): {', '.join(required)}")
-    kwargs = {name: _coerce(name, data[name], _field_kind(f)) for name, f in fields.items()
+    kwargs = {name: _coerce(name, data[name], field_kind(f)) for name, f in fields.items()
               if name in data}
     spec = cls(**kwargs)
     if spec.frame_order == spec.default_frames():
         spec = dataclasses.replace(spec, frame_order=())
     return spec
-
-
-def load_spec(path: str | Path) -> BaseSpec:
-    """Read and validate a ``spec.json``."""
-    return spec_from_dict(read_json(path, "spec file"))

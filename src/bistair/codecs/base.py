@@ -1,40 +1,115 @@
-"""The one small interface every method implements, and the shared encode/decode plumbing.
+"""The interface every method implements, and the plumbing all methods share.
 
-A codec is a spec class plus two functions on the coded axis laid out along image columns:
-``encode_columns(spec) -> (F, other, coded)`` float patterns in [0, 1] and
-``decode_columns(prepared, spec, **options) -> DecodeResult``. The plumbing here handles the
-rows orientation (by transposing), projector gamma pre-compensation, bit depth and the checks
-every capture goes through.
+A codec is a spec class and four functions on the coded axis laid out along image columns
+(captures of the rows orientation are decoded transposed):
+
+================================================  =========================================
+``encode_columns(spec)``                          ``(F, other, coded)`` patterns in [0, 1]
+``measure_columns(prepared, spec, min_mod)``      stage 1, the phase map: a
+                                                  :class:`~bistair.core.measure.FringeSet`
+``code_columns(prepared, spec, fringes, min_mod)``  stage 2, the code map: a :class:`CodeMap`
+``order_columns(fringes, code, spec, **options)`` stage 3, the orders: an :class:`Orders`
+================================================  =========================================
+
+:class:`Codec` wraps them with what every capture goes through (frame count, scaling, frame
+order, orientation, projector gamma, bit depth) and exposes the stages like OpenCV's
+structured-light decoders (``computePhaseMap``, ``computeFloorMap``): :meth:`Codec.phase_map`,
+:meth:`Codec.code_map` and :meth:`Codec.decode`, each in camera image axes.
+
+Examples
+--------
+>>> import numpy as np
+>>> from bistair.codecs import get_codec, make_spec
+>>> spec = make_spec("graycode", width=240, height=32, period=30)
+>>> codec = get_codec("graycode")
+>>> patterns = codec.encode(spec)
+>>> fringes = codec.phase_map(patterns, spec)
+>>> code = codec.code_map(patterns, spec)
+>>> code.code[0, ::30].tolist(), codec.options
+([0, 1, 2, 3, 4, 5, 6, 7], ('min_modulation',))
 """
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from ..captures import Prepared, prepare
+from ..core.captures import Prepared, prepare
+from ..core.measure import FringeSet, measure
+from ..core.result import DecodeResult, result_from_phase
 from ..errors import BistairError
-from ..result import DecodeResult
-from ..spec import BaseSpec
+from ..spec import BaseSpec, PeriodSpec
 
-EncodeFn = Callable[[Any], np.ndarray]
-DecodeFn = Callable[..., DecodeResult]
+
+@dataclass
+class CodeMap:
+    """Stage 2 of a decode: the method's code word per pixel and the maps it came from.
+
+    Attributes
+    ----------
+    code : int32, the code word (``k_s`` for the stair methods, the Gray-code order, the
+        order from the coarser phases for multi-frequency), -1 where not decoded.
+    maps : named method-specific maps of the same shape (e.g. ``stair_phase``).
+    """
+
+    code: np.ndarray
+    maps: dict[str, np.ndarray] = field(default_factory=dict)
+
+    def transposed(self) -> CodeMap:
+        """The same maps with image axes swapped (for the rows orientation)."""
+        return CodeMap(np.ascontiguousarray(self.code.T),
+                       {k: np.ascontiguousarray(v.T) for k, v in self.maps.items()})
+
+
+@dataclass
+class Orders:
+    """Stage 3 of a decode: the absolute phase (NaN where invalid) and figures about it."""
+
+    abs_phase: np.ndarray
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+MeasureFn = Callable[[Prepared, Any, float | None], FringeSet]
+CodeFn = Callable[[Prepared, Any, FringeSet, float | None], CodeMap]
+OrderFn = Callable[..., Orders]
+
+
+def measure_shifts(prepared: Prepared, spec: PeriodSpec,
+                   min_modulation: float | None = None) -> FringeSet:
+    """Stage 1 of the single-period methods: their N-step set, the first ``steps`` frames."""
+    return measure(prepared, 0, spec.steps, min_modulation)
 
 
 @dataclass(frozen=True)
 class Codec:
-    """A method: its name, spec class, encoder and decoder (on column-coded data)."""
+    """A method: its name, spec class and the functions of its stages (column layout).
+
+    ``comparable(width, height, period, steps)`` gives the spec parameters of the method's
+    pattern set that compares with the others on a projector (for the benchmark and the
+    simulator); ``variants`` names decoder options worth comparing too (label -> options).
+    """
 
     name: str
     spec_class: type[BaseSpec]
-    encode_columns: EncodeFn
-    decode_columns: DecodeFn
     summary: str
-    options: tuple[str, ...] = ()  # decode keyword options the codec accepts
+    encode_columns: Callable[[Any], np.ndarray]
+    order_columns: OrderFn
+    code_columns: CodeFn
+    measure_columns: MeasureFn = measure_shifts
+    comparable: Callable[[int, int, int, int], dict[str, Any]] | None = None
+    variants: dict[str, dict[str, Any]] = field(default_factory=dict)
 
+    @property
+    def options(self) -> tuple[str, ...]:
+        """Decode keyword options: ``min_modulation`` and those of the order stage."""
+        params = inspect.signature(self.order_columns).parameters.values()
+        return ("min_modulation", *(p.name for p in params if p.kind is p.KEYWORD_ONLY))
+
+    # -- encoding ----------------------------------------------------------------------------
     def encode(self, spec: BaseSpec) -> np.ndarray:
         """Patterns as float32 in [0, 1], shape (frames, height, width), gamma pre-compensated."""
         pats = np.asarray(self.encode_columns(spec), dtype=np.float64)
@@ -48,35 +123,57 @@ class Codec:
         order = [spec.default_frames().index(name) for name in spec.frames]
         return np.ascontiguousarray(pats[order], dtype=np.float32)
 
-    def decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
-        unknown = set(options) - set(self.options)
-        if unknown:
-            raise BistairError(
-                f"the {self.name} decoder has no option(s) {', '.join(sorted(unknown))}"
-            )
+    # -- decoding stages ---------------------------------------------------------------------
+    def _columns(self, images: np.ndarray, spec: BaseSpec) -> tuple[Prepared, Prepared]:
+        """The checked, scaled stack and its method frames in method order, coded axis along
+        the columns."""
+        if spec.method != self.name:
+            raise BistairError(f"a {spec.method} spec cannot be decoded by the {self.name} codec")
         prepared = prepare(images, spec.frame_count, self.name)
-        order = [spec.frames.index(name) for name in spec._frames()]  # the method's own
+        order = [spec.frames.index(name) for name in spec.method_frames()]
         same = order == list(range(len(order)))
         frames = prepared.frames[:len(order)] if same else prepared.frames[order]
         clipped = prepared.clipped
         if spec.orientation == "rows":
             frames = frames.transpose(0, 2, 1)
             clipped = clipped.T
-        result = self.decode_columns(Prepared(frames, clipped, prepared.full_scale), spec,
-                                     **options)
+        return prepared, Prepared(frames, clipped, prepared.full_scale)
+
+    def phase_map(self, images: np.ndarray, spec: BaseSpec,
+                  min_modulation: float | None = None) -> FringeSet:
+        """Stage 1: wrapped phase, average, modulation and validity of the captures."""
+        _, cols = self._columns(images, spec)
+        fs = self.measure_columns(cols, spec, min_modulation)
+        return fs.transposed() if spec.orientation == "rows" else fs
+
+    def code_map(self, images: np.ndarray, spec: BaseSpec,
+                 min_modulation: float | None = None) -> CodeMap:
+        """Stage 2: the method's code word per pixel (-1 where not decoded)."""
+        _, cols = self._columns(images, spec)
+        fs = self.measure_columns(cols, spec, min_modulation)
+        code = self.code_columns(cols, spec, fs, min_modulation)
+        return code.transposed() if spec.orientation == "rows" else code
+
+    def decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
+        """All stages: absolute phase, projector coordinate and fringe order per pixel."""
+        unknown = set(options) - set(self.options)
+        if unknown:
+            raise BistairError(
+                f"the {self.name} decoder has no option(s) {', '.join(sorted(unknown))}"
+            )
+        min_modulation = options.pop("min_modulation", None)
+        prepared, cols = self._columns(images, spec)
+        fs = self.measure_columns(cols, spec, min_modulation)
+        code = self.code_columns(cols, spec, fs, min_modulation)
+        orders = self.order_columns(fs, code, spec, **options)
+        result = result_from_phase(self.name, fs, orders.abs_phase, spec.period,
+                                   code=code.code, info=orders.info)
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":
             result = result.transposed()
         if spec.white:
             result.texture = prepared.frames[spec.frames.index("white")]
         return result
-
-
-def quantize_patterns(patterns: np.ndarray, bits: int) -> np.ndarray:
-    """Float patterns in [0, 1] to uint8 or uint16 images."""
-    top = (1 << bits) - 1
-    data = np.round(np.clip(patterns, 0.0, 1.0) * top)
-    return data.astype(np.uint8 if bits == 8 else np.uint16)
 
 
 def along_columns(profiles: np.ndarray, spec: BaseSpec) -> np.ndarray:

@@ -34,13 +34,12 @@ import dataclasses
 
 import numpy as np
 
-from ..captures import Prepared
+from ..core.captures import Prepared
+from ..core.measure import FringeSet
+from ..core.phase import TWO_PI, phase_shift_patterns
 from ..errors import BistairError
-from ..fringes import measure
-from ..phase import TWO_PI, phase_shift_patterns
-from ..result import DecodeResult, result_from_phase
-from ..spec import PeriodSpec, field, register_spec
-from .base import Codec, along_columns
+from ..spec import PeriodSpec, field
+from .base import Codec, CodeMap, Orders, along_columns
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -57,7 +56,6 @@ def gray_to_binary(gray: np.ndarray) -> np.ndarray:
     return binary
 
 
-@register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class GrayCodeSpec(PeriodSpec):
     method = "graycode"
@@ -72,7 +70,7 @@ class GrayCodeSpec(PeriodSpec):
         """Gray code bits for the fringe count (the complementary pattern adds one)."""
         return max(1, int(np.ceil(np.log2(self.fringes))))
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
         codes = tuple(f"gray-{i}" for i in range(self.code_bits + self.complementary))
         inverse = tuple(f"{c}-inv" for c in codes) if self.inverse else ()
         return (*self.shift_frames(), *codes, *inverse)
@@ -96,9 +94,10 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     return along_columns(np.concatenate([shifts, codes]), spec)
 
 
-def decode_columns(prepared: Prepared, spec: GrayCodeSpec,
-                   min_modulation: float | None = None) -> DecodeResult:
-    fs = measure(prepared, 0, spec.steps, min_modulation)
+def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
+                 min_modulation: float | None = None) -> CodeMap:
+    """Stage 2: the fringe order read from the Gray code (three-zone rule when
+    complementary), -1 where the fringes are not valid or the code is out of range."""
     n_bits = spec.code_bits + spec.complementary
     code = prepared.frames[spec.steps:spec.steps + n_bits]
     ref = prepared.frames[spec.steps + n_bits:] if spec.inverse else fs.avg[None]
@@ -113,17 +112,26 @@ def decode_columns(prepared: Prepared, spec: GrayCodeSpec,
     else:
         k = gray_to_binary(gray)
     ok = fs.valid & (k >= 0) & (k < spec.fringes)
-    abs_phase = np.where(ok, fs.phi + TWO_PI * k, np.nan)
-    info = {"noise": fs.noise, "bits": n_bits}
-    return result_from_phase("graycode", fs, abs_phase, spec.period,
-                             code=np.where(ok, k, -1).astype(np.int32), info=info)
+    return CodeMap(np.where(ok, k, -1).astype(np.int32))
+
+
+def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec) -> Orders:
+    """Stage 3: the code is the order."""
+    abs_phase = np.where(code.code >= 0, fs.phi + TWO_PI * code.code, np.nan)
+    return Orders(abs_phase, {"noise": fs.noise, "bits": spec.code_bits + spec.complementary})
+
+
+def comparable(width: int, height: int, period: int, steps: int) -> dict:
+    """The complementary Gray code at the same period."""
+    return dict(period=period, complementary=1, steps=steps)
 
 
 CODEC = Codec(
     name="graycode",
     spec_class=GrayCodeSpec,
-    encode_columns=encode_columns,
-    decode_columns=decode_columns,
     summary="N phase shifts + Gray code (optionally complementary, optionally with inverses)",
-    options=("min_modulation",),
+    encode_columns=encode_columns,
+    code_columns=code_columns,
+    order_columns=order_columns,
+    comparable=comparable,
 )

@@ -12,7 +12,7 @@ deterministic depth-first search). Decoding: each fringe region (2-D stripe betw
 jumps) takes the code most of its pixels read; regions are chained to their right-hand
 neighbours across wraps; every chain of ``window`` regions is looked up in the sequence and
 votes for the orders of its members; the votes are checked against each other and against
-the one-order step across every wrap (:func:`bistair.order.phase_from_regions`). A region
+the one-order step across every wrap (:func:`bistair.core.resolve.phase_from_regions`). A region
 in an object narrower than ``window`` fringes gets no window and stays invalid: that is the
 method's known limit, which the bidirectional coding removes.
 
@@ -29,16 +29,15 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..captures import Prepared
+from ..core.captures import Prepared
+from ..core.measure import FringeSet
+from ..core.phase import phase_shift_patterns
+from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
+from ..core.resolve import code_evidence, phase_from_regions
+from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
-from ..fringes import measure
-from ..order import code_evidence, phase_from_regions
-from ..phase import phase_shift_patterns
-from ..regions import RegionLinks, core_weight, fringe_regions, region_links
-from ..result import DecodeResult, result_from_phase
-from ..spec import PeriodSpec, field, register_spec
-from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
-from .base import Codec, along_columns
+from ..spec import PeriodSpec, field
+from .base import Codec, CodeMap, Orders, along_columns
 
 
 @lru_cache(maxsize=64)
@@ -78,7 +77,6 @@ def code_sequence(length: int, levels: int, window: int) -> tuple[int, ...]:
     return tuple(seq)
 
 
-@register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class LvSpec(PeriodSpec):
     method = "lv"
@@ -90,7 +88,7 @@ class LvSpec(PeriodSpec):
     def sequence(self) -> tuple[int, ...]:
         return code_sequence(self.fringes, self.levels, self.window)
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
         return (*self.shift_frames(), "code-cos", "code-sin")
 
     def validate(self) -> None:
@@ -177,12 +175,18 @@ def _window_key(codes: np.ndarray, levels: int) -> np.ndarray:
     return (codes * levels ** np.arange(codes.shape[1] - 1, -1, -1)).sum(axis=1)
 
 
-def decode_columns(prepared: Prepared, spec: LvSpec,
-                   min_modulation: float | None = None) -> DecodeResult:
-    fs = measure(prepared, 0, spec.steps, min_modulation)
+def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
+                 min_modulation: float | None = None) -> CodeMap:
+    """Stage 2: each valid pixel's code level from the coded pair."""
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
-    codes = np.where(fs.valid, quantize(theta, spec.levels), -1)
+    codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
+    return CodeMap(codes, {"code_phase": theta})
+
+
+def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
+    """Stage 3: windows of adjacent fringe regions looked up in the code sequence."""
+    codes = code.code
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     weight = core_weight(fs.phi)
 
@@ -198,15 +202,32 @@ def decode_columns(prepared: Prepared, spec: LvSpec,
     abs_phase = phase_from_regions(
         fs.phi, fs.valid, labels, evidence_of, info=info,
         agrees=lambda k: (codes == sequence[np.clip(k, 0, None)]) | (codes < 0))
-    return result_from_phase("lv", fs, abs_phase, spec.period, code=codes.astype(np.int32),
-                             info=info)
+    return Orders(abs_phase, info)
+
+
+def levels_for(fringes: int, window: int = 4) -> int:
+    """The fewest stair levels (at least the paper's 4) whose windows can tell the fringes.
+
+    >>> levels_for(36), levels_for(200)
+    (4, 5)
+    """
+    levels = 4
+    while levels * (levels - 1) ** (window - 1) + window - 1 < fringes:
+        levels += 1
+    return levels
+
+
+def comparable(width: int, height: int, period: int, steps: int) -> dict:
+    """The same period with the fewest levels that tell its fringes apart."""
+    return dict(period=period, steps=steps, levels=levels_for(-(-width // period)))
 
 
 CODEC = Codec(
     name="lv",
     spec_class=LvSpec,
-    encode_columns=encode_columns,
-    decode_columns=decode_columns,
     summary="N phase shifts + a few-level code read over four adjacent fringes (after Lv 2019)",
-    options=("min_modulation",),
+    encode_columns=encode_columns,
+    code_columns=code_columns,
+    order_columns=order_columns,
+    comparable=comparable,
 )

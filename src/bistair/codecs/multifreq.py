@@ -33,16 +33,16 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
-from ..captures import Prepared
+from ..core.captures import Prepared
+from ..core.measure import FringeSet, measure
+from ..core.phase import TWO_PI, order_from_reference, phase_shift_patterns
 from ..errors import BistairError
-from ..fringes import measure
-from ..phase import TWO_PI, order_from_reference, phase_shift_patterns
-from ..result import DecodeResult, result_from_phase
-from ..spec import BaseSpec, field, register_spec
-from .base import Codec, along_columns
+from ..spec import BaseSpec, field
+from .base import Codec, CodeMap, Orders, along_columns
 
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
@@ -55,7 +55,6 @@ def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     return levels
 
 
-@register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class MultiFreqSpec(BaseSpec):
     method = "multifreq"
@@ -73,7 +72,7 @@ class MultiFreqSpec(BaseSpec):
             object.__setattr__(self, "unwrap", rule)
         super().__post_init__()
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
         return tuple(f"T{t}-shift-{n}" for t in self.periods for n in range(self.steps))
 
     def validate(self) -> None:
@@ -123,13 +122,27 @@ class _Unwrapper:
         return phi + TWO_PI * k
 
 
-def decode_columns(prepared: Prepared, spec: MultiFreqSpec,
-                   min_modulation: float | None = None) -> DecodeResult:
+def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
+                    min_modulation: float | None = None) -> FringeSet:
+    """Stage 1: the N-step set of the shortest period (the phase the result refers to)."""
+    i = spec.periods.index(min(spec.periods))
+    return measure(prepared, i * spec.steps, spec.steps, min_modulation)
+
+
+def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
+                 min_modulation: float | None = None) -> CodeMap:
+    """Stage 2: the shortest period's order from the longer periods (or their beats).
+
+    ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step and
+    ``maps["valid"]`` where every period is well modulated.
+    """
     n = spec.steps
-    sets = {float(t): measure(prepared, i * n, n, min_modulation, check=(i == 0))
+    shortest = float(spec.period)
+    sets = {float(t): fs if float(t) == shortest else
+            measure(prepared, i * n, n, min_modulation, check=False)
             for i, t in enumerate(spec.periods)}
-    valid = np.logical_and.reduce([fs.valid for fs in sets.values()])
-    phase_of = {t: fs.phi.astype(np.float64) for t, fs in sets.items()}
+    valid = np.logical_and.reduce([s.valid for s in sets.values()])
+    phase_of = {t: s.phi.astype(np.float64) for t, s in sets.items()}
     unwrap = _Unwrapper()
     if spec.unwrap == "hierarchical":
         chain = sorted(phase_of, reverse=True)
@@ -148,23 +161,38 @@ def decode_columns(prepared: Prepared, spec: MultiFreqSpec,
             for i, t in enumerate(levels[lvl]):
                 parent = above[min(i, len(above) - 1)]
                 absolute[t] = unwrap(phase_of[t], absolute[parent], parent / t)
-    shortest = float(spec.period)
-    # Every step agrees when the coarser phase lands within a quarter fringe of the finer.
-    agree = unwrap.worst < 0.25
+    order = order_from_reference(fs.phi, absolute[shortest])
+    code = np.where(valid & np.isfinite(order), order, -1).astype(np.int32)
+    return CodeMap(code, {"worst": np.broadcast_to(unwrap.worst, valid.shape), "valid": valid})
+
+
+def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
+    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe."""
+    valid = code.maps["valid"]
+    agree = code.maps["worst"] < 0.25
     lit = valid.sum()
-    info = {"unwrap": spec.unwrap, "noise": sets[shortest].noise,
+    info = {"unwrap": spec.unwrap, "noise": fs.noise,
             "valid_modulation": int(lit),
             "period_agreement": float((agree & valid).sum() / max(lit, 1))}
-    ok = valid & agree & (absolute[shortest] >= 0)
-    abs_phase = np.where(ok, absolute[shortest], np.nan)
-    return result_from_phase("multifreq", sets[shortest], abs_phase, shortest, info=info)
+    ok = valid & agree & (code.code >= 0)
+    abs_phase = np.where(ok, fs.phi + TWO_PI * code.code, np.nan)
+    return Orders(abs_phase, info)
+
+
+def comparable(width: int, height: int, period: int, steps: int) -> dict:
+    """The paper's three-frequency twelve-step reference: the width, about
+    ``sqrt(width * period)`` and the period (1080/180/30, 1920/240/30)."""
+    middle = int(round(math.sqrt(width * period) / period)) * period
+    return dict(periods=(width, middle, period), steps=12)
 
 
 CODEC = Codec(
     name="multifreq",
     spec_class=MultiFreqSpec,
-    encode_columns=encode_columns,
-    decode_columns=decode_columns,
     summary="N-step sets at several periods, unwrapped hierarchically or by heterodyne beats",
-    options=("min_modulation",),
+    encode_columns=encode_columns,
+    measure_columns=measure_columns,
+    code_columns=code_columns,
+    order_columns=order_columns,
+    comparable=comparable,
 )

@@ -15,7 +15,7 @@ Forms:
     Frames ``shift-n``, ``code-n``.
 
 Strategies: ``region`` (default) votes the code over each fringe region and checks orders
-step by one across wraps (:func:`bistair.order.phase_from_regions`); ``pixel`` is the
+step by one across wraps (:func:`bistair.core.resolve.phase_from_regions`); ``pixel`` is the
 classic per-pixel ``k = code``, which misorders pixels where the code and the wrapped phase
 change together.
 
@@ -37,19 +37,17 @@ import dataclasses
 
 import numpy as np
 
-from ..captures import Prepared
+from ..core.captures import Prepared
+from ..core.measure import FringeSet
+from ..core.phase import TWO_PI, phase_shift_patterns, wrapped_phase
+from ..core.regions import core_weight, fringe_regions
+from ..core.resolve import code_evidence, phase_from_regions
+from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
-from ..fringes import measure
-from ..order import code_evidence, phase_from_regions
-from ..phase import TWO_PI, phase_shift_patterns, wrapped_phase
-from ..regions import core_weight, fringe_regions
-from ..result import DecodeResult, result_from_phase
-from ..spec import PeriodSpec, field, register_spec
-from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
-from .base import Codec, along_columns
+from ..spec import PeriodSpec, field
+from .base import Codec, CodeMap, Orders, along_columns
 
 
-@register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class PhaseCodingSpec(PeriodSpec):
     method = "phase-coding"
@@ -62,7 +60,7 @@ class PhaseCodingSpec(PeriodSpec):
         """Stair levels: one per fringe across the coded axis."""
         return self.fringes
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
         shifts = self.shift_frames()
         if self.form == "pair":
             return (*shifts, "code-cos", "code-sin")
@@ -88,45 +86,52 @@ def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:
     return along_columns(np.concatenate([shifts, coded]), spec)
 
 
-def code_phase(prepared: Prepared, spec: PhaseCodingSpec, avg: np.ndarray) -> np.ndarray:
-    """The decoded code phase of either form."""
+def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
+                 min_modulation: float | None = None) -> CodeMap:
+    """Stage 2: the code phase of either form and its stair level on the valid pixels."""
     frames = prepared.frames[spec.steps:]
     if spec.form == "pair":
-        return stair_phase(frames[0], frames[1], avg)[0]
-    return wrapped_phase(frames)[0]
+        theta = stair_phase(frames[0], frames[1], fs.avg)[0]
+    else:
+        theta = wrapped_phase(frames)[0]
+    codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
+    return CodeMap(codes, {"code_phase": theta})
 
 
-def decode_columns(prepared: Prepared, spec: PhaseCodingSpec, strategy: str = "region",
-                   min_modulation: float | None = None) -> DecodeResult:
+def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
+                  strategy: str = "region") -> Orders:
+    """Stage 3: the code per pixel (``pixel``) or voted per fringe region (``region``)."""
     if strategy not in ("region", "pixel"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'pixel')")
-    fs = measure(prepared, 0, spec.steps, min_modulation)
-    codes = np.where(fs.valid, quantize(code_phase(prepared, spec, fs.avg), spec.levels), -1)
+    codes = code.code
     info = {"strategy": strategy, "noise": fs.noise, "levels": spec.levels}
     if strategy == "pixel":
-        abs_phase = np.where(codes >= 0, fs.phi + TWO_PI * codes, np.nan)
-    else:
-        labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-        weight = core_weight(fs.phi)
+        return Orders(np.where(codes >= 0, fs.phi + TWO_PI * codes, np.nan), info)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    weight = core_weight(fs.phi)
 
-        def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-            return labels, n, code_evidence(labels, n, codes, spec.levels, weight)
+    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+        return labels, n, code_evidence(labels, n, codes, spec.levels, weight)
 
-        def agrees(k: np.ndarray) -> np.ndarray:
-            """Noise moves a code a level or so; another surface's fringe moves it more."""
-            off = np.abs(codes - k) % spec.levels
-            return (np.minimum(off, spec.levels - off) <= 1) | (codes < 0)
+    def agrees(k: np.ndarray) -> np.ndarray:
+        """Noise moves a code a level or so; another surface's fringe moves it more."""
+        off = np.abs(codes - k) % spec.levels
+        return (np.minimum(off, spec.levels - off) <= 1) | (codes < 0)
 
-        abs_phase = phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
-    return result_from_phase("phase-coding", fs, abs_phase, spec.period,
-                             code=codes.astype(np.int32), info=info)
+    return Orders(phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info), info)
+
+
+def comparable(width: int, height: int, period: int, steps: int) -> dict:
+    """One level per fringe at the same period."""
+    return dict(period=period, steps=steps)
 
 
 CODEC = Codec(
     name="phase-coding",
     spec_class=PhaseCodingSpec,
-    encode_columns=encode_columns,
-    decode_columns=decode_columns,
     summary="N phase shifts + a stair code with one level per fringe (Wang and Zhang 2012)",
-    options=("strategy", "min_modulation"),
+    encode_columns=encode_columns,
+    code_columns=code_columns,
+    order_columns=order_columns,
+    comparable=comparable,
 )

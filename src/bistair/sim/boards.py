@@ -1,9 +1,10 @@
 """Calibration boards on the virtual rig: a printed board as a textured plane in several poses,
-rendered in both orientations and written in the layout ``bistair calibrate`` reads.
+rendered in both orientations and written in the layout ``bistair calibrate`` reads; and
+board correspondences drawn straight from a calibration (:func:`synthetic_views`).
 
 Examples
 --------
->>> from bistair.board import Board
+>>> from bistair.geometry.board import Board
 >>> plane = board_plane(Board("checkerboard", 9, 6, 20.0), 0, 0, 0, 0, 0, 600)
 >>> [round(float(v), 6) for v in plane.center]
 [0.0, 0.0, 600.0]
@@ -16,13 +17,17 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
+import cv2
 import numpy as np
 
-from ..board import Board
-from ..io import output_folder, write_image
+from ..codecs import encode
+from ..errors import BistairError
+from ..geometry.board import Board
+from ..geometry.calibration import Calibration
+from ..io.files import output_folder, write_image
 from ..spec import BaseSpec
-from .geometry import Rig, euler
 from .render import Imaging, expose, trace
+from .rig import Rig, euler
 from .shapes import Plane, Scene
 
 # Board poses: degrees about x, y, z, then the features' centre in mm. Tilted up to 25
@@ -49,7 +54,7 @@ def write_board_captures(rig: Rig, board: Board, specs: dict[str, BaseSpec], out
     """Render ``board`` in every pose for the ``"columns"`` and ``"rows"`` specs (each with a
     white frame) and write ``board.json`` and ``pose-NN/{columns,rows}/`` into ``out``."""
     imaging = imaging or Imaging()
-    patterns = {o: _encode(s) for o, s in specs.items()}
+    patterns = {o: encode(s) for o, s in specs.items()}
     with output_folder(out) as tmp:
         (tmp / "board.json").write_text(json.dumps(board.to_dict(), indent=2) + "\n")
         for i, pose in enumerate(poses):
@@ -64,7 +69,32 @@ def write_board_captures(rig: Rig, board: Board, specs: dict[str, BaseSpec], out
     return Path(out)
 
 
-def _encode(spec: BaseSpec) -> np.ndarray:
-    from .. import encode
+def synthetic_views(calibration: Calibration, board: Board, poses: int,
+                    rng: np.random.Generator, noise: float = 0.0, distance: float = 600.0
+                    ) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
+    """Random board poses seen by both devices of ``calibration``: object points and the
+    camera and projector pixels of each pose (``cv2.projectPoints``, Gaussian ``noise`` px).
 
-    return encode(spec)
+    The board is tilted by up to 25 degrees about x and y and turned about its normal, near
+    ``(0, 0, distance)``; every point falls inside both images.
+    """
+    obj = board.object_points().astype(float)
+    centre = obj.mean(axis=0)
+    views: tuple[list, list, list] = ([], [], [])
+    for _ in range(100 * poses):
+        if len(views[0]) == poses:
+            return views
+        rvec = np.deg2rad([rng.uniform(-25, 25), rng.uniform(-25, 25), rng.uniform(-20, 20)])
+        rot = cv2.Rodrigues(rvec)[0]
+        tvec = np.array([rng.uniform(-30, 30), rng.uniform(-30, 30),
+                         distance + rng.uniform(-60, 60)]) - rot @ centre
+        world = obj @ rot.T + tvec
+        pix = [cv2.projectPoints(world @ r.T + t, np.zeros(3), np.zeros(3), d.K, d.dist)[0]
+               .reshape(-1, 2) + (rng.normal(0, noise, (len(obj), 2)) if noise else 0.0)
+               for d, r, t in ((calibration.camera, np.eye(3), np.zeros(3)),
+                               (calibration.projector, calibration.R, calibration.T))]
+        if all(((p >= 0) & (p <= np.array(d.size) - 1)).all()
+               for p, d in zip(pix, (calibration.camera, calibration.projector), strict=True)):
+            for out, value in zip(views, (obj.astype(np.float32), *pix), strict=True):
+                out.append(value)
+    raise BistairError("the board rarely falls inside both images; check the geometry")

@@ -32,8 +32,9 @@ from typing import Any
 
 import numpy as np
 
+from ..codecs import make_spec
 from ..spec import BaseSpec
-from .geometry import Rig, euler
+from .rig import Rig, euler
 from .shapes import Box, Ellipsoid, MaskRelief, Mesh, Plane, Prism, Scene, Sphere
 
 
@@ -142,8 +143,6 @@ def preset(name: str, **overrides: Any) -> tuple[Rig, Scene]:
 
 def preset_spec(name: str, method: str = "bidirectional", **params: Any) -> BaseSpec:
     """The period-30 pattern set a preset was sized for (``params`` override it)."""
-    from .. import make_spec
-
     if name not in _PRESETS:
         raise ValueError(f"unknown preset {name!r} (known: {', '.join(_PRESETS)})")
     return make_spec(method, **{"period": 30, **_PRESETS[name][2], **params})

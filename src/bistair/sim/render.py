@@ -34,9 +34,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from ..spec import BaseSpec
-from .geometry import Rig, dot
+from ..core.captures import to_bit_depth
+from .rig import Rig, dot
 from .shapes import Scene
+from .truth import Truth
 
 _SHADOW_EPS = 1e-6  # relative distance along a shadow ray counted as the point itself
 _BLOCK = 1 << 16  # rays per block of work
@@ -97,38 +98,6 @@ class Imaging:
             raise ValueError("projector_sampling must be 'nearest' or 'linear'")
         if self.supersample < 1:
             raise ValueError("supersample must be at least 1")
-
-
-@dataclass(frozen=True, eq=False)
-class Truth:
-    """Ground truth per camera pixel (from the ray through the pixel centre).
-
-    Attributes
-    ----------
-    coord_x, coord_y : continuous projector column and row (NaN where nothing is hit).
-    depth : z in the camera frame, mm (NaN where nothing is hit).
-    points, normals : (H, W, 3) world point and unit normal facing the camera (NaN).
-    object_id : surface object id, 0 for nothing.
-    lit : the point faces the projector, lies inside its image and not in its shadow.
-    mask : ground truth usable for scoring: lit, not grazing, every sub-ray of the pixel on
-        the same surface and lit, eroded by the edge margin.
-    """
-
-    coord_x: np.ndarray
-    coord_y: np.ndarray
-    depth: np.ndarray
-    points: np.ndarray
-    normals: np.ndarray
-    object_id: np.ndarray
-    lit: np.ndarray
-    mask: np.ndarray
-
-    def coord(self, spec: BaseSpec | str) -> np.ndarray:
-        """The projector coordinate along a spec's coded axis (or ``"columns"``/``"rows"``)."""
-        orientation = spec if isinstance(spec, str) else spec.orientation
-        if orientation not in ("columns", "rows"):
-            raise ValueError(f"orientation must be 'columns' or 'rows', got {orientation!r}")
-        return self.coord_x if orientation == "columns" else self.coord_y
 
 
 @dataclass(frozen=True, eq=False)
@@ -366,11 +335,7 @@ def _frame(trace: Trace, imaging: Imaging, where: list, ambient: np.ndarray,
     img = np.clip(img, 0.0, 1.0)
     if imaging.bits is None:
         return img.astype(np.float32)
-    top = (1 << imaging.bits) - 1
-    codes = np.round(img * top)
-    if imaging.float_output:
-        return (codes / top).astype(np.float32)
-    return codes.astype(np.uint8 if imaging.bits == 8 else np.uint16)
+    return to_bit_depth(img, imaging.bits, as_float=imaging.float_output)
 
 
 def _nearest_pixel(x: np.ndarray, y: np.ndarray, width: int, height: int) -> np.ndarray:

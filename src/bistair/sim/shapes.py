@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .geometry import apply, dot
 from .raycast import Triangles, barycentric
+from .rig import apply, dot
 
 Albedo = float | Callable[[np.ndarray], np.ndarray]
 

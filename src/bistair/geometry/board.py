@@ -26,8 +26,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from .errors import BistairError
-from .jsonfile import read_json
+from ..errors import BistairError
+from ..io.jsonfile import read_json
 
 BOARD_TYPES = ("checkerboard", "circles", "asymmetric-circles")
 

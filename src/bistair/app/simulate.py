@@ -23,19 +23,22 @@ Examples
 from __future__ import annotations
 
 import dataclasses
-import json
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from . import encode
-from .compare import method_specs
-from .errors import BistairError
-from .io import output_folder, write_image
-
-METHODS = ("bidirectional", "lv", "phase-coding", "graycode", "multifreq")
+from ..codecs import encode
+from ..codecs import methods as known_methods
+from ..core.captures import to_bit_depth
+from ..errors import BistairError
+from ..evaluation.benchmark import method_specs
+from ..geometry.board import Board
+from ..io.files import output_folder, write_image
+from ..io.jsonfile import write_json
+from ..sim import Imaging, Rig, expose, preset, scene_names, trace
+from ..sim.boards import write_board_captures
 
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
@@ -47,16 +50,14 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
     the projector's gamma.
     """
-    from .sim import Imaging, expose, preset, scene_names, trace
-
     if scene not in (*scene_names(), "calibration"):
         raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
                            "calibration)")
     methods = list(methods)
-    unknown = set(methods) - set(METHODS)
+    unknown = set(methods) - set(known_methods())
     if unknown:
         raise BistairError(f"unknown method(s) {', '.join(sorted(unknown))} "
-                           f"(known: {', '.join(METHODS)}, all)")
+                           f"(known: {', '.join(known_methods())}, all)")
     try:
         im = Imaging(**imaging)
     except (TypeError, ValueError) as exc:
@@ -73,7 +74,7 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
             folder.mkdir()
             images = expose(traced, encode(spec), im)
             if images.dtype.kind == "f":
-                images = np.round(np.clip(images, 0, 1) * 65535).astype(np.uint16)
+                images = to_bit_depth(images, 16)
             for i, img in enumerate(images):
                 write_image(folder / f"{i:02d}.png", img)
             (folder / "spec.json").write_text(spec.to_json())
@@ -82,9 +83,9 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
         t = traced.truth
         for name in ("coord_x", "coord_y", "depth", "object_id", "mask"):
             np.save(truth_dir / f"{name}.npy", getattr(t, name))
-        (tmp / "scene.json").write_text(json.dumps(
-            {"scene": scene, "methods": methods, "compensated": compensated,
-             "imaging": dataclasses.asdict(im), "rig": _rig_dict(rig)}, indent=2) + "\n")
+        write_json(tmp / "scene.json",
+                   {"scene": scene, "methods": methods, "compensated": compensated,
+                    "imaging": dataclasses.asdict(im), "rig": _rig_dict(rig)})
     return Path(out)
 
 
@@ -101,10 +102,6 @@ def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, in
                  compensated: bool, imaging: Any) -> Path:
     """A 9 x 6 checkerboard (20 mm) in eight poses, both orientations with a white frame, in
     the layout ``bistair calibrate`` reads (one method: the first named)."""
-    from .board import Board
-    from .sim import Rig
-    from .sim.boards import write_board_captures
-
     rig = Rig.default(**({} if camera_size is None else {"camera_size": camera_size}))
     base = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
                         methods=methods[:1])[methods[0]][0]

@@ -11,23 +11,24 @@ calibration) and ``report.html`` with everything embedded.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import click
 from tqdm import tqdm
 
-from .compare import format_table, method_specs, run, table
-from .io import output_folder
-from .report import method_figure, write_report
+from ..evaluation.benchmark import format_table, method_specs, run, table
+from ..evaluation.report import method_figure, write_report
+from ..evaluation.views import cloud_view
+from ..io.files import output_folder
+from ..io.jsonfile import write_json
+from ..sim import Imaging, preset, trace
 
 TARGET = {"order_error_rate": 0.001, "coverage": 0.99, "small_objects": 0.99}
 
 
 def run_demo(out: str | Path, seed: int = 0, camera_size: tuple[int, int] = (1280, 1024),
              show_progress: bool = True) -> list[dict]:
-    from .sim import Imaging, preset, trace
-
+    """Run the demo into ``out``; prints the table and the verdict; returns the table rows."""
     rig, scene = preset("paper-sim", camera_size=camera_size)
     imaging = Imaging(gamma=2.2, read_noise=0.01, camera_blur=1.0, seed=seed)
     specs = method_specs(rig.projector.size, gamma=2.2)
@@ -52,7 +53,7 @@ def run_demo(out: str | Path, seed: int = 0, camera_size: tuple[int, int] = (128
         bar.update()
         bar.close()
         (tmp / "table.txt").write_text(text + "\n")
-        (tmp / "table.json").write_text(json.dumps(rows, indent=2) + "\n")
+        write_json(tmp / "table.json", rows)
         verdict = target_check(rows, comparison.objects)
         write_report(tmp / "report.html", "bistair: the paper's simulation (paper-sim)",
                      "One big mask and three small isolated objects (1.3, 1.7 and 2.8 "
@@ -66,17 +67,6 @@ def run_demo(out: str | Path, seed: int = 0, camera_size: tuple[int, int] = (128
     click.echo(verdict)
     click.echo(f"figures, table and report.html in {out}/")
     return rows
-
-
-def cloud_view(row, rig, path: Path) -> Path:
-    """The default decoder's absolute phase triangulated with the rig's calibration, shaded."""
-    from .calib import Calibration
-    from .reconstruct import reconstruct, render_cloud
-
-    rec = reconstruct(row.result, Calibration.from_rig(rig), row.spec)
-    render_cloud(rec.points, rec.colors, path, azimuth=25, elevation=15, size=(900, 700),
-                 title=f"{row.label}: {int(rec.mask.sum())} points (mm, camera frame)")
-    return Path(path)
 
 
 def target_check(rows: list[dict], objects: list[int]) -> str:

@@ -13,7 +13,7 @@ import imageio.v3 as iio
 import numpy as np
 from matplotlib import colormaps
 
-from .result import DecodeResult
+from ..core.result import DecodeResult
 
 
 def colorize(values: np.ndarray, cmap: str = "jet", vmin: float | None = None,
@@ -53,6 +53,7 @@ def preview_images(result: DecodeResult) -> dict[str, np.ndarray]:
 
 
 def write_previews(result: DecodeResult, folder: str | Path) -> list[Path]:
+    """Write the preview PNGs of a result into ``folder``; returns their paths."""
     folder = Path(folder)
     paths = []
     for stem, rgb in preview_images(result).items():

@@ -17,13 +17,18 @@ Examples
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .phase import TWO_PI
 
 
-def stair_level_phase(level: np.ndarray, levels: int) -> np.ndarray:
-    """Phase of stair level ``level`` (0-based) of a ``levels``-step stair."""
+def stair_level_phase(level: np.ndarray | int, levels: int) -> np.ndarray | float:
+    """Phase of stair level ``level`` (0-based) of a ``levels``-step stair (a float for an
+    int level)."""
+    if isinstance(level, int | np.integer):
+        return -math.pi + math.pi / levels + TWO_PI * int(level) / levels
     return -np.pi + np.pi / levels + TWO_PI * np.asarray(level, dtype=np.float64) / levels
 
 
@@ -43,9 +48,23 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     return np.arctan2(s, c).astype(np.float32), np.hypot(s, c).astype(np.float32)
 
 
-def quantize(theta: np.ndarray, levels: int) -> np.ndarray:
-    """Stair level index of the phase ``theta`` (Eq. 20), modulo ``levels``; int32."""
+def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
+    """Stair level index of the phase ``theta`` (Eq. 20), modulo ``levels``; int32 (an int
+    for a float phase)."""
+    if isinstance(theta, float):
+        return int(math.floor(((theta + math.pi) % TWO_PI) * levels / TWO_PI)) % levels
     theta = np.asarray(theta)
     scale = (levels / TWO_PI) if theta.dtype != np.float32 else np.float32(levels / TWO_PI)
     scaled = (theta + (np.pi if theta.dtype != np.float32 else np.float32(np.pi))) * scale
     return np.floor(scaled).astype(np.int32) % np.int32(levels)
+
+
+def level_misfit(theta: float, level: int, levels: int) -> float:
+    """Squared distance of a phase from a stair level, in half steps: 0 on the level, 1 at
+    the border of its quantisation bin.
+
+    >>> level_misfit(float(stair_level_phase(2, 6)), 2, 6), round(level_misfit(0.0, 2, 6), 9)
+    (0.0, 1.0)
+    """
+    d = (theta - stair_level_phase(level, levels) + math.pi) % TWO_PI
+    return ((d - math.pi) / (math.pi / levels)) ** 2

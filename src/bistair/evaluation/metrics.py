@@ -7,13 +7,13 @@ order ``k + 1`` with one near 0 give the same absolute phase; both are right.
 Examples
 --------
 >>> import numpy as np
->>> from bistair.result import make_result
+>>> from bistair.core.result import make_result
 >>> truth = np.tile(np.arange(90.0) + 0.5, (4, 1))
 >>> phi = (2 * np.pi * truth / 30) % (2 * np.pi)
 >>> order = truth // 30
 >>> order[0, 10] += 1
 >>> res = make_result("demo", phi, order.astype(int), 30, np.ones_like(phi))
->>> m = compare(res, truth, np.ones_like(phi, bool))
+>>> m = score(res, truth, np.ones_like(phi, bool))
 >>> m["coverage"], round(m["order_error_rate"], 5), m["order_errors"]
 (1.0, 0.00278, 1)
 """
@@ -22,11 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .phase import TWO_PI
-from .result import DecodeResult
+from ..core.phase import TWO_PI
+from ..core.result import DecodeResult
 
 
-def compare(result: DecodeResult, coord: np.ndarray, mask: np.ndarray,
+def score(result: DecodeResult, coord: np.ndarray, mask: np.ndarray,
             object_id: np.ndarray | None = None) -> dict:
     """Coverage, order error rate and phase RMSE of ``result`` against the true coordinate.
 

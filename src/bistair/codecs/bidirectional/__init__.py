@@ -10,15 +10,16 @@ small region of the image holds both and ``k = k_s1 + S * k_s2`` (Eq. 22).
 Decoding strategies:
 
 ``"region"`` (default)
-    Fringe regions (2-D areas between wrapped-phase jumps, :mod:`bistair.regions`) each
-    hold one order. The stair phase is averaged along each row of a region, the bands of
-    the resulting profile are told apart by their lengths (:mod:`bistair.bands`), and every
+    Fringe regions (2-D areas between wrapped-phase jumps, :mod:`bistair.core.regions`)
+    each hold one order. The stair phase is averaged along each row of a region, the bands
+    of the resulting profile are told apart by their lengths (:mod:`.bands`), and every
     region gets one order, checked against its neighbours across each wrap, where orders
-    must step by exactly one (:func:`bistair.order.resolve_regions`).
+    must step by exactly one (:func:`bistair.core.resolve.resolve_regions`).
 ``"paper"``
-    The paper's decoder: ``k_s`` by Eq. 19-20, a column scan of run lengths ``C`` whose
-    increases mark group starts, ``k = k_s1 + S*k_s2`` per group (``k_s1 * (S+1)`` where the
-    runs merge), then each fringe (a 2-D stripe between two phase jumps) takes the mode.
+    The paper's decoder (:mod:`.paper`): ``k_s`` by Eq. 19-20, a column scan of run lengths
+    ``C`` whose increases mark group starts, ``k = k_s1 + S*k_s2`` per group (``k_s1 *
+    (S+1)`` where the runs merge), then each fringe (a 2-D stripe between two phase jumps)
+    takes the mode.
 
 Examples
 --------
@@ -38,14 +39,23 @@ Examples
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
-from ..bands import (
+from ...core.captures import Prepared
+from ...core.measure import FringeSet
+from ...core.phase import TWO_PI, phase_shift_patterns
+from ...core.regions import core_weight, fringe_regions
+from ...core.resolve import phase_from_regions
+from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
+from ...errors import BistairError
+from ...spec import PeriodSpec, field
+from ..base import Codec, CodeMap, Orders
+from .bands import (
     BandLayout,
     band_splits,
     group_heights,
-    nearest_level,
     profile_centroids,
     region_evidence,
     row_profiles,
@@ -53,19 +63,9 @@ from ..bands import (
     split_regions,
     union_levels,
 )
-from ..captures import Prepared
-from ..errors import BistairError
-from ..fringes import FringeSet, measure
-from ..order import mode_by_label, phase_from_regions
-from ..phase import TWO_PI, phase_shift_patterns
-from ..regions import core_weight, fringe_regions
-from ..result import DecodeResult, result_from_phase
-from ..spec import PeriodSpec, field, register_spec
-from ..stair import quantize, stair_level_phase, stair_pair, stair_phase
-from .base import Codec
+from .paper import paper_orders
 
 
-@register_spec
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class BidirectionalSpec(PeriodSpec):
     method = "bidirectional"
@@ -75,7 +75,7 @@ class BidirectionalSpec(PeriodSpec):
     group_rows: int = field(30, "projector rows per group (local + partition rows)")
     local_rows: int = field(20, "rows of each group that carry the local stair")
 
-    def _frames(self) -> tuple[str, ...]:
+    def method_frames(self) -> tuple[str, ...]:
         return (*self.shift_frames(), "stair-cos", "stair-sin")
 
     def validate(self) -> None:
@@ -126,23 +126,29 @@ def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
     return np.concatenate([rows, pair]).astype(np.float32)
 
 
-def decode_columns(prepared: Prepared, spec: BidirectionalSpec, strategy: str = "region",
-                   min_modulation: float | None = None) -> DecodeResult:
-    """Decode a capture stack (vertical fringes) into absolute phase."""
-    if strategy not in ("region", "paper"):
-        raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
-    fs = measure(prepared, 0, spec.steps, min_modulation)
-    phi, valid = fs.phi, fs.valid
+def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
+                 min_modulation: float | None = None) -> CodeMap:
+    """Stage 2: the stair phase of the coded pair (Eq. 19), its modulation and ``k_s`` (Eq. 20)
+    on the valid pixels."""
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
-    ks = np.where(valid, quantize(theta, spec.stairs), -1).astype(np.int32)
-    info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(valid.sum())}
+    ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
+    return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod})
+
+
+def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
+                  strategy: str = "region") -> Orders:
+    """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy."""
+    if strategy not in ("region", "paper"):
+        raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
+    theta, ks = code.maps["stair_phase"], code.code
+    info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
     if strategy == "paper":
-        order = _paper_orders(ks, theta, fs, spec)
-        abs_phase = np.where(order >= 0, phi + TWO_PI * order, np.nan)
+        order = paper_orders(ks, theta, fs, spec)
+        abs_phase = np.where(order >= 0, fs.phi + TWO_PI * order, np.nan)
     else:
-        abs_phase = _region_phase(fs, theta, stair_mod, ks, spec, info)
-    return result_from_phase("bidirectional", fs, abs_phase, spec.period, code=ks, info=info)
+        abs_phase = _region_phase(fs, theta, code.maps["stair_modulation"], ks, spec, info)
+    return Orders(abs_phase, info)
 
 
 def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
@@ -177,60 +183,29 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
     return phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
 
 
-def _paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
-                  spec: BidirectionalSpec) -> np.ndarray:
-    """The paper's column scan (Sec. 2.3) and per-fringe mode (Sec. 3)."""
-    S, P = spec.stairs, spec.partitions
-    h, w = ks.shape
-    v = fs.valid.T.ravel()
-    t = theta.T.ravel()
-    # Runs of equal k_s; with P != S the levels of both stairs are told apart.
-    q = ks.T.ravel() if P == S else nearest_level(t, union_levels(P, S))
-    col_start = np.zeros(v.size, bool)
-    col_start[::h] = True
-    seg_start = v & (col_start | ~np.r_[False, v[:-1]])
-    start = seg_start | (v & np.r_[True, q[1:] != q[:-1]])
-    pix = np.flatnonzero(v)
-    run_of = np.cumsum(start)[pix] - 1
-    first = np.flatnonzero(start)
-    c_len = np.bincount(run_of)  # C: run lengths
-    run_theta = np.arctan2(np.bincount(run_of, np.sin(t[pix])), np.bincount(run_of, np.cos(t[pix])))
-    new_group = seg_start[first].copy()
-    new_group[1:] |= c_len[1:] > c_len[:-1]  # difference of C above zero: a group starts
-    # "When k_s1 and k_s2 are the same, the value of C is very large": such a run is a
-    # group of its own. Very large = 1.4 times the run length a typical pixel sits in.
-    merged = c_len > 1.4 * np.median(c_len[run_of])
-    new_group[1:] |= merged[:-1]
-    group = np.cumsum(new_group) - 1
-    g_first = np.flatnonzero(new_group)
-    g_second = g_first + 1
-    has_second = np.zeros(g_first.size, bool)
-    ok = g_second < first.size
-    has_second[ok] = group[g_second[ok]] == group[g_first[ok]]
-    has_second &= ~merged[g_first]
-    second_theta = np.where(has_second, run_theta[np.minimum(g_second, first.size - 1)],
-                            run_theta[g_first])
-    # The longer run opens a group: the local one unless the spec gives it fewer rows.
-    local_first = 2 * spec.local_rows > spec.group_rows
-    local_theta, part_theta = ((run_theta[g_first], second_theta) if local_first
-                               else (second_theta, run_theta[g_first]))
-    k1 = quantize(local_theta, S)
-    k2 = quantize(part_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
-    k_group = k1 + S * k2
-    order = np.full(v.size, -1, np.int64)
-    order[pix] = k_group[group[run_of]]
-    order = order.reshape(w, h).T
-    fringes, n_fringes = fringe_regions(fs.phi, fs.valid, min_size=1,
-                                        phase_noise=fs.phase_noise)
-    mode, _ = mode_by_label(fringes, order, n_fringes, S * P)
-    return np.where(fringes > 0, mode[fringes], -1)
+def stairs_for(fringes: int) -> tuple[int, int]:
+    """Partitions and stairs (P, S) with P*S >= fringes, as square as possible.
+
+    >>> stairs_for(36), stairs_for(64), stairs_for(121)
+    ((6, 6), (8, 8), (11, 11))
+    """
+    stairs = math.ceil(math.sqrt(fringes))
+    return math.ceil(fringes / stairs), stairs
+
+
+def comparable(width: int, height: int, period: int, steps: int) -> dict:
+    """The squarest P x S covering the width at this period (6 x 6 on 1080 px at 30 px)."""
+    parts, stairs = stairs_for(math.ceil(width / period))
+    return dict(period=period, partitions=parts, stairs=stairs, steps=steps)
 
 
 CODEC = Codec(
     name="bidirectional",
     spec_class=BidirectionalSpec,
-    encode_columns=encode_columns,
-    decode_columns=decode_columns,
     summary="N phase shifts + a bidirectional stair-phase pair (Qi, Zhou et al.)",
-    options=("strategy", "min_modulation"),
+    encode_columns=encode_columns,
+    code_columns=code_columns,
+    order_columns=order_columns,
+    comparable=comparable,
+    variants={"paper decoder": {"strategy": "paper"}},
 )

@@ -1,9 +1,15 @@
-"""Reading captures and writing outputs without leaving half-written results behind.
+"""Reading captures and specs, and writing outputs without leaving half-written results
+behind.
 
 Captures are a folder of PNG/TIFF/BMP images taken in name order (numbers inside names are
 compared as numbers), 8 or 16 bit, grey or colour (converted to grey), or one ``.npy`` stack.
 Outputs go to a temporary folder beside the destination and are moved in only when every
 file is written.
+
+Examples
+--------
+>>> sorted(["10.png", "2.png", "1.png"], key=natural_key)
+['1.png', '2.png', '10.png']
 """
 
 from __future__ import annotations
@@ -20,7 +26,10 @@ import imageio.v3 as iio
 import numpy as np
 import tifffile
 
-from .errors import BistairError
+from ..codecs import spec_from_dict
+from ..errors import BistairError
+from ..spec import BaseSpec
+from .jsonfile import read_json
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp")
 
@@ -89,6 +98,25 @@ def read_captures(path: str | Path) -> np.ndarray:
                 f"frame {f.name} is {img.dtype} but {files[0].name} is {first.dtype}"
             )
     return np.stack(frames)
+
+
+def load_spec(path: str | Path) -> BaseSpec:
+    """Read and validate a ``spec.json``."""
+    return spec_from_dict(read_json(path, "spec file"))
+
+
+def read_with_spec(captures: str | Path, spec: BaseSpec | str | Path | None
+                   ) -> tuple[np.ndarray, BaseSpec]:
+    """The capture stack and its spec (``CAPTURES/spec.json``, or beside a ``.npy`` stack,
+    unless given)."""
+    captures = Path(captures)
+    if not captures.exists():
+        raise BistairError(f"captures {captures} not found")
+    if spec is None:
+        spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
+    if not isinstance(spec, BaseSpec):
+        spec = load_spec(spec)
+    return read_captures(captures), spec
 
 
 def write_image(path: str | Path, image: np.ndarray) -> None:

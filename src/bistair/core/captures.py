@@ -1,4 +1,5 @@
-"""Captured stacks: checks, scaling to float32 full scale, saturation and validity masks.
+"""Captured stacks: checks, scaling to float32 full scale, bit depths, saturation and
+validity masks.
 
 Every codec calls :func:`prepare` first, so frame count, sizes, dark and saturated captures
 are refused the same way whatever the method.
@@ -17,10 +18,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
-from .errors import BistairError
-from .phase import residuals
+from ..errors import BistairError
 
 
 @dataclass(frozen=True)
@@ -73,33 +72,6 @@ def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
     return Prepared(frames, clipped, scale)
 
 
-def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> float:
-    """Camera noise sigma (fraction of full scale) from an N-step set's fit residual.
-
-    The residual also holds the projector's harmonics (an uncompensated gamma), but those
-    change slowly along a fringe while noise does not: the residuals of vertically adjacent
-    pixels are differenced, and the median of their squared norm is scaled by the chi-square
-    median of N - 3 degrees of freedom. Pixels that a frame clips are left out. Zero for N = 3.
-    """
-    steps = frames.shape[0]
-    if steps <= 3:
-        return 0.0
-    top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
-    low = (slice(None), slice(1, None, 4), slice(None, None, 4))
-    n_rows = min(frames[top].shape[1], frames[low].shape[1])
-    pair = []
-    for sub in (top, low):
-        f = frames[sub][:, :n_rows]
-        p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
-        pair.append((residuals(f, p, a, m), (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
-    (r0, ok0), (r1, ok1) = pair
-    energy = ((r1 - r0) ** 2).sum(axis=0)
-    ok = ok0 & ok1
-    sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
-    dof = steps - 3
-    return float(np.sqrt(np.median(sample) / (2.0 * stats.chi2.ppf(0.5, dof))))
-
-
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
     """Pixels clipped by the camera: a frame at full scale where the fitted sinusoid's peak
     ``A + B`` exceeds it. An exact capture of a full-range pattern touches full scale with a
@@ -130,3 +102,19 @@ def check_decodable(valid: np.ndarray, clipped: np.ndarray) -> None:
             f"captures are saturated: {100 * share:.0f}% of pixels reach full scale"
         )
     raise BistairError("captures are dark: no pixel has enough fringe modulation to decode")
+
+
+def to_bit_depth(values: np.ndarray, bits: int, as_float: bool = False) -> np.ndarray:
+    """Values in [0, 1] (clipped) as the integer codes of a ``bits``-deep image: uint8 for 8
+    bits, uint16 above; with ``as_float`` the codes divided by full scale, as float32.
+
+    >>> to_bit_depth(np.array([0.0, 0.5, 1.2]), 8).tolist()
+    [0, 128, 255]
+    >>> to_bit_depth(np.array([0.5]), 2, as_float=True).tolist()
+    [0.6666666865348816]
+    """
+    top = (1 << bits) - 1
+    codes = np.round(np.clip(values, 0.0, 1.0) * top)
+    if as_float:
+        return (codes / top).astype(np.float32)
+    return codes.astype(np.uint8 if bits <= 8 else np.uint16)

@@ -1,4 +1,4 @@
-"""The decode result every codec returns, and how it is written to a folder.
+"""The decode result every codec returns (written to a folder by :mod:`bistair.io.writers`).
 
 Examples
 --------
@@ -13,15 +13,12 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+from .measure import FringeSet
 from .phase import TWO_PI, order_from_reference
-
-if TYPE_CHECKING:
-    from .fringes import FringeSet
 
 
 @dataclass
@@ -69,16 +66,6 @@ class DecodeResult:
                 ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
                             texture=self.texture)
-
-    def save(self, folder: str | Path, previews: bool = True) -> None:
-        """Write the arrays (and PNG previews) into an existing folder."""
-        folder = Path(folder)
-        for name, arr in self.arrays().items():
-            np.save(folder / f"{name}.npy", arr)
-        if previews:
-            from .preview import write_previews
-
-            write_previews(self, folder)
 
 
 def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,

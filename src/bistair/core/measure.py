@@ -6,8 +6,8 @@ refusal of dark or blown captures are the same for all methods.
 Examples
 --------
 >>> import numpy as np
->>> from bistair.captures import prepare
->>> from bistair.phase import phase_shift_patterns
+>>> from bistair.core.captures import prepare
+>>> from bistair.core.phase import phase_shift_patterns
 >>> x = np.tile(np.arange(120.0), (16, 1))
 >>> frames = 0.1 + 0.8 * phase_shift_patterns(x, 30, 4, offset=0.5, amplitude=0.4)
 >>> fs = measure(prepare(frames, 4, "demo"), 0, 4)
@@ -20,9 +20,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
-from .captures import Prepared, check_decodable, noise_level, saturation, validity
-from .phase import wrapped_phase
+from .captures import Prepared, check_decodable, saturation, validity
+from .phase import residuals, wrapped_phase
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,39 @@ class FringeSet:
         """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``."""
         steps = 4 if self.steps is None else self.steps
         return self.noise / (np.maximum(self.mod, 1e-6) * np.sqrt(steps / 2.0))
+
+    def transposed(self) -> FringeSet:
+        """The same set with image axes swapped (for the rows orientation)."""
+        return FringeSet(*(np.ascontiguousarray(a.T) for a in (self.phi, self.avg, self.mod,
+                                                                 self.valid)),
+                         self.noise, self.steps)
+
+
+def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> float:
+    """Camera noise sigma (fraction of full scale) from an N-step set's fit residual.
+
+    The residual also holds the projector's harmonics (an uncompensated gamma), but those
+    change slowly along a fringe while noise does not: the residuals of vertically adjacent
+    pixels are differenced, and the median of their squared norm is scaled by the chi-square
+    median of N - 3 degrees of freedom. Pixels that a frame clips are left out. Zero for N = 3.
+    """
+    steps = frames.shape[0]
+    if steps <= 3:
+        return 0.0
+    top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
+    low = (slice(None), slice(1, None, 4), slice(None, None, 4))
+    n_rows = min(frames[top].shape[1], frames[low].shape[1])
+    pair = []
+    for sub in (top, low):
+        f = frames[sub][:, :n_rows]
+        p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
+        pair.append((residuals(f, p, a, m), (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
+    (r0, ok0), (r1, ok1) = pair
+    energy = ((r1 - r0) ** 2).sum(axis=0)
+    ok = ok0 & ok1
+    sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
+    dof = steps - 3
+    return float(np.sqrt(np.median(sample) / (2.0 * stats.chi2.ppf(0.5, dof))))
 
 
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,

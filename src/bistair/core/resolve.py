@@ -1,4 +1,4 @@
-"""Fringe-order correction shared by the codecs.
+"""Fringe-order resolution shared by the codecs.
 
 * :func:`mode_by_label`: the most frequent value per label (the paper's per-fringe mode).
 * :func:`resolve_regions`: pick one order per fringe region from its own evidence and the

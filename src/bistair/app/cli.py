@@ -1,6 +1,8 @@
 """The ``bistair`` command line.
 
 Every failure on bad input prints one line, ``Error: <what is wrong>``, and exits with 2.
+Commands import their jobs when they run, so that ``bistair --help`` and ``--version`` do
+not pay for the imaging and geometry libraries.
 """
 
 from __future__ import annotations
@@ -15,10 +17,9 @@ from typing import Any
 import click
 import numpy as np
 
-from . import __version__
-from .codecs import CODECS
-from .errors import BistairError
-from .spec import BaseSpec, _field_kind
+from ..codecs import REGISTRY
+from ..errors import BistairError
+from ..spec import BaseSpec, field_kind
 
 
 class CliError(click.ClickException):
@@ -41,7 +42,7 @@ def reports_errors(func: Callable) -> Callable:
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
-@click.version_option(__version__, prog_name="bistair")
+@click.version_option(package_name="bistair", prog_name="bistair")
 def cli() -> None:
     """Absolute phase measurement for fringe projection profilometry."""
 
@@ -65,7 +66,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
     for f in dataclasses.fields(spec_class):
         if f.metadata.get("cli") is False:
             continue
-        kind = _field_kind(f)
+        kind = field_kind(f)
         opt: dict[str, Any] = {"help": f.metadata.get("help", ""), "show_default": True}
         if "choices" in f.metadata:
             opt["type"] = click.Choice([str(c) for c in f.metadata["choices"]])
@@ -85,7 +86,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
 
     @reports_errors
     def callback(out: Path, **values: Any) -> None:
-        from .workflow import save_patterns
+        from .jobs import save_patterns
 
         for f in dataclasses.fields(spec_class):
             if f.name in values and isinstance(f.default, int) and isinstance(values[f.name], str):
@@ -97,7 +98,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
     return click.Command(name, params=params, callback=callback, help=summary)
 
 
-for _codec in CODECS.values():
+for _codec in REGISTRY.values():
     patterns.add_command(_spec_command(_codec.name, _codec.spec_class, _codec.summary))
 
 
@@ -116,7 +117,7 @@ for _codec in CODECS.values():
 def decode(captures: Path, spec_path: Path | None, out: Path, strategy: str | None,
            min_modulation: float | None, no_previews: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order."""
-    from .workflow import decode_folder
+    from .jobs import decode_folder
 
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
@@ -173,10 +174,9 @@ def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int,
              noise: float, blur: float, gamma: float, compensated: bool, ambient: float,
              bits: str, seed: int) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth."""
-    from .simulate import METHODS
     from .simulate import simulate as run
 
-    chosen = list(METHODS) if "all" in methods else list(dict.fromkeys(methods))
+    chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
     run(scene, chosen, out, camera_size=camera, compensated=compensated, gamma=gamma,
         read_noise=noise, camera_blur=blur, ambient=ambient, bits=int(bits), seed=seed)
     if scene == "calibration":
@@ -195,7 +195,7 @@ def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int,
 @reports_errors
 def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> None:
     """Calibrate camera and projector from board captures (both orientations per pose)."""
-    from .calib import calibrate_folder
+    from .jobs import calibrate_folder
 
     cal = calibrate_folder(captures, out, board=board, min_poses=min_poses)
     click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
@@ -220,7 +220,7 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> 
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
                 depth: Path | None, strategy: str | None) -> None:
     """Decode, triangulate with a calibration, write a coloured PLY and a depth map."""
-    from .reconstruct import reconstruct_folder
+    from .jobs import reconstruct_folder
 
     depth = depth or out.with_name(out.stem + "-depth")
     options = {} if strategy is None else {"strategy": strategy}
@@ -242,7 +242,7 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
            planes: tuple[str, ...], geometry: str | None) -> None:
     """Height above a reference plane without a calibration (phase-to-height)."""
-    from .workflow import height_folder
+    from .jobs import height_folder
 
     h = height_folder(captures, reference, out, spec_path, planes, geometry)
     click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")

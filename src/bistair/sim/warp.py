@@ -1,20 +1,19 @@
 """Synthetic captures with ground truth from a 2-D warp of the projected patterns.
 
-This is the test generator: camera pixels map to projector coordinates through a
-horizontal stretch and offset, a vertical scale that changes down the image (so a group of
-projector rows spans a varying number of camera rows), a roll, and per-object horizontal
-shifts and domes (object height moves fringes sideways). Objects are ellipses on a dark
-background; the image is integrated over each pixel (supersampled), blurred, made noisy and
-quantised. The physical projector-camera rig is :mod:`bistair.sim`.
+This is the fast test generator (no 3-D geometry): camera pixels map to projector
+coordinates through a horizontal stretch and offset, a vertical scale that changes down the
+image (so a group of projector rows spans a varying number of camera rows), a roll, and per-
+object horizontal shifts and domes (object height moves fringes sideways). Objects are
+ellipses on a dark background; the image is integrated over each pixel (supersampled),
+blurred, made noisy and quantised. The physical projector-camera rig is :mod:`bistair.sim`.
 
 Examples
 --------
->>> import bistair
->>> from bistair.synth import Blob, WarpScene, render_warp
->>> spec = bistair.make_spec("bidirectional", width=360, height=240, period=20, partitions=3)
+>>> from bistair.codecs import make_spec
+>>> spec = make_spec("bidirectional", width=360, height=240, period=20, partitions=3)
 >>> scene = WarpScene(size=(120, 160), blobs=(Blob(80, 60, 50, 40),), noise=0.0, blur=0.0)
 >>> images, truth = render_warp(spec, scene)
->>> images.shape, truth.coord.shape, bool(truth.mask[60, 80]), bool(truth.mask[5, 5])
+>>> images.shape, truth.coord(spec).shape, bool(truth.mask[60, 80]), bool(truth.mask[5, 5])
 ((6, 120, 160), (120, 160), True, False)
 """
 
@@ -25,7 +24,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .spec import BaseSpec
+from ..codecs import encode
+from ..core.captures import to_bit_depth
+from ..spec import BaseSpec
+from .truth import Truth
 
 
 @dataclass(frozen=True)
@@ -63,16 +65,6 @@ class WarpScene:
     albedo_texture: float = 0.0  # relative amplitude of a smooth albedo texture
 
 
-@dataclass(frozen=True)
-class Truth:
-    """Ground truth per camera pixel."""
-
-    coord: np.ndarray  # projector coordinate along the coded axis (float64)
-    row: np.ndarray  # projector coordinate across it
-    mask: np.ndarray  # pixel wholly on a lit object
-    object_id: np.ndarray  # 0 background, 1.. blobs
-
-
 def _geometry(scene: WarpScene, u: np.ndarray, v: np.ndarray):
     h = scene.size[0]
     r = np.deg2rad(scene.roll_deg)
@@ -96,10 +88,9 @@ def render_warp(spec: BaseSpec, scene: WarpScene,
                 patterns: np.ndarray | None = None) -> tuple[np.ndarray, Truth]:
     """Render the captures of ``spec``'s patterns under ``scene``; returns (images, truth).
 
-    Images are float32 in [0, 1] (quantised to ``scene.bits`` levels when set).
+    Images are float32 in [0, 1] (quantised to ``scene.bits`` levels when set). The truth's
+    ``coord(spec)`` is the projector coordinate along the coded axis.
     """
-    from . import encode
-
     pats = encode(spec) if patterns is None else patterns
     if spec.orientation == "rows":
         pats = pats.transpose(0, 2, 1)
@@ -125,8 +116,7 @@ def render_warp(spec: BaseSpec, scene: WarpScene,
         img = img + rng.normal(0.0, scene.noise, img.shape)
     img = np.clip(img, 0.0, 1.0)
     if scene.bits:
-        top = (1 << scene.bits) - 1
-        img = np.round(img * top) / top
+        img = to_bit_depth(img, scene.bits, as_float=True)
     x, y, obj = _geometry(scene, uu.astype(float), vv.astype(float))
     lit = (obj > 0) & (x >= -0.5) & (x < p_cols - 0.5) & (y >= -0.5) & (y < p_rows - 0.5)
     # Only pixels wholly inside one lit object (plus a blur margin) are ground truth.
@@ -135,11 +125,11 @@ def render_warp(spec: BaseSpec, scene: WarpScene,
     for i in np.unique(obj[lit]):
         mask |= ndimage.binary_erosion(lit & (obj == i), iterations=margin)
     images = img.astype(np.float32)
-    truth = Truth(coord=x, row=y, mask=mask, object_id=np.where(mask, obj, 0))
-    if spec.orientation == "rows":
+    object_id = np.where(mask, obj, 0)
+    if spec.orientation == "rows":  # the coded axis (x here) is the projector's rows
         images = np.ascontiguousarray(images.transpose(0, 2, 1))
-        truth = Truth(coord=x.T, row=y.T, mask=mask.T, object_id=truth.object_id.T)
-    return images, truth
+        return images, Truth(coord_x=y.T, coord_y=x.T, object_id=object_id.T, mask=mask.T)
+    return images, Truth(coord_x=x, coord_y=y, object_id=object_id, mask=mask)
 
 
 def _albedo(scene: WarpScene, obj: np.ndarray, u: np.ndarray, v: np.ndarray) -> np.ndarray:

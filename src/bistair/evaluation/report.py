@@ -14,8 +14,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from .compare import Row  # noqa: E402
-from .phase import TWO_PI  # noqa: E402
+from ..core.phase import TWO_PI  # noqa: E402
+from .benchmark import Row  # noqa: E402
 
 
 def method_figure(row: Row, truth: Any, path: str | Path) -> Path:

@@ -1,4 +1,5 @@
-"""Every method on the same virtual scene, scored against ground truth and the reference.
+"""The benchmark: every method on the same virtual scene, scored against ground truth and the
+reference.
 
 The scene is ray-cast once (:func:`bistair.sim.trace`) and exposed with each method's
 patterns, so all methods see the same geometry, noise model and camera. Scores: coverage of
@@ -16,34 +17,20 @@ Examples
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from . import decode, encode, make_spec
-from .metrics import compare
-from .phase import TWO_PI
-from .result import DecodeResult
-from .spec import BaseSpec
+from ..codecs import REGISTRY, decode, encode, make_spec
+from ..core.phase import TWO_PI
+from ..core.result import DecodeResult
+from ..sim import expose
+from ..spec import BaseSpec
+from .metrics import score
 
 REFERENCE = "multifreq"
-
-
-def stairs_for(fringes: int) -> tuple[int, int]:
-    """Partitions and stairs (P, S) with P*S >= fringes, as square as possible."""
-    stairs = math.ceil(math.sqrt(fringes))
-    return math.ceil(fringes / stairs), stairs
-
-
-def lv_levels(fringes: int, window: int = 4) -> int:
-    """The fewest stair levels (at least the paper's 4) whose windows can tell the fringes."""
-    levels = 4
-    while levels * (levels - 1) ** (window - 1) + window - 1 < fringes:
-        levels += 1
-    return levels
 
 
 def method_specs(projector_size: tuple[int, int], period: int = 30, gamma: float = 1.0,
@@ -51,31 +38,23 @@ def method_specs(projector_size: tuple[int, int], period: int = 30, gamma: float
                  ) -> dict[str, tuple[BaseSpec, dict[str, Any]]]:
     """The comparable pattern set of every method for a projector: label -> (spec, options).
 
-    All use the fringe period ``period`` (the paper's 30 px) and ``steps`` phase shifts; the
-    bidirectional code uses the squarest ``P x S`` covering the width (6 x 6 on 1080 px,
-    8 x 8 on 1920); Gray code is complementary; the reference is the three-frequency
-    twelve-step set of the paper (width, about sqrt(width*period), period: 1080/180/30,
-    1920/240/30).
+    Every registered codec gives its own comparable parameters at the fringe period
+    ``period`` (the paper's 30 px) with ``steps`` phase shifts (:attr:`Codec.comparable
+    <bistair.codecs.base.Codec.comparable>`), and each of its decoder variants is a row of
+    its own, labelled ``"method (variant)"``. ``methods`` selects labels.
     """
     width, height = projector_size
-    common = dict(width=width, height=height, gamma=gamma)
-    fringes = math.ceil(width / period)
-    parts, stairs = stairs_for(fringes)
-    middle = int(round(math.sqrt(width * period) / period)) * period
-    table: dict[str, tuple[str, dict, dict]] = {
-        "bidirectional": ("bidirectional", dict(period=period, partitions=parts,
-                                                stairs=stairs, steps=steps), {}),
-        "bidirectional (paper decoder)": ("bidirectional", dict(
-            period=period, partitions=parts, stairs=stairs, steps=steps), {"strategy": "paper"}),
-        "lv": ("lv", dict(period=period, steps=steps, levels=lv_levels(fringes)), {}),
-        "phase-coding": ("phase-coding", dict(period=period, steps=steps), {}),
-        "graycode": ("graycode", dict(period=period, complementary=1, steps=steps), {}),
-        "multifreq": ("multifreq", dict(periods=(width, middle, period), steps=12), {}),
-    }
+    table: dict[str, tuple[str, dict, dict]] = {}
+    for name, codec in REGISTRY.items():
+        params = codec.comparable(width, height, period, steps) if codec.comparable else {}
+        table[name] = (name, params, {})
+        for variant, options in codec.variants.items():
+            table[f"{name} ({variant})"] = (name, params, options)
     wanted = set(table if methods is None else methods)
     unknown = wanted - set(table)
     if unknown:
         raise ValueError(f"unknown method(s) {sorted(unknown)} (known: {sorted(table)})")
+    common = dict(width=width, height=height, gamma=gamma)
     return {label: (make_spec(method, **common, **params), options)
             for label, (method, params, options) in table.items() if label in wanted}
 
@@ -106,8 +85,6 @@ def run(trace: Any, specs: dict[str, tuple[BaseSpec, dict[str, Any]]],
         progress: Callable[[str], None] | None = None, imaging: Any = None) -> Comparison:
     """Expose ``trace`` with every spec's patterns (under ``imaging``, default the trace's
     own: noise, blur, gamma and light do not change the geometry), decode and score."""
-    from .sim import expose
-
     truth = trace.truth
     rows = []
     for label, (spec, options) in specs.items():
@@ -115,7 +92,7 @@ def run(trace: Any, specs: dict[str, tuple[BaseSpec, dict[str, Any]]],
             progress(label)
         images = expose(trace, encode(spec), imaging or trace.imaging)
         result = decode(images, spec, **options)
-        scores = compare(result, truth.coord(spec), truth.mask, truth.object_id)
+        scores = score(result, truth.coord(spec), truth.mask, truth.object_id)
         rows.append(Row(label, spec, result, scores))
     ref = next((r for r in rows if r.spec.method == REFERENCE), None)
     if ref is not None:

@@ -6,20 +6,20 @@ horizontal bands that alternate down the region. Averaging the stair phase over 
 a region (across the fringe) gives a clean 1-D profile; its runs are the bands, their
 lengths tell the local bands (``L`` of every ``G`` projector rows) from the partition bands
 (``G - L``), and together they give the region's order. Where a region is too small to
-tell, the evidence says so and the neighbours decide (see :func:`bistair.order.resolve_regions`).
+tell, the evidence says so and the neighbours decide (see
+:func:`bistair.core.resolve.resolve_regions`).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .phase import TWO_PI, wrap
-from .stair import stair_level_phase
+from ...core.phase import TWO_PI, wrap
+from ...core.stair import level_misfit, quantize, stair_level_phase
 
 
 @dataclass
@@ -347,9 +347,9 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         # this capture); its nominal phase says which stair index that is.
         th_x = layout.levels[vals[x]]
         if y < 0:
-            a, b = _index(th_x, S), _index(th_x, P)
+            a, b = quantize(th_x, S), quantize(th_x, P)
             if length.max() >= 1.3 * max(f_loc, f_par) * h:
-                fit = _fit(th_x, a, S) + _fit(th_x, b, P)
+                fit = level_misfit(th_x, a, S) + level_misfit(th_x, b, P)
                 ev[r, a + S * b] = cls_w[x] / total - 0.5 * fit
             else:
                 share = 0.4 * cls_w[x] / total
@@ -360,10 +360,10 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         options = []
         for loc, par in ((x, y), (y, x)):
             th_l, th_p = (th_x, th_y) if loc == x else (th_y, th_x)
-            a, b = _index(th_l, S), _index(th_p, P)
+            a, b = quantize(th_l, S), quantize(th_p, P)
             expect = np.where(inv == loc, f_loc * h, np.where(inv == par, f_par * h, np.nan))
             cost = _length_cost(length, expect, complete)
-            fit = _fit(th_l, a, S) + _fit(th_p, b, P)
+            fit = level_misfit(th_l, a, S) + level_misfit(th_p, b, P)
             # A class seen in 3 or more rows' worth of pixels is certain; a match counts +1,
             # a mismatch -1, each weighted by how certain its class is.
             e_l, e_p = np.minimum(1.0, cls_w[[loc, par]] / (3.0 * row_weight))
@@ -374,17 +374,6 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
         low = min(cost for _, cost in options)
         ev[r] = np.max([score - 0.5 * min(1.0, cost - low) for score, cost in options], axis=0)
     return ev
-
-
-def _index(theta: float, levels: int) -> int:
-    """:func:`bistair.stair.quantize` of one phase, without array overhead."""
-    return int(math.floor(((theta + math.pi) % TWO_PI) * levels / TWO_PI)) % levels
-
-
-def _fit(theta: float, level: int, levels: int) -> float:
-    """Squared distance to a stair level, in half-steps (0 on the level, 1 at the border)."""
-    d = (theta - (-math.pi + math.pi / levels + TWO_PI * level / levels) + math.pi) % TWO_PI
-    return ((d - math.pi) / (math.pi / levels)) ** 2
 
 
 def _length_cost(length: np.ndarray, expect: np.ndarray, complete: np.ndarray) -> float:

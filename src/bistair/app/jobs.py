@@ -1,0 +1,219 @@
+"""The jobs on folders behind the command line: write a pattern set, decode a capture folder,
+reconstruct, measure height against a reference plane, calibrate from board captures.
+
+Each job reads its inputs, works in memory and writes its outputs atomically (a temporary
+folder or file moved in at the end), so a failed job leaves nothing behind.
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> from bistair.codecs import make_spec
+>>> spec = make_spec("bidirectional", width=240, height=60, period=20, partitions=2)
+>>> with tempfile.TemporaryDirectory() as tmp:
+...     out = save_patterns(spec, pathlib.Path(tmp) / "pats")
+...     sorted(p.name for p in out.iterdir())
+['00.png', '01.png', '02.png', '03.png', '04.png', '05.png', 'spec.json']
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..codecs import decode, encode
+from ..core.captures import to_bit_depth
+from ..core.result import DecodeResult
+from ..errors import BistairError
+from ..geometry.board import Board
+from ..geometry.calibrate import PoseCapture, calibrate_poses
+from ..geometry.calibration import Calibration, load_calibration, save_calibration
+from ..geometry.height import HeightModel
+from ..geometry.triangulate import Reconstruction, check_fit, reconstruct
+from ..io.files import (
+    load_spec,
+    natural_key,
+    output_folder,
+    read_captures,
+    read_with_spec,
+    write_image,
+)
+from ..io.previews import colorize
+from ..io.writers import write_depth, write_ply, write_result
+from ..spec import BaseSpec
+
+
+def save_patterns(spec: BaseSpec, out: str | Path) -> Path:
+    """Write ``00.png`` ... and ``spec.json`` into ``out``; returns ``out``."""
+    images = to_bit_depth(encode(spec), spec.bits)
+    width = max(2, len(str(len(images) - 1)))
+    with output_folder(out) as tmp:
+        for i, img in enumerate(images):
+            write_image(tmp / f"{i:0{width}d}.png", img)
+        (tmp / "spec.json").write_text(spec.to_json())
+    return Path(out)
+
+
+def decode_folder(captures: str | Path, out: str | Path, spec: BaseSpec | str | Path | None = None,
+                  previews: bool = True, **options: Any) -> DecodeResult:
+    """Decode a capture folder (or ``.npy`` stack) and write the result arrays into ``out``.
+
+    ``spec`` defaults to ``CAPTURES/spec.json``.
+    """
+    stack, spec = read_with_spec(captures, spec)
+    result = decode(stack, spec, **options)
+    with output_folder(out) as tmp:
+        write_result(result, tmp, previews=previews)
+    return result
+
+
+def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
+                  spec: BaseSpec | str | Path | None = None, planes: tuple[str, ...] = (),
+                  geometry: str | None = None) -> np.ndarray:
+    """Height above a reference plane (mm) from the captures of the object, of the plane and
+    either of planes at known heights (``"FOLDER:HEIGHT"``, two or more) or of the geometry
+    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``."""
+    stack, spec = read_with_spec(captures, spec)
+    if bool(planes) == bool(geometry):
+        raise BistairError("give either two or more --plane FOLDER:HEIGHT or --geometry")
+
+    def coord(folder: str | Path) -> np.ndarray:
+        return decode(read_captures(folder), spec).coord.astype(np.float64)
+
+    ref = coord(reference)
+    if geometry:
+        try:
+            distance, baseline, frequency = (float(v) for v in geometry.split(","))
+        except ValueError:
+            raise BistairError(f"--geometry must be DISTANCE,BASELINE,FREQUENCY, got "
+                               f"{geometry!r}") from None
+        model = HeightModel.classical(ref, distance, baseline, frequency, spec.period)
+    else:
+        pairs = []
+        for item in planes:
+            folder, _, value = item.rpartition(":")
+            try:
+                pairs.append((coord(folder), float(value)))
+            except ValueError:
+                raise BistairError(f"--plane must be FOLDER:HEIGHT, got {item!r}") from None
+        model = HeightModel.fit(ref, [p for p, _ in pairs], [h for _, h in pairs])
+    obj = decode(stack, spec).coord.astype(np.float64)
+    if obj.shape != ref.shape:
+        raise BistairError(f"captures are {obj.shape[1]}x{obj.shape[0]}, the reference "
+                           f"{ref.shape[1]}x{ref.shape[0]}")
+    heights = model.height(obj).astype(np.float32)
+    with output_folder(out) as tmp:
+        np.save(tmp / "height.npy", heights)
+        write_image(tmp / "height.png", colorize(heights, "viridis"))
+    return heights
+
+
+def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
+                       calibration: Calibration | str | Path, out_ply: str | Path,
+                       depth_dir: str | Path | None = None, orientation: str | None = None,
+                       min_depth: float = 0.0, max_depth: float = np.inf,
+                       **options: Any) -> Reconstruction:
+    """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
+    ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
+    ``CAPTURES/spec.json``; ``options`` go to the decoder. Nothing is written on error."""
+    stack, spec = read_with_spec(captures, spec)
+    if not isinstance(calibration, Calibration):
+        calibration = load_calibration(calibration)
+    blank = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8, period=1.0, method="")
+    check_fit(blank, calibration, spec, orientation)  # before the work of decoding
+    rec = reconstruct(decode(stack, spec, **options), calibration, spec, orientation,
+                      min_depth, max_depth)
+    pts, cols = rec.cloud()
+    if depth_dir is None:
+        write_ply(out_ply, pts, cols)
+        return rec
+    with output_folder(depth_dir) as tmp:
+        write_depth(rec.depth, tmp)
+        write_ply(out_ply, pts, cols)
+    return rec
+
+
+# -- calibration ---------------------------------------------------------------------------
+def pose_folders(folder: Path) -> list[Path]:
+    """The pose sub-folders of a calibration capture folder (natural name order)."""
+    subs = sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: natural_key(p.name))
+    poses = []
+    for sub in subs:
+        have = [(sub / o).is_dir() for o in ("columns", "rows")]
+        if all(have):
+            poses.append(sub)
+        elif any(have):
+            missing = "rows" if have[0] else "columns"
+            raise BistairError(f"pose {sub.name} has no {missing}/ folder")
+    return poses
+
+
+def read_pose(folder: Path, orientation: str) -> tuple[np.ndarray, np.ndarray, BaseSpec]:
+    """Decode one orientation of a pose: the projector coordinate, the white frame, the spec."""
+    sub = folder / orientation
+    spec = load_spec(sub / "spec.json")
+    where = f"{folder.name}/{orientation}"
+    if spec.orientation != orientation:
+        raise BistairError(f"{where}/spec.json codes {spec.orientation}, the folder is for "
+                           f"{orientation}")
+    if not spec.white:
+        raise BistairError(f"{where}/spec.json has no white frame (white=1 is needed to "
+                           "find the board)")
+    try:
+        result = decode(read_captures(sub), spec)
+    except BistairError as exc:
+        raise BistairError(f"{where}: {exc}") from None
+    return result.coord, result.texture, spec
+
+
+def calibrate_folder(folder: str | Path, out: str | Path | None = None,
+                     board: Board | str | Path | None = None, min_poses: int = 3,
+                     **options: Any) -> Calibration:
+    """Calibrate from board captures; write the calibration file to ``out`` (atomically) if
+    given. ``options`` go to :func:`~bistair.geometry.calibrate.calibrate_poses` and
+    :func:`~bistair.geometry.calibrate.calibrate_points` (``fix_k3``, ``refine``).
+
+    Capture layout::
+
+        calib/
+          board.json            {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20}
+          pose-00/columns/      images in name order + spec.json (orientation columns, white=1)
+          pose-00/rows/         images in name order + spec.json (orientation rows, white=1)
+          pose-01/...
+
+    Every sub-folder holding ``columns/`` and ``rows/`` is a pose (in natural name order);
+    both specs must code the same projector size. ``board.json``: see
+    :mod:`bistair.geometry.board` (``columns x rows`` inner corners or circles, ``spacing``
+    in mm).
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise BistairError(f"calibration captures {folder} not found")
+    if not isinstance(board, Board):
+        board = Board.load(folder / "board.json" if board is None else board)
+    folders = pose_folders(folder)
+    if not folders:
+        raise BistairError(f"no pose folders with columns/ and rows/ in {folder}")
+    poses, proj_size, cam_size = [], None, None
+    for sub in folders:
+        x, white, sx = read_pose(sub, "columns")
+        y, _, sy = read_pose(sub, "rows")
+        for s, o in ((sx, "columns"), (sy, "rows")):
+            if proj_size is None:
+                proj_size = (s.width, s.height)
+            elif (s.width, s.height) != proj_size:
+                raise BistairError(f"{sub.name}/{o}/spec.json is for a {s.width}x{s.height} "
+                                   f"projector, earlier specs for {proj_size[0]}x{proj_size[1]}")
+        for arr, o in ((x, "columns"), (y, "rows")):
+            if cam_size is None:
+                cam_size = arr.shape
+            elif arr.shape != cam_size:
+                raise BistairError(f"{sub.name}/{o} images are {arr.shape[1]}x{arr.shape[0]}, "
+                                   f"earlier ones {cam_size[1]}x{cam_size[0]}")
+        poses.append(PoseCapture(sub.name, white, x, y))
+    assert proj_size is not None
+    cal = calibrate_poses(poses, board, proj_size, min_poses=min_poses, **options)
+    if out is not None:
+        save_calibration(cal, out)
+    return cal

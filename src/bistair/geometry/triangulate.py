@@ -1,0 +1,188 @@
+"""From absolute phase to 3-D points: triangulation with a calibrated rig.
+
+Triangulation. A valid camera pixel's ray ``X = z * (x, y, 1)`` (``(x, y)`` undistorted
+through the camera model) meets the surface of projector points whose coded coordinate (the
+column ``x_p`` for ``orientation="columns"``, the row ``y_p`` for ``"rows"``), projected with
+the projector's distortion, equals the decoded one. The depth ``z`` starts at the
+distortion-free ray-plane intersection and is refined by vectorised Newton steps on the
+projector's own projection, so distortion is honoured exactly. Points are in the camera
+frame, millimetres.
+
+Examples
+--------
+>>> cal = _toy_calibration()
+>>> pixels = np.array([[320.0, 240.0], [100.0, 400.0]])
+>>> point = np.array([[10.0, -20.0, 600.0]])
+>>> uv = cal.camera.K @ point[0] / point[0, 2]
+>>> xp = cal.projector.K @ (cal.R @ point[0] + cal.T)
+>>> triangulate(uv[None, :2], np.array([xp[0] / xp[2]]), cal).round(6).tolist()
+[[10.0, -20.0, 600.0]]
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+
+from ..core.result import DecodeResult
+from ..errors import BistairError
+from ..spec import BaseSpec
+from .calibration import Calibration, Device
+
+_UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
+
+
+@dataclass
+class Reconstruction:
+    """Per camera pixel: ``points`` (H, W, 3) float32 mm in the camera frame and ``depth``
+    (H, W) float32 ``z`` (NaN where invalid), ``colors`` (H, W, 3) uint8, ``mask``."""
+
+    points: np.ndarray
+    depth: np.ndarray
+    colors: np.ndarray
+    mask: np.ndarray
+
+    def cloud(self) -> tuple[np.ndarray, np.ndarray]:
+        """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
+        return self.points[self.mask], self.colors[self.mask]
+
+
+def _project_coded(dev: Device, pts: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel coordinates (coded axis, other axis) of device-frame points ``(N, 3)``."""
+    k1, k2, p1, p2, k3 = dev.dist
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x, y = pts[:, 0] / pts[:, 2], pts[:, 1] / pts[:, 2]
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+    xd = x * radial + 2 * p1 * x * y + p2 * (r2 + 2 * x * x)
+    yd = y * radial + p1 * (r2 + 2 * y * y) + 2 * p2 * x * y
+    u = dev.K[0, 0] * xd + dev.K[0, 1] * yd + dev.K[0, 2]
+    v = dev.K[1, 1] * yd + dev.K[1, 2]
+    return (u, v) if axis == 0 else (v, u)
+
+
+def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
+                orientation: str = "columns", iterations: int = 12, tolerance: float = 1e-4,
+                sensitivity: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """3-D points (camera frame, mm) of camera ``pixels`` ``(N, 2)`` whose decoded projector
+    coordinate along the coded axis is ``coord`` ``(N,)``; NaN rows where there is no
+    solution in front of both devices inside the projector image (to ``tolerance`` px).
+
+    With ``sensitivity``, also the depth change per projector pixel, ``|dz/dcoord|``."""
+    cam, proj = calibration.camera, calibration.projector
+    axis = 0 if orientation == "columns" else 1
+    pix = np.asarray(pixels, np.float64).reshape(-1, 1, 2)
+    target = np.asarray(coord, np.float64).ravel()
+    if not len(target):
+        return (np.zeros((0, 3)), np.zeros(0)) if sensitivity else np.zeros((0, 3))
+    norm = cv2.undistortPoints(pix, cam.K, cam.dist, criteria=_UNDISTORT).reshape(-1, 2)
+    ray = np.column_stack([norm, np.ones(len(norm))])
+    a = ray @ calibration.R.T  # projector-frame point = z * a + T
+    t = calibration.T
+    # distortion-free start: the ray meets the plane of projector points with this coordinate
+    m = (target - proj.K[axis, 2]) / proj.K[axis, axis]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = (m * t[2] - t[axis]) / (a[:, axis] - m * a[:, 2])
+        for _ in range(iterations):
+            step = 1e-3 * np.abs(z) + 1e-9
+            f0 = _project_coded(proj, z[:, None] * a + t, axis)[0] - target
+            f1 = _project_coded(proj, (z + step)[:, None] * a + t, axis)[0] - target
+            dz = f0 * step / (f1 - f0)
+            z = z - dz
+            if not np.nanmax(np.abs(dz) / np.abs(z), initial=0.0) > 1e-12:
+                break
+        pts_p = z[:, None] * a + t
+        coded, other = _project_coded(proj, pts_p, axis)
+        span = proj.size[1 - axis]
+        ok = ((z > 0) & (pts_p[:, 2] > 0) & (np.abs(coded - target) <= tolerance)
+              & (other >= -0.5) & (other <= span - 0.5))
+        points = np.where(ok[:, None], z[:, None] * ray, np.nan)
+        if not sensitivity:
+            return points
+        step = 1e-3 * np.abs(z) + 1e-9
+        slope = (_project_coded(proj, (z + step)[:, None] * a + t, axis)[0] - coded) / step
+        return points, np.where(ok, 1.0 / np.abs(slope), np.nan)
+
+
+def _grey_colors(result: DecodeResult, spec: BaseSpec | None) -> np.ndarray:
+    if result.texture is not None:
+        grey = np.asarray(result.texture, float)
+    else:
+        grey = np.asarray(result.average, float) / (spec.offset if spec else 0.5)
+    grey = np.round(np.clip(np.nan_to_num(grey), 0.0, 1.0) * 255).astype(np.uint8)
+    return np.repeat(grey[..., None], 3, axis=2)
+
+
+def check_fit(result: DecodeResult, calibration: Calibration,
+              spec: BaseSpec | str, orientation: str | None = None) -> str:
+    """The coded orientation, after checking that captures, spec and calibration belong
+    together (one-line :class:`BistairError` otherwise)."""
+    coded = spec if isinstance(spec, str) else spec.orientation
+    if coded not in ("columns", "rows"):
+        raise BistairError(f"orientation must be 'columns' or 'rows', got {coded!r}")
+    if orientation is not None and orientation != coded:
+        raise BistairError(f"the spec codes {coded}, but {orientation} were asked for")
+    cam, proj = calibration.camera, calibration.projector
+    h, w = result.coord.shape
+    if (w, h) != cam.size:
+        raise BistairError(f"calibration is for {cam.width}x{cam.height} camera images, "
+                           f"captures are {w}x{h}")
+    if isinstance(spec, BaseSpec) and (spec.width, spec.height) != proj.size:
+        raise BistairError(f"calibration is for a {proj.width}x{proj.height} projector, the "
+                           f"spec for {spec.width}x{spec.height}")
+    return coded
+
+
+def reconstruct(result: DecodeResult, calibration: Calibration, spec: BaseSpec | str,
+                orientation: str | None = None, min_depth: float = 0.0,
+                max_depth: float = np.inf, **options: Any) -> Reconstruction:
+    """Triangulate every valid pixel of a decode.
+
+    ``spec`` is the spec of the captures (or just its orientation); ``orientation``, if
+    given, is what the caller expects the spec to code. Depths outside ``[min_depth,
+    max_depth]`` are dropped. ``options`` go to :func:`triangulate`. Colours are the white
+    frame if the spec has one, else the fringes' average.
+    """
+    coded = check_fit(result, calibration, spec, orientation)
+    h, w = result.coord.shape
+    valid = np.flatnonzero(result.mask.ravel() & np.isfinite(result.coord.ravel()))
+    pix = np.column_stack([valid % w, valid // w]).astype(float)
+    pts, sens = triangulate(pix, result.coord.ravel()[valid], calibration, coded,
+                            sensitivity=True, **options)
+    _check_geometry(pts, sens, calibration, coded)
+    with np.errstate(invalid="ignore"):
+        keep = np.isfinite(pts[:, 2]) & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
+    points = np.full((h * w, 3), np.nan, np.float32)
+    points[valid[keep]] = pts[keep]
+    points = points.reshape(h, w, 3)
+    mask = np.isfinite(points[..., 2])
+    return Reconstruction(points, points[..., 2].copy(), _grey_colors(
+        result, spec if isinstance(spec, BaseSpec) else None), mask)
+
+
+def _check_geometry(points: np.ndarray, sens: np.ndarray, calibration: Calibration,
+                    coded: str) -> None:
+    """Refuse a coded axis that carries almost no depth in this rig (baseline across it)."""
+    ok = np.isfinite(sens)
+    if ok.sum() < 10:
+        return
+    axis = 0 if coded == "columns" else 1
+    dist = np.linalg.norm(points[ok] @ calibration.R.T + calibration.T, axis=1)
+    ideal = np.median(dist) ** 2 / (calibration.projector.K[axis, axis] * calibration.baseline)
+    ratio = float(np.median(sens[ok]) / ideal)
+    if ratio > 8:
+        other = "rows" if coded == "columns" else "columns"
+        raise BistairError(f"projector {coded} barely change with depth in this rig "
+                           f"({np.median(sens[ok]):.1f} mm per projector pixel, {ratio:.0f}x "
+                           f"worse than along the baseline): capture {other} instead")
+
+
+def _toy_calibration() -> Calibration:
+    """A distortion-free camera and projector for the examples."""
+    cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    proj = Device(800, 600, [[1000.0, 0, 399.5], [0, 1000, 299.5], [0, 0, 1]])
+    rot = cv2.Rodrigues(np.array([0.0, 0.3, 0.0]))[0]
+    return Calibration(cam, proj, rot, -rot @ np.array([150.0, 0.0, 0.0]))
