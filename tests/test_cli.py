@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from conftest import cli_run, warped_scene
 
+import bistair
 from bistair.sim.warp import render_warp
 
 run = cli_run
@@ -143,7 +144,7 @@ def test_missing_captures_and_empty_folder(tmp_path, monkeypatch, capsys):
                     tmp_path / "r", message="captures")
     (tmp_path / "empty").mkdir()
     (tmp_path / "empty" / "spec.json").write_text(
-        json.dumps({"method": "bidirectional", "width": 1080, "height": 1080, "period": 30}))
+        bistair.make_spec("bidirectional", width=1080, height=1080, period=30).to_json())
     _expect_refusal(monkeypatch, capsys, None, "decode", tmp_path / "empty", "--out",
                     tmp_path / "r", message="no PNG, TIFF or BMP images")
 
@@ -156,7 +157,7 @@ def test_spec_not_json_or_missing_fields(pats, tmp_path, monkeypatch, capsys):
                     message="is not valid JSON")
     (caps / "spec.json").write_text(json.dumps({"method": "bidirectional", "width": 480}))
     _expect_refusal(monkeypatch, capsys, out, "decode", caps, "--out", out,
-                    message="spec misses field(s): height, period")
+                    message="spec misses field(s): height, steps")
     _expect_refusal(monkeypatch, capsys, out, "decode", caps, "--spec", tmp_path / "x.json",
                     "--out", out, message="not found")
 

@@ -51,18 +51,18 @@ def test_parameters_that_cannot_work_are_refused(params, reason):
     assert "\n" not in str(info.value)
 
 
+FULL = bistair.make_spec("bidirectional", width=1080, height=1080, period=30).to_dict()
+
+
 @pytest.mark.parametrize(
     ("data", "reason"),
     [
         ({"width": 10, "height": 10, "period": 30}, "misses the field 'method'"),
         ({"method": "bidirectional", "width": 1080, "height": 1080}, "misses field"),
         ({"method": "nope", "width": 1080, "height": 1080}, "unknown method"),
-        ({"method": "bidirectional", "width": 1080, "height": 1080, "period": 30, "x": 1},
-         "unknown field"),
-        ({"method": "bidirectional", "width": "wide", "height": 1080, "period": 30},
-         "must be an integer"),
-        ({"method": "bidirectional", "width": 1080, "height": 1080, "period": 30,
-          "frames": ["a"]}, "must list the frames"),
+        ({**FULL, "x": 1}, "unknown field"),
+        ({**FULL, "width": "wide"}, "must be an integer"),
+        ({**FULL, "frames": ["a"]}, "spec field 'frames' misses"),
         ([1, 2], "JSON object"),
     ],
 )

@@ -19,7 +19,7 @@ import numpy as np
 
 from ..codecs import REGISTRY
 from ..errors import BistairError
-from ..spec import BaseSpec, field_kind
+from ..spec import BaseSpec, coerce_field, field_kind
 
 
 class CliError(click.ClickException):
@@ -52,34 +52,22 @@ def patterns() -> None:
     """Write a method's patterns (NN.png) and their spec.json into a folder."""
 
 
-def _parse_list(ctx: click.Context, param: click.Parameter, value: Any) -> Any:
-    if value is None or isinstance(value, tuple):
-        return value
-    try:
-        return tuple(int(v) for v in str(value).split(",") if v.strip())
-    except ValueError:
-        raise click.BadParameter("expected comma-separated integers, e.g. 1080,180,30") from None
-
-
 def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.Command:
+    """``bistair patterns NAME``: an option per spec field (numbers may be written as
+    fractions such as ``1920/58`` or with ``pi`` such as ``-2*pi/3``; lists with commas)."""
     params: list[click.Parameter] = []
-    for f in dataclasses.fields(spec_class):
-        if f.metadata.get("cli") is False:
-            continue
+    fields = {f.name: f for f in dataclasses.fields(spec_class)
+              if f.metadata.get("cli") is not False}
+    for f in fields.values():
         kind = field_kind(f)
-        opt: dict[str, Any] = {"help": f.metadata.get("help", ""), "show_default": True}
+        default = f.default
+        shown = ",".join(_show(v) for v in default) if kind is tuple else _show(default)
+        opt: dict[str, Any] = {"help": f.metadata.get("help", ""), "show_default": True,
+                               "default": shown, "type": str}
         if "choices" in f.metadata:
-            opt["type"] = click.Choice([str(c) for c in f.metadata["choices"]])
-            opt["default"] = str(f.default)
+            opt["type"] = click.Choice([_show(c) for c in f.metadata["choices"]])
             if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
                 opt.update(is_flag=False, flag_value="1")
-        elif kind is tuple:
-            opt["type"] = str
-            opt["default"] = ",".join(map(str, f.default))
-            opt["callback"] = _parse_list
-        else:
-            opt["type"] = kind
-            opt["default"] = f.default
         params.append(click.Option([f"--{f.name.replace('_', '-')}", f.name], **opt))
     params.append(click.Option(["--out", "-o"], required=True, type=click.Path(path_type=Path),
                                help="output folder"))
@@ -88,14 +76,17 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
     def callback(out: Path, **values: Any) -> None:
         from .jobs import save_patterns
 
-        for f in dataclasses.fields(spec_class):
-            if f.name in values and isinstance(f.default, int) and isinstance(values[f.name], str):
-                values[f.name] = int(values[f.name])
+        values = {key: coerce_field(fields[key], value) for key, value in values.items()}
         spec = spec_class(**values)
         save_patterns(spec, out)
         click.echo(f"wrote {spec.frame_count} {name} patterns and spec.json to {out}")
 
     return click.Command(name, params=params, callback=callback, help=summary)
+
+
+def _show(value: Any) -> str:
+    """A default as the command line shows it: 30 rather than 30.0."""
+    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
 
 
 for _codec in REGISTRY.values():

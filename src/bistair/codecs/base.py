@@ -40,9 +40,10 @@ import numpy as np
 
 from ..core.captures import Prepared, prepare
 from ..core.measure import FringeSet, measure
-from ..core.result import DecodeResult, result_from_phase
+from ..core.phase import phase_shift_patterns
+from ..core.result import AxesResult, DecodeResult, result_from_phase
 from ..errors import BistairError
-from ..spec import BaseSpec, PeriodSpec
+from ..spec import AXES, BaseSpec, PeriodSpec
 
 
 @dataclass
@@ -53,16 +54,26 @@ class CodeMap:
     ----------
     code : int32, the code word (``k_s`` for the stair methods, the Gray-code order, the
         order from the coarser phases for multi-frequency), -1 where not decoded.
-    maps : named method-specific maps of the same shape (e.g. ``stair_phase``).
+    maps : named method-specific maps of the same shape (e.g. ``stair_phase``). ``edges``,
+        if present, is the code as read from its own patterns (else ``code`` is), whose
+        steps sit where the wrapped phase is ``edge_phase`` (0: at the phase jumps).
+    edge_phase : the wrapped phase at the code's edges.
     """
 
     code: np.ndarray
     maps: dict[str, np.ndarray] = field(default_factory=dict)
+    edge_phase: float = 0.0
+
+    @property
+    def edges(self) -> np.ndarray:
+        """The code whose steps are the code's own edges (see the attributes)."""
+        return self.maps.get("edges", self.code)
 
     def transposed(self) -> CodeMap:
         """The same maps with image axes swapped (for the rows orientation)."""
         return CodeMap(np.ascontiguousarray(self.code.T),
-                       {k: np.ascontiguousarray(v.T) for k, v in self.maps.items()})
+                       {k: np.ascontiguousarray(v.T) for k, v in self.maps.items()},
+                       self.edge_phase)
 
 
 @dataclass
@@ -80,8 +91,10 @@ OrderFn = Callable[..., Orders]
 
 def measure_shifts(prepared: Prepared, spec: PeriodSpec,
                    min_modulation: float | None = None) -> FringeSet:
-    """Stage 1 of the single-period methods: their N-step set, the first ``steps`` frames."""
-    return measure(prepared, 0, spec.steps, min_modulation)
+    """Stage 1 of the single-period methods: their N-step set, the first ``steps`` frames,
+    in the spec's phase convention."""
+    return measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
+                   phase_offset=spec.phase_offset)
 
 
 @dataclass(frozen=True)
@@ -111,33 +124,42 @@ class Codec:
 
     # -- encoding ----------------------------------------------------------------------------
     def encode(self, spec: BaseSpec) -> np.ndarray:
-        """Patterns as float32 in [0, 1], shape (frames, height, width), gamma pre-compensated."""
-        pats = np.asarray(self.encode_columns(spec), dtype=np.float64)
-        pats = np.clip(pats, 0.0, 1.0)
-        if spec.white:
-            pats = np.concatenate([pats, np.ones((1, *pats.shape[1:]))])
+        """Patterns as float32 in [0, 1], shape (frames, height, width), in the order of
+        ``spec.frames``, gamma pre-compensated; ``black`` and ``ignore`` frames are dark."""
+        by_name: dict[str, np.ndarray] = {}
+        for axis, sub in spec.axes():
+            pats = np.clip(np.asarray(self.encode_columns(sub), dtype=np.float64), 0.0, 1.0)
+            if axis == "rows":
+                pats = pats.transpose(0, 2, 1)
+            tag = f"{AXES[axis]}/" if spec.orientation == "both" else ""
+            by_name.update((tag + name, p) for name, p in zip(sub.method_frames(), pats,
+                                                              strict=True))
+        lit = np.ones((spec.height, spec.width))
+        dark = np.zeros((spec.height, spec.width))
+        pats = np.stack([by_name.get(n, lit if n == "white" else dark) for n in spec.frames])
         if spec.gamma != 1.0:
             pats = pats ** (1.0 / spec.gamma)
-        if spec.orientation == "rows":
-            pats = pats.transpose(0, 2, 1)
-        order = [spec.default_frames().index(name) for name in spec.frames]
-        return np.ascontiguousarray(pats[order], dtype=np.float32)
+        return np.ascontiguousarray(pats, dtype=np.float32)
 
     # -- decoding stages ---------------------------------------------------------------------
     def _columns(self, images: np.ndarray, spec: BaseSpec) -> tuple[Prepared, Prepared]:
         """The checked, scaled stack and its method frames in method order, coded axis along
-        the columns."""
+        the columns (white and black frames kept beside them)."""
         if spec.method != self.name:
             raise BistairError(f"a {spec.method} spec cannot be decoded by the {self.name} codec")
-        prepared = prepare(images, spec.frame_count, self.name)
-        order = [spec.frames.index(name) for name in spec.method_frames()]
-        same = order == list(range(len(order)))
-        frames = prepared.frames[:len(order)] if same else prepared.frames[order]
-        clipped = prepared.clipped
+        if spec.orientation == "both":
+            raise BistairError("a spec of both axes decodes with decode(), axis by axis")
+        frames = spec.frames
+        roles = {role: frames.index(role) if role in frames else None
+                 for role in ("white", "black")}
+        prepared = prepare(images, spec.frame_count, self.name,
+                           select=[frames.index(name) for name in spec.method_frames()],
+                           **roles)
         if spec.orientation == "rows":
-            frames = frames.transpose(0, 2, 1)
-            clipped = clipped.T
-        return prepared, Prepared(frames, clipped, prepared.full_scale)
+            return prepared, Prepared(
+                prepared.frames.transpose(0, 2, 1), prepared.clipped.T, prepared.full_scale,
+                *(None if a is None else a.T for a in (prepared.white, prepared.black)))
+        return prepared, prepared
 
     def phase_map(self, images: np.ndarray, spec: BaseSpec,
                   min_modulation: float | None = None) -> FringeSet:
@@ -154,26 +176,55 @@ class Codec:
         code = self.code_columns(cols, spec, fs, min_modulation)
         return code.transposed() if spec.orientation == "rows" else code
 
-    def decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
-        """All stages: absolute phase, projector coordinate and fringe order per pixel."""
+    def decode(self, images: np.ndarray, spec: BaseSpec,
+               **options: Any) -> DecodeResult | AxesResult:
+        """All stages: absolute phase, projector coordinate and fringe order per pixel.
+
+        A spec of both axes gives an :class:`~bistair.core.result.AxesResult` (one decode
+        per axis), any other a :class:`~bistair.core.result.DecodeResult`.
+        """
         unknown = set(options) - set(self.options)
         if unknown:
             raise BistairError(
                 f"the {self.name} decoder has no option(s) {', '.join(sorted(unknown))}"
             )
+        if spec.orientation == "both":
+            x, y = (self.decode(images, axis_spec, **options) for _, axis_spec in spec.axes())
+            return AxesResult(x, y)
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
         code = self.code_columns(cols, spec, fs, min_modulation)
         orders = self.order_columns(fs, code, spec, **options)
         result = result_from_phase(self.name, fs, orders.abs_phase, spec.period,
-                                   code=code.code, info=orders.info)
+                                   code=code.code, info=orders.info, length=spec.coded_length)
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":
             result = result.transposed()
-        if spec.white:
-            result.texture = prepared.frames[spec.frames.index("white")]
+        result.texture = prepared.white
         return result
+
+
+def fringe_index(spec: BaseSpec, period: float | None = None) -> np.ndarray:
+    """``floor(x / period)`` for every projector pixel ``x`` along the coded axis (int64; the
+    spec's period by default). A hair of tolerance keeps pixels that sit exactly on a
+    fringe edge of a fractional period (``1920/58``) in the fringe their phase says.
+
+    >>> from bistair.codecs import make_spec
+    >>> fringe_index(make_spec("graycode", width=120, height=16, period=30))[28:32].tolist()
+    [0, 0, 1, 1]
+    """
+    x = np.arange(spec.coded_length, dtype=np.float64)
+    return np.floor(x / (spec.period if period is None else period) + 1e-9).astype(np.int64)
+
+
+def shift_patterns(spec: BaseSpec, period: float | None = None) -> np.ndarray:
+    """The N-step fringe patterns along the coded axis, ``(steps, coded_length)``, in the
+    spec's phase convention (``phase_offset``, ``shift_sign``)."""
+    x = np.arange(spec.coded_length)
+    return phase_shift_patterns(x, spec.period if period is None else period, spec.steps,
+                                spec.offset, spec.amplitude, spec.phase_offset,
+                                spec.shift_sign)
 
 
 def along_columns(profiles: np.ndarray, spec: BaseSpec) -> np.ndarray:

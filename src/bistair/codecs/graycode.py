@@ -1,11 +1,27 @@
-"""Gray code plus N-step phase shifting, plain or complementary.
+"""Gray code plus N-step phase shifting: plain, complementary, shifted, or checked by a
+second period.
 
-Frames ``shift-n``, then ``gray-0 .. gray-(B-1)`` (most significant first, ``B`` bits for
-the fringe count), with ``complementary`` one more, ``gray-B``, and with ``inverse`` each
-code pattern's inverse ``gray-i-inv`` after them.
+Frames ``shift-n``; with ``second_period`` a second N-step set ``second-shift-n``; then
+``gray-0 .. gray-(B-1)`` (most significant first, ``B`` bits for the levels the code needs),
+with ``complementary`` one more, ``gray-B``, and with ``inverse`` each code pattern's
+inverse ``gray-i-inv`` after them (``frames`` may put them in any order, e.g. OpenCV's
+``GrayCodePattern``: each pattern followed by its inverse). A pattern is bright where its
+bit is 1; the Gray code of level ``j`` is ``j ^ (j >> 1)``.
 
 Plain: the code gives ``k = floor(x/T)`` directly; its edges sit exactly on the phase wraps,
 so blur and noise put pixels beside every edge one order off (the method's known limit).
+
+Shifted (``gray_offset = 0.5``; Wu Z. et al., Opt. Express 27(16), 2019): the code's edges
+sit half a period off the phase jumps, ``g = floor(x/T + 1/2)`` over ``fringes + 1``
+levels; ``k = g`` where ``phi < pi`` and ``g - 1`` where ``phi >= pi``, so no pixel reads the
+code next to one of its edges.
+
+Second period (``second_period = T2``; the layout of kamino410/phase-shifting, with OpenCV's
+Gray code): the order read from the code is checked against the phase of a second N-step
+set. Next to a code edge the true order is the code's or its neighbour on the side the
+wrapped phase says (``k + 1`` where ``phi < pi``, ``k - 1`` where ``phi >= pi``); the one
+whose coordinate predicts the second phase best is kept, and a pixel where neither predicts
+it within half their separation is invalid. ``T / T2`` must not be close to a whole number.
 
 Complementary (Zhang Q. et al., Opt. Lasers Eng. 50(4), 2012): the ``B+1`` patterns form a
 Gray code of half-period resolution whose last bit has its edges mid-fringe. With ``k1``
@@ -14,7 +30,9 @@ rule picks the code whose edges are far from the pixel: ``k2`` where ``phi < pi/
 ``k2 - 1`` where ``phi >= 3*pi/2``, ``k1`` in between.
 
 Bits are binarised against the fringes' average intensity, or against the inverse patterns
-when the spec has them (robust to albedo and ambient light).
+when the spec has them (robust to albedo and ambient light); with inverses, a pixel whose
+pattern and inverse differ by less than twice the modulation threshold (median over the
+bits) is in shadow and invalid.
 
 Examples
 --------
@@ -31,15 +49,16 @@ True
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.measure import FringeSet
-from ..core.phase import TWO_PI, phase_shift_patterns
+from ..core.measure import FringeSet, measure
+from ..core.phase import TWO_PI, wrap
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
-from .base import Codec, CodeMap, Orders, along_columns
+from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -64,55 +83,129 @@ class GrayCodeSpec(PeriodSpec):
                                choices=(0, 1))
     inverse: int = field(0, "also project each code pattern's inverse to binarise against",
                          choices=(0, 1))
+    gray_offset: float = field(0.0, "where the code's edges sit, as a fraction of a period "
+                               "after the phase jumps: 0, or 0.5 for the shifted Gray code",
+                               choices=(0.0, 0.5))
+    second_period: float = field(0.0, "period of a second N-step set that checks the code's "
+                                 "orders next to its edges (0: none)")
+
+    @property
+    def levels(self) -> int:
+        """Code levels: the fringes, one more for the shifted code, twice for the
+        complementary one."""
+        if self.complementary:
+            return 2 * self.fringes
+        return self.fringes + (1 if self.gray_offset else 0)
 
     @property
     def code_bits(self) -> int:
-        """Gray code bits for the fringe count (the complementary pattern adds one)."""
-        return max(1, int(np.ceil(np.log2(self.fringes))))
+        """Gray code bits of the fringe count (the complementary pattern adds one)."""
+        return max(1, int(np.ceil(np.log2(self.levels if not self.complementary
+                                          else self.fringes))))
 
     def method_frames(self) -> tuple[str, ...]:
         codes = tuple(f"gray-{i}" for i in range(self.code_bits + self.complementary))
         inverse = tuple(f"{c}-inv" for c in codes) if self.inverse else ()
-        return (*self.shift_frames(), *codes, *inverse)
+        second = tuple(f"second-{n}" for n in self.shift_frames()) if self.second_period else ()
+        return (*self.shift_frames(), *second, *codes, *inverse)
 
     def validate(self) -> None:
         super().validate()
         if self.complementary not in (0, 1) or self.inverse not in (0, 1):
             raise BistairError("complementary and inverse must be 0 or 1")
+        if self.gray_offset not in (0.0, 0.5):
+            raise BistairError(f"gray_offset must be 0 or 0.5, got {self.gray_offset}")
+        if self.gray_offset and self.complementary:
+            raise BistairError("a shifted Gray code (gray_offset 0.5) cannot be complementary")
+        if self.second_period:
+            turn = abs(((self.period / self.second_period) + 0.5) % 1.0 - 0.5)
+            if not (math.isfinite(self.second_period) and self.second_period >= 4):
+                raise BistairError(f"second_period must be at least 4 projector pixels, got "
+                                   f"{self.second_period}")
+            if turn < 0.2:
+                raise BistairError(
+                    f"period / second_period = {self.period / self.second_period:.3f} is too "
+                    "close to a whole number: a period off would not show in the second phase")
 
 
 def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
-    x = np.arange(spec.coded_length)
-    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
+    shifts = shift_patterns(spec)
+    second = shift_patterns(spec, spec.second_period) if spec.second_period else shifts[:0]
     n_bits = spec.code_bits + spec.complementary
-    level = (2 * x) // spec.period if spec.complementary else x // spec.period
+    if spec.complementary:
+        level = fringe_index(spec, spec.period / 2)
+    else:
+        level = np.floor(np.arange(spec.coded_length) / spec.period + spec.gray_offset
+                         + 1e-9).astype(np.int64)
     gray = level ^ (level >> 1)
     bits = (gray[None, :] >> np.arange(n_bits - 1, -1, -1)[:, None]) & 1
     codes = spec.offset + spec.amplitude * (2.0 * bits - 1.0)
     if spec.inverse:
         codes = np.concatenate([codes, 2 * spec.offset - codes])
-    return along_columns(np.concatenate([shifts, codes]), spec)
+    return along_columns(np.concatenate([shifts, second, codes]), spec)
 
 
 def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
     """Stage 2: the fringe order read from the Gray code (three-zone rule when
-    complementary), -1 where the fringes are not valid or the code is out of range."""
+    complementary, half-period rule when shifted, checked by the second phase when there is
+    one), -1 where the fringes are not valid, the pixel is in shadow or the code is out of
+    range.
+
+    ``edges`` is the code as read, whose steps sit at the code's own edges (at wrapped phase
+    ``edge_phase``): the decode checks them against the phase.
+    """
+    n = spec.steps
+    start = n * (2 if spec.second_period else 1)
     n_bits = spec.code_bits + spec.complementary
-    code = prepared.frames[spec.steps:spec.steps + n_bits]
-    ref = prepared.frames[spec.steps + n_bits:] if spec.inverse else fs.avg[None]
+    code = prepared.frames[start:start + n_bits]
+    ref = prepared.frames[start + n_bits:start + 2 * n_bits] if spec.inverse else fs.avg[None]
     gray = np.zeros(fs.phi.shape, np.int32)
     for frame, against in zip(code, np.broadcast_to(ref, code.shape), strict=True):
         gray <<= 1
         gray |= frame > against
+    valid = fs.valid
+    if spec.inverse and fs.threshold is not None:
+        valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
+    maps: dict[str, np.ndarray] = {}
     if spec.complementary:
         k1 = gray_to_binary(gray >> 1)
         k2 = (gray_to_binary(gray) + 1) // 2
         k = np.where(fs.phi < np.pi / 2, k2, np.where(fs.phi >= 1.5 * np.pi, k2 - 1, k1))
+        edges, edge_phase = k1, 0.0
+    elif spec.gray_offset:
+        g = gray_to_binary(gray)
+        k = np.where(fs.phi < np.pi, g, g - 1)
+        edges, edge_phase = g, np.pi
     else:
-        k = gray_to_binary(gray)
-    ok = fs.valid & (k >= 0) & (k < spec.fringes)
-    return CodeMap(np.where(ok, k, -1).astype(np.int32))
+        k = edges = gray_to_binary(gray)
+        edge_phase = 0.0
+    if spec.second_period:
+        second = measure(prepared, n, n, min_modulation, check=False,
+                         shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
+        k, agree = _second_period_check(k, fs.phi, second.phi, spec)
+        valid = valid & second.valid & agree
+        maps["second_phase"] = second.phi
+    ok = valid & (k >= 0) & (k < spec.fringes)
+    maps["edges"] = np.where(valid, edges, -1).astype(np.int32)
+    return CodeMap(np.where(ok, k, -1).astype(np.int32), maps, edge_phase=edge_phase)
+
+
+def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
+                         spec: GrayCodeSpec) -> tuple[np.ndarray, np.ndarray]:
+    """The order (the code's, or its neighbour on the phase's side) that predicts the second
+    phase best, and where that prediction is within half the candidates' separation."""
+    ratio = spec.period / spec.second_period
+    side = np.where(phi < np.pi, 1, -1)
+    best, best_err = k, None
+    errs = []
+    for cand in (k, k + side):
+        pred = (cand + phi / TWO_PI) * (TWO_PI * ratio)
+        errs.append(np.abs(wrap(pred - phi2)))
+    best = np.where(errs[1] < errs[0], k + side, k)
+    best_err = np.minimum(errs[0], errs[1])
+    separation = abs(wrap(np.array(TWO_PI * ratio)))
+    return best, best_err < 0.5 * separation
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec) -> Orders:
@@ -129,7 +222,8 @@ def comparable(width: int, height: int, period: int, steps: int) -> dict:
 CODEC = Codec(
     name="graycode",
     spec_class=GrayCodeSpec,
-    summary="N phase shifts + Gray code (optionally complementary, optionally with inverses)",
+    summary="N phase shifts + Gray code (complementary, shifted, with inverses, or checked "
+            "by a second period)",
     encode_columns=encode_columns,
     code_columns=code_columns,
     order_columns=order_columns,

@@ -31,13 +31,12 @@ import numpy as np
 
 from ..core.captures import Prepared
 from ..core.measure import FringeSet
-from ..core.phase import phase_shift_patterns
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..core.resolve import code_evidence, phase_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
-from .base import Codec, CodeMap, Orders, along_columns
+from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
 
 @lru_cache(maxsize=64)
@@ -104,9 +103,8 @@ class LvSpec(PeriodSpec):
 
 
 def encode_columns(spec: LvSpec) -> np.ndarray:
-    x = np.arange(spec.coded_length)
-    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
-    codes = np.asarray(spec.sequence)[x // spec.period]
+    shifts = shift_patterns(spec)
+    codes = np.asarray(spec.sequence)[fringe_index(spec)]
     pair = stair_pair(stair_level_phase(codes, spec.levels), spec.offset, spec.amplitude)
     return along_columns(np.concatenate([shifts, pair]), spec)
 

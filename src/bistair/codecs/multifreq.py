@@ -39,10 +39,10 @@ import numpy as np
 
 from ..core.captures import Prepared
 from ..core.measure import FringeSet, measure
-from ..core.phase import TWO_PI, order_from_reference, phase_shift_patterns
+from ..core.phase import TWO_PI, order_from_reference
 from ..errors import BistairError
-from ..spec import BaseSpec, field
-from .base import Codec, CodeMap, Orders, along_columns
+from ..spec import BaseSpec, field, format_period
+from .base import Codec, CodeMap, Orders, along_columns, shift_patterns
 
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
@@ -58,22 +58,22 @@ def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class MultiFreqSpec(BaseSpec):
     method = "multifreq"
-    required = ("periods",)
 
-    periods: tuple[int, ...] = field((1080, 180, 30), "fringe periods in projector pixels, "
-                                     "projected in this order")
+    periods: tuple[float, ...] = field((1080, 180, 30), "fringe periods in projector pixels, "
+                                       "projected in this order")
     unwrap: str = field("auto", "hierarchical, heterodyne, or auto (hierarchical when the "
-                        "longest period covers the axis)",
+                        "longest period covers the axis)", shapes=False,
                         choices=("auto", "hierarchical", "heterodyne"))
 
     def __post_init__(self) -> None:
-        if self.unwrap == "auto" and self.periods:
+        if self.unwrap == "auto" and self.periods and self.orientation != "both":
             rule = "hierarchical" if max(self.periods) >= self.coded_length else "heterodyne"
             object.__setattr__(self, "unwrap", rule)
         super().__post_init__()
 
     def method_frames(self) -> tuple[str, ...]:
-        return tuple(f"T{t}-shift-{n}" for t in self.periods for n in range(self.steps))
+        return tuple(f"T{format_period(t)}-shift-{n}" for t in self.periods
+                     for n in range(self.steps))
 
     def validate(self) -> None:
         super().validate()
@@ -97,15 +97,13 @@ class MultiFreqSpec(BaseSpec):
                 )
 
     @property
-    def period(self) -> int:
+    def period(self) -> float:
         """The shortest period, which ``phase`` and ``order`` refer to."""
         return min(self.periods)
 
 
 def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
-    x = np.arange(spec.coded_length)
-    sets = [phase_shift_patterns(x, t, spec.steps, spec.offset, spec.amplitude)
-            for t in spec.periods]
+    sets = [shift_patterns(spec, t) for t in spec.periods]
     return along_columns(np.concatenate(sets), spec)
 
 
@@ -126,7 +124,8 @@ def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
                     min_modulation: float | None = None) -> FringeSet:
     """Stage 1: the N-step set of the shortest period (the phase the result refers to)."""
     i = spec.periods.index(min(spec.periods))
-    return measure(prepared, i * spec.steps, spec.steps, min_modulation)
+    return measure(prepared, i * spec.steps, spec.steps, min_modulation,
+                   shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
 
 
 def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
@@ -139,7 +138,8 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     n = spec.steps
     shortest = float(spec.period)
     sets = {float(t): fs if float(t) == shortest else
-            measure(prepared, i * n, n, min_modulation, check=False)
+            measure(prepared, i * n, n, min_modulation, check=False,
+                    shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
             for i, t in enumerate(spec.periods)}
     valid = np.logical_and.reduce([s.valid for s in sets.values()])
     phase_of = {t: s.phi.astype(np.float64) for t, s in sets.items()}

@@ -39,13 +39,13 @@ import numpy as np
 
 from ..core.captures import Prepared
 from ..core.measure import FringeSet
-from ..core.phase import TWO_PI, phase_shift_patterns, wrapped_phase
+from ..core.phase import TWO_PI, shifts_of, wrapped_phase
 from ..core.regions import core_weight, fringe_regions
 from ..core.resolve import code_evidence, phase_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
-from .base import Codec, CodeMap, Orders, along_columns
+from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -75,13 +75,12 @@ class PhaseCodingSpec(PeriodSpec):
 
 
 def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:
-    x = np.arange(spec.coded_length)
-    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
-    code = stair_level_phase(x // spec.period, spec.levels)
+    shifts = shift_patterns(spec)
+    code = stair_level_phase(fringe_index(spec), spec.levels)
     if spec.form == "pair":
         coded = stair_pair(code, spec.offset, spec.amplitude)
     else:
-        steps = TWO_PI * np.arange(spec.steps)[:, None] / spec.steps
+        steps = shifts_of(spec.steps, spec.shift_sign)[:, None]
         coded = spec.offset + spec.amplitude * np.cos(code[None, :] + steps)
     return along_columns(np.concatenate([shifts, coded]), spec)
 
@@ -93,7 +92,7 @@ def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
     if spec.form == "pair":
         theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     else:
-        theta = wrapped_phase(frames)[0]
+        theta = wrapped_phase(frames, spec.shift_sign)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
     return CodeMap(codes, {"code_phase": theta})
 

@@ -15,6 +15,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +30,8 @@ class Prepared:
     frames: np.ndarray  # (F, H, W) float32 in [0, 1]
     clipped: np.ndarray  # (H, W) bool: some frame at full scale
     full_scale: float  # the input value that maps to 1.0
+    white: np.ndarray | None = None  # (H, W) the fully lit frame, if the capture has one
+    black: np.ndarray | None = None  # (H, W) the dark frame, if the capture has one
 
 
 def full_scale_of(stack: np.ndarray) -> float:
@@ -44,8 +47,39 @@ def full_scale_of(stack: np.ndarray) -> float:
     return 1.0
 
 
-def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
-    """Check a capture stack against a spec's frame count and scale it to float32."""
+def prepare(images: np.ndarray, frame_count: int, method: str,
+            select: Sequence[int] | None = None, white: int | None = None,
+            black: int | None = None) -> Prepared:
+    """Check a capture stack against a spec's frame count and scale it to float32.
+
+    Parameters
+    ----------
+    images : (frames, height, width) stack, any numeric dtype (a 2-D image is one frame).
+    frame_count : the frames the spec describes.
+    method : the method's name, for messages.
+    select : the indices of the frames to decode, in the order to keep (default: all);
+        clipping is judged on these, full scale on these and the white and black frames.
+    white, black : indices of a fully lit and of a dark frame, if the capture has them.
+
+    Returns
+    -------
+    Prepared
+        The selected frames as fractions of full scale, the clipped pixels, and the white
+        and black frames.
+
+    Raises
+    ------
+    BistairError
+        Wrong shape or frame count, too small, not numeric, NaN or infinite values.
+
+    Examples
+    --------
+    >>> stack = np.zeros((3, 8, 8), np.uint8)
+    >>> stack[0] = 255
+    >>> p = prepare(stack, 3, "demo", select=[2, 1], white=0)
+    >>> p.frames.shape, float(p.white.max()), bool(p.clipped.any())
+    ((2, 8, 8), 1.0, False)
+    """
     stack = np.asarray(images)
     if stack.ndim == 2:
         stack = stack[None]
@@ -61,15 +95,23 @@ def prepare(images: np.ndarray, frame_count: int, method: str) -> Prepared:
         raise BistairError(f"captures of {stack.shape[2]}x{stack.shape[1]} pixels are too small")
     if not (np.issubdtype(stack.dtype, np.number) and not np.iscomplexobj(stack)):
         raise BistairError(f"captures must be numeric images, got dtype {stack.dtype}")
-    scale = full_scale_of(stack)
+    if select is None or list(select) == list(range(len(select))):
+        used = stack[:frame_count if select is None else len(select)]
+    else:
+        used = stack[list(select)]
+    lit = [stack[i][None] for i in (white, black) if i is not None]
+    scale = max(full_scale_of(a) for a in (used, *lit))
     if np.issubdtype(stack.dtype, np.integer):
-        clipped = (stack >= scale).any(axis=0)
+        clipped = (used >= scale).any(axis=0)
     else:
         if not np.isfinite(stack).all():
             raise BistairError("captures contain NaN or infinite values")
-        clipped = (stack >= scale * (1.0 - 1e-6)).any(axis=0)
-    frames = np.multiply(stack, np.float32(1.0 / scale), dtype=np.float32)
-    return Prepared(frames, clipped, scale)
+        clipped = (used >= scale * (1.0 - 1e-6)).any(axis=0)
+    factor = np.float32(1.0 / scale)
+    frames = np.multiply(used, factor, dtype=np.float32)
+    extra = [None if i is None else np.multiply(stack[i], factor, dtype=np.float32)
+             for i in (white, black)]
+    return Prepared(frames, clipped, scale, *extra)
 
 
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
@@ -79,14 +121,19 @@ def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndar
     return clipped & (avg + mod > 1.02)
 
 
-def validity(mod: np.ndarray, saturated: np.ndarray, noise: float,
-             min_modulation: float | None = None) -> np.ndarray:
-    """Pixels with enough modulation and no saturation.
+def modulation_threshold(noise: float, min_modulation: float | None = None) -> float:
+    """The modulation a valid pixel needs (fraction of full scale): ``min_modulation`` if
+    given, else ``max(0.01, 4 * noise)`` (pure noise exceeds four sigma in about one pixel
+    in ten million).
 
-    ``min_modulation`` (fraction of full scale) defaults to ``max(0.01, 4 * noise)``: pure
-    noise exceeds four sigma in about one pixel in ten million.
+    >>> modulation_threshold(0.005), modulation_threshold(0.001), modulation_threshold(0.0, 0.2)
+    (0.02, 0.01, 0.2)
     """
-    threshold = max(0.01, 4.0 * noise) if min_modulation is None else min_modulation
+    return max(0.01, 4.0 * noise) if min_modulation is None else min_modulation
+
+
+def validity(mod: np.ndarray, saturated: np.ndarray, threshold: float) -> np.ndarray:
+    """Pixels with at least ``threshold`` modulation and no saturation."""
     return (mod >= threshold) & ~saturated
 
 

@@ -22,7 +22,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
-from .captures import Prepared, check_decodable, saturation, validity
+from .captures import (
+    Prepared,
+    check_decodable,
+    modulation_threshold,
+    saturation,
+    validity,
+)
 from .phase import residuals, wrapped_phase
 
 
@@ -36,6 +42,7 @@ class FringeSet:
     valid: np.ndarray  # enough modulation, not saturated
     noise: float  # camera noise sigma estimated from the fit residual
     steps: int | None = None  # N
+    threshold: float | None = None  # the modulation a valid pixel needs
 
     @property
     def phase_noise(self) -> np.ndarray:
@@ -47,20 +54,27 @@ class FringeSet:
         """The same set with image axes swapped (for the rows orientation)."""
         return FringeSet(*(np.ascontiguousarray(a.T) for a in (self.phi, self.avg, self.mod,
                                                                  self.valid)),
-                         self.noise, self.steps)
+                         self.noise, self.steps, self.threshold)
 
 
-def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> float:
-    """Camera noise sigma (fraction of full scale) from an N-step set's fit residual.
+def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
+                shift_sign: int = 1, phase_offset: float = 0.0) -> float:
+    """Camera noise sigma (fraction of full scale) of an N-step set.
 
-    The residual also holds the projector's harmonics (an uncompensated gamma), but those
-    change slowly along a fringe while noise does not: the residuals of vertically adjacent
-    pixels are differenced, and the median of their squared norm is scaled by the chi-square
-    median of N - 3 degrees of freedom. Pixels that a frame clips are left out. Zero for N = 3.
+    N >= 4: from the fit residual. The residual also holds the projector's harmonics (an
+    uncompensated gamma), but those change slowly along a fringe while noise does not: the
+    residuals of vertically adjacent pixels are differenced, and the median of their
+    squared norm is scaled by the chi-square median of N - 3 degrees of freedom.
+
+    N = 3 leaves no residual (three unknowns, three frames): the frames' second differences
+    along the fringes (down the columns of the column layout, where the pattern does not
+    change) are used instead, ``sigma = median|d2| / (0.6745 * sqrt(6))``.
+
+    Pixels that a frame clips (or that read exactly 0) are left out.
     """
     steps = frames.shape[0]
     if steps <= 3:
-        return 0.0
+        return _along_fringe_noise(frames)
     top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
     low = (slice(None), slice(1, None, 4), slice(None, None, 4))
     n_rows = min(frames[top].shape[1], frames[low].shape[1])
@@ -68,7 +82,8 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
     for sub in (top, low):
         f = frames[sub][:, :n_rows]
         p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
-        pair.append((residuals(f, p, a, m), (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
+        pair.append((residuals(f, p, a, m, shift_sign, phase_offset),
+                     (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
     (r0, ok0), (r1, ok1) = pair
     energy = ((r1 - r0) ** 2).sum(axis=0)
     ok = ok0 & ok1
@@ -77,16 +92,36 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
     return float(np.sqrt(np.median(sample) / (2.0 * stats.chi2.ppf(0.5, dof))))
 
 
+def _along_fringe_noise(frames: np.ndarray) -> float:
+    """Noise sigma from second differences down the columns (along the fringes)."""
+    f = frames[:, :, ::4]  # every fourth column: plenty for a median
+    d2 = f[:, :-2] - 2.0 * f[:, 1:-1] + f[:, 2:]
+    lo, hi = f.min(axis=0), f.max(axis=0)
+    ok = ((lo[:-2] > 0) & (lo[1:-1] > 0) & (lo[2:] > 0)
+          & (hi[:-2] < 1) & (hi[1:-1] < 1) & (hi[2:] < 1))
+    sample = np.abs(d2[:, ok]) if ok.sum() >= 100 else np.abs(d2).reshape(len(f), -1)
+    if sample.size == 0:
+        return 0.0
+    return float(np.median(sample) / (0.6745 * np.sqrt(6.0)))
+
+
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,
-            check: bool = True) -> FringeSet:
+            check: bool = True, shift_sign: int = 1, phase_offset: float = 0.0) -> FringeSet:
     """Measure frames ``start .. start+steps-1`` of a prepared stack as an N-step set.
 
+    ``shift_sign`` and ``phase_offset`` are the rig's phase convention
+    (:func:`~bistair.core.phase.wrapped_phase`). Valid pixels have enough modulation
+    (:func:`~bistair.core.captures.validity`), are not saturated and, when the capture has
+    white and black frames, enough contrast between them (twice the modulation threshold).
     With ``check``, captures with (almost) no valid pixel are refused as dark or saturated.
     """
     frames = prepared.frames[start:start + steps]
-    phi, avg, mod = wrapped_phase(frames)
-    noise = noise_level(frames, phi, avg, mod)
-    valid = validity(mod, saturation(prepared.clipped, avg, mod), noise, min_modulation)
+    phi, avg, mod = wrapped_phase(frames, shift_sign, phase_offset)
+    noise = noise_level(frames, phi, avg, mod, shift_sign, phase_offset)
+    threshold = modulation_threshold(noise, min_modulation)
+    valid = validity(mod, saturation(prepared.clipped, avg, mod), threshold)
+    if prepared.white is not None and prepared.black is not None:
+        valid &= (prepared.white - prepared.black) >= 2.0 * threshold
     if check:
         check_decodable(valid, prepared.clipped)
-    return FringeSet(phi, avg, mod, valid, noise, steps)
+    return FringeSet(phi, avg, mod, valid, noise, steps, threshold)

@@ -1,7 +1,10 @@
 """N-step phase shifting: the patterns and the wrapped phase, average and modulation.
 
-Convention: frame ``n`` of an ``N``-step set shows ``a + b*cos(2*pi*x/T + 2*pi*n/N)``; the
-camera sees ``A + B*cos(phi + 2*pi*n/N)`` and the wrapped phase ``phi`` lies in ``[0, 2*pi)``.
+Convention: frame ``n`` of an ``N``-step set shows
+``a + b*cos(2*pi*x/T + phase_offset + shift_sign*2*pi*n/N)`` (``phase_offset = 0`` and
+``shift_sign = +1`` unless a rig says otherwise); the camera sees
+``A + B*cos(phi + phase_offset + shift_sign*2*pi*n/N)`` and the wrapped phase
+``phi = 2*pi*x/T mod 2*pi`` lies in ``[0, 2*pi)``.
 
 Examples
 --------
@@ -22,27 +25,41 @@ import numpy as np
 TWO_PI = 2.0 * np.pi
 
 
+def shifts_of(steps: int, shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
+    """The phase added to frame ``n``: ``phase_offset + shift_sign*2*pi*n/steps`` (float64).
+
+    >>> shifts_of(4, -1).round(4).tolist()
+    [0.0, -1.5708, -3.1416, -4.7124]
+    """
+    return phase_offset + shift_sign * TWO_PI * np.arange(steps) / steps
+
+
 def phase_shift_patterns(
-    x: np.ndarray, period: float, steps: int, offset: float = 0.5, amplitude: float = 0.5
+    x: np.ndarray, period: float, steps: int, offset: float = 0.5, amplitude: float = 0.5,
+    phase_offset: float = 0.0, shift_sign: int = 1,
 ) -> np.ndarray:
-    """Intensities ``offset + amplitude*cos(2*pi*x/period + 2*pi*n/steps)``, n = 0..steps-1.
+    """Intensities ``offset + amplitude*cos(2*pi*x/period + phase_offset +
+    shift_sign*2*pi*n/steps)``, n = 0..steps-1.
 
     Returns an array of shape ``(steps, *x.shape)``.
     """
-    shifts = TWO_PI * np.arange(steps) / steps
+    shifts = shifts_of(steps, shift_sign, phase_offset)
     shifts = shifts.reshape((steps,) + (1,) * np.ndim(x))
     return offset + amplitude * np.cos(TWO_PI * np.asarray(x, dtype=np.float64) / period + shifts)
 
 
-def wrapped_phase(frames: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def wrapped_phase(frames: np.ndarray, shift_sign: int = 1, phase_offset: float = 0.0
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Wrapped phase in ``[0, 2*pi)``, average ``A`` and modulation ``B`` of an N-step stack.
 
     Least-squares N-step estimate (Eq. 9-11 of the paper for N = 4, general N here):
-    ``phi = atan2(-sum I_n sin d_n, sum I_n cos d_n)`` with ``d_n = 2*pi*n/N``.
+    ``phi = atan2(-sum I_n sin d_n, sum I_n cos d_n) - phase_offset`` with
+    ``d_n = shift_sign*2*pi*n/N``.
 
     Parameters
     ----------
     frames : (N, H, W) array, any dtype.
+    shift_sign, phase_offset : the rig's phase convention (see the module docstring).
 
     Returns
     -------
@@ -52,10 +69,12 @@ def wrapped_phase(frames: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     steps = stack.shape[0]
     if steps < 3:
         raise ValueError("N-step phase shifting needs at least 3 frames")
-    shifts = TWO_PI * np.arange(steps) / steps
+    shifts = shifts_of(steps, shift_sign)
     num = -np.tensordot(np.sin(shifts).astype(np.float32), stack, axes=1)
     den = np.tensordot(np.cos(shifts).astype(np.float32), stack, axes=1)
     phi = np.arctan2(num, den)
+    if phase_offset:
+        phi = (phi - np.float32(phase_offset)) % np.float32(TWO_PI)
     phi = np.where(phi < 0, phi + np.float32(TWO_PI), phi)
     phi[phi >= np.float32(TWO_PI)] = 0.0  # float32 rounding of tiny negatives
     mod = np.hypot(num, den) * np.float32(2.0 / steps)
@@ -63,21 +82,21 @@ def wrapped_phase(frames: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return phi.astype(np.float32), avg.astype(np.float32), mod.astype(np.float32)
 
 
-def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
-              mod: np.ndarray) -> np.ndarray:
+def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
+              shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
     """The N-step stack minus its fitted sinusoid, shape (N, ...)."""
     stack = np.asarray(frames, dtype=np.float32)
     steps = stack.shape[0]
-    shifts = (TWO_PI * np.arange(steps) / steps).astype(np.float32)
+    shifts = shifts_of(steps, shift_sign, phase_offset).astype(np.float32)
     shifts = shifts.reshape((steps,) + (1,) * (stack.ndim - 1))
     return stack - (avg[None] + mod[None] * np.cos(phi[None] + shifts))
 
 
-def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray,
-                   mod: np.ndarray) -> np.ndarray:
+def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
+                   shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
     """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy)."""
     dof = max(np.shape(frames)[0] - 3, 1)
-    res = residuals(frames, phi, avg, mod)
+    res = residuals(frames, phi, avg, mod, shift_sign, phase_offset)
     return np.sqrt((res**2).sum(axis=0) / dof).astype(np.float32)
 
 

@@ -68,17 +68,70 @@ class DecodeResult:
                             texture=self.texture)
 
 
+@dataclass
+class AxesResult:
+    """A decode of both projector axes: ``x`` (the columns, ``coord_x``) and ``y`` (the
+    rows, ``coord_y``), each a :class:`DecodeResult`."""
+
+    x: DecodeResult
+    y: DecodeResult
+
+    @property
+    def mask(self) -> np.ndarray:
+        """Pixels valid on both axes."""
+        return self.x.mask & self.y.mask
+
+    @property
+    def coord_x(self) -> np.ndarray:
+        """Projector column per camera pixel (NaN where that axis is invalid)."""
+        return self.x.coord
+
+    @property
+    def coord_y(self) -> np.ndarray:
+        """Projector row per camera pixel (NaN where that axis is invalid)."""
+        return self.y.coord
+
+    @property
+    def method(self) -> str:
+        return self.x.method
+
+    @property
+    def texture(self) -> np.ndarray | None:
+        return self.x.texture
+
+    @property
+    def info(self) -> dict[str, Any]:
+        """Each axis's figures, under ``"x"`` and ``"y"``."""
+        return {"x": self.x.info, "y": self.y.info}
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """The arrays written as ``NAME.npy``: each axis's with a suffix (``coord_x``,
+        ``phase_y``, ...) and ``mask`` where both are valid."""
+        out = {f"{name}_{tag}": arr for tag, res in (("x", self.x), ("y", self.y))
+               for name, arr in res.arrays().items()}
+        out["mask"] = self.mask
+        return out
+
+
 def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
                 modulation: np.ndarray, average: np.ndarray | None = None,
                 code: np.ndarray | None = None, wrapped: np.ndarray | None = None,
-                info: dict[str, Any] | None = None) -> DecodeResult:
+                info: dict[str, Any] | None = None, length: float | None = None
+                ) -> DecodeResult:
     """Assemble a result from the wrapped phase and the fringe order (``< 0`` = invalid).
 
-    ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly.
+    ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly. With
+    ``length`` (projector pixels along the coded axis), coordinates outside ``[0, length)``
+    are invalid: they cannot come from the projector.
     """
     phi = np.asarray(phi, dtype=np.float32)
     out_order = np.asarray(order).astype(np.int32)
     mask = (out_order >= 0) & np.isfinite(phi)
+    if length is not None:
+        top = np.floor(np.float32(length) / np.float32(period)).astype(np.int32)
+        # the coordinate (order + phi/2pi) * period must stay below length
+        mask &= (out_order < top) | ((out_order == top) & (
+            phi * np.float32(period / TWO_PI) < np.float32(length - top * period)))
     out_order[~mask] = -1
     phase = phi + np.float32(TWO_PI) * out_order.astype(np.float32)
     phase[~mask] = np.nan
@@ -95,11 +148,12 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
 
 
 def result_from_phase(method: str, fs: FringeSet, abs_phase: np.ndarray, period: float,
-                      code: np.ndarray | None = None, info: dict[str, Any] | None = None
-                      ) -> DecodeResult:
-    """A result from a measured fringe set and its absolute phase (NaN = invalid)."""
+                      code: np.ndarray | None = None, info: dict[str, Any] | None = None,
+                      length: float | None = None) -> DecodeResult:
+    """A result from a measured fringe set and its absolute phase (NaN = invalid); with
+    ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`)."""
     order = order_from_reference(fs.phi, abs_phase)
     order[~np.isfinite(order)] = -1
     return make_result(method, fs.phi, order, period, fs.mod, fs.avg,
                        code=code, wrapped=np.where(fs.valid, fs.phi, np.float32(np.nan)),
-                       info=info)
+                       info=info, length=length)

@@ -45,13 +45,13 @@ import numpy as np
 
 from ...core.captures import Prepared
 from ...core.measure import FringeSet
-from ...core.phase import TWO_PI, phase_shift_patterns
+from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import phase_from_regions
 from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
 from ...spec import PeriodSpec, field
-from ..base import Codec, CodeMap, Orders
+from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
 from .bands import (
     BandLayout,
     band_splits,
@@ -115,8 +115,8 @@ def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
     """The N phase-shift patterns and the bidirectional pair, vertical fringes."""
     x = np.arange(spec.coded_length)
     y = np.arange(spec.other_length)
-    k = x // spec.period
-    shifts = phase_shift_patterns(x, spec.period, spec.steps, spec.offset, spec.amplitude)
+    k = fringe_index(spec)
+    shifts = shift_patterns(spec)
     local = stair_level_phase(k % spec.stairs, spec.stairs)
     partition = stair_level_phase(k // spec.stairs, spec.partitions)
     is_local = (y % spec.group_rows) < spec.local_rows
