@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 
 from ..core.captures import Prepared, prepare
+from ..core.checks import EdgeCheck, convention_problem, edge_alignment
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
 from ..core.result import AxesResult, DecodeResult, result_from_phase
@@ -58,11 +59,16 @@ class CodeMap:
         if present, is the code as read from its own patterns (else ``code`` is), whose
         steps sit where the wrapped phase is ``edge_phase`` (0: at the phase jumps).
     edge_phase : the wrapped phase at the code's edges.
+    cycle : the code repeats every ``cycle`` values (a stair), or ``None``.
+    check : a codec's own check of the phase convention, where its code says nothing of
+        it (multi-frequency: the code comes from the phases themselves).
     """
 
     code: np.ndarray
     maps: dict[str, np.ndarray] = field(default_factory=dict)
     edge_phase: float = 0.0
+    cycle: int | None = None  # the code repeats every ``cycle`` values (a stair)
+    check: EdgeCheck | None = None  # a codec's own check of the phase convention
 
     @property
     def edges(self) -> np.ndarray:
@@ -73,7 +79,7 @@ class CodeMap:
         """The same maps with image axes swapped (for the rows orientation)."""
         return CodeMap(np.ascontiguousarray(self.code.T),
                        {k: np.ascontiguousarray(v.T) for k, v in self.maps.items()},
-                       self.edge_phase)
+                       self.edge_phase, self.cycle, self.check)
 
 
 @dataclass
@@ -195,7 +201,10 @@ class Codec:
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
         code = self.code_columns(cols, spec, fs, min_modulation)
+        warnings = check_convention(fs, code, spec)
         orders = self.order_columns(fs, code, spec, **options)
+        if warnings:
+            orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         result = result_from_phase(self.name, fs, orders.abs_phase, spec.period,
                                    code=code.code, info=orders.info, length=spec.coded_length)
         result.info.setdefault("full_scale", prepared.full_scale)
@@ -203,6 +212,20 @@ class Codec:
             result = result.transposed()
         result.texture = prepared.white
         return result
+
+
+def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
+    """Refuse captures whose code steps do not sit where the spec's phase convention puts
+    them (:mod:`bistair.core.checks`); returns the warnings worth a line."""
+    check = code.check or edge_alignment(fs.phi, code.edges, fs.valid, code.edge_phase,
+                                         code.cycle)
+    problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase)
+    if problem is None:
+        return []
+    kind, message = problem
+    if kind == "refuse":
+        raise BistairError(f"the captures do not fit the spec: {message}")
+    return [message]
 
 
 def fringe_index(spec: BaseSpec, period: float | None = None) -> np.ndarray:

@@ -179,7 +179,7 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
-    return CodeMap(codes, {"code_phase": theta})
+    return CodeMap(codes, {"code_phase": theta}, cycle=spec.levels)
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:

@@ -108,16 +108,36 @@ def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
 
 
 class _Unwrapper:
-    """Unwraps a phase from a coarser absolute one, keeping the worst residual per pixel."""
+    """Unwraps a phase from a coarser absolute one, keeping the worst residual per pixel
+    and the signed residual (in fringes) of the last step."""
 
     def __init__(self) -> None:
         self.worst: np.ndarray | float = 0.0
+        self.last: np.ndarray | float = 0.0
 
     def __call__(self, phi: np.ndarray, coarse: np.ndarray, ratio: float) -> np.ndarray:
         ref = coarse * ratio
         k = order_from_reference(phi, ref)
-        self.worst = np.maximum(self.worst, np.abs((ref - phi) / TWO_PI - k))
+        self.last = (ref - phi) / TWO_PI - k
+        self.worst = np.maximum(self.worst, np.abs(self.last))
         return phi + TWO_PI * k
+
+
+def top_phase(phi: np.ndarray, period: float, length: int) -> np.ndarray:
+    """The absolute phase of the coarsest period (or beat), which covers the coded axis.
+
+    Coordinates between the axis's end and the period's are impossible; the upper half of
+    them are pixels at the start of the axis whose phase noise crossed the wrap, so they are
+    moved one period down (to small negative coordinates, which the finer periods bring
+    back): without this, a pixel at column 1 of a 1920-px projector decoded with beats of
+    5040 px lands at 5041.
+
+    >>> top_phase(np.array([0.1, 6.28]), 5040.0, 1920).round(3).tolist()
+    [0.1, -0.003]
+    """
+    x = phi * (period / TWO_PI)
+    fold = x >= 0.5 * (length + period)
+    return np.where(fold, phi - TWO_PI, phi)
 
 
 def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
@@ -146,7 +166,7 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     unwrap = _Unwrapper()
     if spec.unwrap == "hierarchical":
         chain = sorted(phase_of, reverse=True)
-        absolute = {chain[0]: phase_of[chain[0]]}
+        absolute = {chain[0]: top_phase(phase_of[chain[0]], chain[0], spec.coded_length)}
         for coarse, fine in zip(chain[:-1], chain[1:], strict=True):
             absolute[fine] = unwrap(phase_of[fine], absolute[coarse], coarse / fine)
     else:
@@ -155,7 +175,8 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
             for i, t in enumerate(levels[lvl]):
                 a, b = levels[lvl - 1][i], levels[lvl - 1][i + 1]
                 phase_of[t] = (phase_of[a] - phase_of[b]) % TWO_PI
-        absolute = {levels[-1][0]: phase_of[levels[-1][0]]}
+        top = levels[-1][0]
+        absolute = {top: top_phase(phase_of[top], top, spec.coded_length)}
         for lvl in range(len(levels) - 2, -1, -1):
             above = levels[lvl + 1]
             for i, t in enumerate(levels[lvl]):
@@ -163,19 +184,42 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
                 absolute[t] = unwrap(phase_of[t], absolute[parent], parent / t)
     order = order_from_reference(fs.phi, absolute[shortest])
     code = np.where(valid & np.isfinite(order), order, -1).astype(np.int32)
-    return CodeMap(code, {"worst": np.broadcast_to(unwrap.worst, valid.shape), "valid": valid})
+    return CodeMap(code, {"worst": np.broadcast_to(unwrap.worst, valid.shape), "valid": valid,
+                          "residual": np.broadcast_to(unwrap.last, valid.shape)})
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
-    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe."""
+    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe.
+
+    Captures where the periods agree on under half of the well-modulated pixels do not fit
+    the spec (periods, frame order or phase convention) and are refused; a coordinate that
+    falls along the image axis is worth a warning (the projector is mirrored, or the shifts
+    run the other way: the captures alone cannot tell).
+    """
     valid = code.maps["valid"]
     agree = code.maps["worst"] < 0.25
     lit = valid.sum()
+    share = float((agree & valid).sum() / max(lit, 1))
     info = {"unwrap": spec.unwrap, "noise": fs.noise,
-            "valid_modulation": int(lit),
-            "period_agreement": float((agree & valid).sum() / max(lit, 1))}
+            "valid_modulation": int(lit), "period_agreement": share}
+    if lit >= 500 and share < 0.5:
+        residual = code.maps["residual"][valid]
+        turn = float(np.angle(np.exp(-2j * np.pi * residual).mean()))
+        hint = ""
+        if spec.unwrap == "heterodyne" and abs(turn) > 0.5:
+            hint = f"; the shortest period is {turn:+.2f} rad off its beats: phase_offset " \
+                   f"{(spec.phase_offset + turn + np.pi) % TWO_PI - np.pi:.3f}?"
+        raise BistairError(
+            f"the captures do not fit the spec: the periods agree on {100 * share:.0f}% of "
+            f"the modulated pixels (check the periods, the frame order, phase_offset and "
+            f"shift_sign{hint})")
     ok = valid & agree & (code.code >= 0)
     abs_phase = np.where(ok, fs.phi + TWO_PI * code.code, np.nan)
+    slope = np.nanmedian(np.diff(abs_phase[::4], axis=1)) if ok.sum() > 100 else 0.0
+    if slope < 0:
+        info["warnings"] = ["the projector coordinate falls along the image's coded axis: "
+                            "if the projector is not mirrored, is shift_sign "
+                            f"{-spec.shift_sign:+d}?"]
     return Orders(abs_phase, info)
 
 

@@ -133,7 +133,7 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
     ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
-    return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod})
+    return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod}, cycle=spec.stairs)
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
