@@ -94,27 +94,45 @@ for _codec in REGISTRY.values():
 
 
 @cli.command()
-@click.argument("captures", type=click.Path(path_type=Path))
+@click.argument("captures", nargs=-1, required=True)
 @click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
-              help="spec.json of the pattern set [default: CAPTURES/spec.json]")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder")
+              help="spec.json of the pattern set [default: spec.json in the captures' folder]")
+@click.option("--out", "-o", required=True, help="output folder")
 @click.option("--strategy", default=None, help="fringe-order strategy (bidirectional: "
               "region [default] or paper)")
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale [default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
 @reports_errors
-def decode(captures: Path, spec_path: Path | None, out: Path, strategy: str | None,
+def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
            min_modulation: float | None, no_previews: bool) -> None:
-    """Decode captured images into absolute phase, projector coordinate and fringe order."""
+    """Decode captured images into absolute phase, projector coordinate and fringe order.
+
+    CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
+    order; a folder's or pattern's images in natural name order; or one .npy stack.
+    """
     from .jobs import decode_folder
 
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
-    result = decode_folder(captures, out, spec_path, previews=not no_previews, **options)
-    click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
-               f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}")
+    result = decode_folder(list(captures), out, spec_path, previews=not no_previews, **options)
+    _warn(result)
+    if hasattr(result, "x"):
+        click.echo(f"decoded {result.method} on both axes: {int(result.mask.sum())} of "
+                   f"{result.mask.size} pixels valid on both ({100 * result.mask.mean():.1f}%; "
+                   f"x {100 * result.x.mask.mean():.1f}%, y {100 * result.y.mask.mean():.1f}%); "
+                   f"wrote {out}")
+    else:
+        click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
+                   f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}")
+
+
+def _warn(result: Any) -> None:
+    """Print a decode's warnings on stderr, one line each."""
+    infos = [result.info] if not hasattr(result, "x") else [result.x.info, result.y.info]
+    for info in infos:
+        for message in info.get("warnings", []):
+            click.echo(f"Warning: {message}", err=True)
 
 
 def _size(ctx: click.Context, param: click.Parameter, value: str | None) -> Any:
@@ -245,6 +263,10 @@ def main() -> None:
     except click.exceptions.Abort:
         click.echo("Aborted.", err=True)
         sys.exit(1)
+    except click.UsageError as exc:  # one line, like every other refusal
+        where = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
+        click.echo(f"Error: {exc.format_message()}{where}", err=True)
+        sys.exit(2)
     except click.ClickException as exc:
         exc.show()
         sys.exit(exc.exit_code)

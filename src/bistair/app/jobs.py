@@ -24,7 +24,7 @@ import numpy as np
 
 from ..codecs import decode, encode
 from ..core.captures import to_bit_depth
-from ..core.result import DecodeResult
+from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.board import Board
 from ..geometry.calibrate import PoseCapture, calibrate_poses
@@ -32,6 +32,8 @@ from ..geometry.calibration import Calibration, load_calibration, save_calibrati
 from ..geometry.height import HeightModel
 from ..geometry.triangulate import Reconstruction, check_fit, reconstruct
 from ..io.files import (
+    Captures,
+    check_output,
     load_spec,
     natural_key,
     output_folder,
@@ -55,16 +57,33 @@ def save_patterns(spec: BaseSpec, out: str | Path) -> Path:
     return Path(out)
 
 
-def decode_folder(captures: str | Path, out: str | Path, spec: BaseSpec | str | Path | None = None,
-                  previews: bool = True, **options: Any) -> DecodeResult:
-    """Decode a capture folder (or ``.npy`` stack) and write the result arrays into ``out``.
+def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Path | None = None,
+                  previews: bool = True, **options: Any) -> DecodeResult | AxesResult:
+    """Decode captures (folders, files, glob patterns or a ``.npy`` stack; see
+    :func:`~bistair.io.files.capture_files`) and write the result into the folder ``out``.
 
-    ``spec`` defaults to ``CAPTURES/spec.json``.
+    ``spec`` defaults to ``spec.json`` in the captures' folder. A decode with no valid pixel
+    is refused.
     """
+    check_output(out, captures)
     stack, spec = read_with_spec(captures, spec)
-    result = decode(stack, spec, **options)
+    result = require_valid(decode(stack, spec, **options))
     with output_folder(out) as tmp:
         write_result(result, tmp, previews=previews)
+    return result
+
+
+def require_valid(result: DecodeResult | AxesResult) -> DecodeResult | AxesResult:
+    """Refuse a decode that has no valid pixel (an answer of nothing is not an answer)."""
+    for tag, res in ((("", result),) if isinstance(result, DecodeResult)
+                     else (("x: ", result.x), ("y: ", result.y))):
+        if res.mask.any():
+            continue
+        outside = res.info.get("outside_projector", 0)
+        why = (f"{outside} pixels decode outside the projector" if outside
+               else f"{res.info.get('valid_modulation', 0)} pixels have fringes")
+        raise BistairError(f"{tag}no pixel decoded ({why}): does the spec fit the captures "
+                           "(method, periods, frame order, phase_offset, shift_sign)?")
     return result
 
 

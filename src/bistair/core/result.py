@@ -127,11 +127,14 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
     phi = np.asarray(phi, dtype=np.float32)
     out_order = np.asarray(order).astype(np.int32)
     mask = (out_order >= 0) & np.isfinite(phi)
+    outside = 0
     if length is not None:
         top = np.floor(np.float32(length) / np.float32(period)).astype(np.int32)
         # the coordinate (order + phi/2pi) * period must stay below length
-        mask &= (out_order < top) | ((out_order == top) & (
+        inside = (out_order < top) | ((out_order == top) & (
             phi * np.float32(period / TWO_PI) < np.float32(length - top * period)))
+        outside = int((mask & ~inside).sum())
+        mask &= inside
     out_order[~mask] = -1
     phase = phi + np.float32(TWO_PI) * out_order.astype(np.float32)
     phase[~mask] = np.nan
@@ -143,7 +146,8 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
         modulation=np.asarray(modulation, np.float32),
         average=(np.zeros_like(phase) if average is None else average).astype(np.float32),
         mask=mask, code=(np.full(phase.shape, -1, np.int32) if code is None else code),
-        period=float(period), method=method, info=dict(info or {}),
+        period=float(period), method=method,
+        info={**(info or {}), **({"outside_projector": outside} if outside else {})},
     )
 
 

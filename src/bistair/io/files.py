@@ -1,10 +1,13 @@
 """Reading captures and specs, and writing outputs without leaving half-written results
 behind.
 
-Captures are a folder of PNG/TIFF/BMP images taken in name order (numbers inside names are
-compared as numbers), 8 or 16 bit, grey or colour (converted to grey), or one ``.npy`` stack.
-Outputs go to a temporary folder beside the destination and are moved in only when every
-file is written.
+Captures are given as folders, image files or quoted glob patterns (``'scan/pat*.png'``),
+in the order given; a folder's or a pattern's images are taken in natural name order
+(``2.bmp`` before ``10.bmp``), skipping files that are not PNG, TIFF or BMP images and hidden
+files (such as macOS's ``._00.png``). Images are 8 or 16 bit, grey or colour (converted to
+grey). One ``.npy`` stack of shape (frames, height, width) is an alternative. Frames the
+spec marks ``ignore`` are not read. Outputs go to a temporary folder beside the destination
+and are moved in only when every file is written.
 
 Examples
 --------
@@ -15,11 +18,12 @@ Examples
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import re
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -39,23 +43,41 @@ def natural_key(name: str) -> list:
     return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", name)]
 
 
+def _is_image(path: Path) -> bool:
+    return (path.suffix.lower() in IMAGE_SUFFIXES and not path.name.startswith(".")
+            and path.is_file())
+
+
 def list_images(folder: Path) -> list[Path]:
-    files = [p for p in folder.iterdir() if p.is_file() and p.suffix.lower() in IMAGE_SUFFIXES]
-    return sorted(files, key=lambda p: natural_key(p.name))
+    """The images in a folder, in natural name order (hidden files left out)."""
+    return sorted((p for p in folder.iterdir() if _is_image(p)),
+                  key=lambda p: natural_key(p.name))
 
 
 def read_image(path: str | Path) -> np.ndarray:
-    """One image as a 2-D array in its own dtype (colour converted to grey)."""
+    """One image as a 2-D array in its own dtype (colour converted to grey).
+
+    Raises
+    ------
+    BistairError
+        A missing, empty or unreadable file, or one that is not a 2-D grey or colour image.
+    """
     path = Path(path)
     try:
+        if path.stat().st_size == 0:
+            raise BistairError(f"image {path} is empty (0 bytes)")
         if path.suffix.lower() in (".tif", ".tiff"):
             img = tifffile.imread(path)
         else:
             img = iio.imread(path, plugin="pillow")
     except FileNotFoundError:
         raise BistairError(f"image {path} not found") from None
+    except BistairError:
+        raise
     except Exception as exc:  # the imaging libraries raise many kinds for bad files
         reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        if "can not handle" in reason or "cannot identify" in reason:
+            reason = "not a readable image (corrupt or of another format)"
         raise BistairError(f"cannot read image {path}: {reason}") from None
     img = np.asarray(img)
     if img.ndim == 3 and img.shape[-1] in (3, 4):
@@ -67,24 +89,82 @@ def read_image(path: str | Path) -> np.ndarray:
     return img
 
 
-def read_captures(path: str | Path) -> np.ndarray:
-    """A capture stack (frames, height, width) from a folder of images or a ``.npy`` file."""
-    path = Path(path)
-    if not path.exists():
-        raise BistairError(f"captures {path} not found")
-    if path.is_file():
-        if path.suffix.lower() != ".npy":
-            raise BistairError(f"captures {path} must be a folder of images or a .npy stack")
+Captures = str | Path | Sequence[str | Path]
+
+
+def capture_files(captures: Captures) -> list[Path]:
+    """The files of a capture set: folders, image files and glob patterns expanded in order
+    (see the module docstring), or a single ``.npy`` stack.
+
+    Raises
+    ------
+    BistairError
+        Nothing given, a path that does not exist, a folder or pattern without images, a
+        file that is neither an image nor a ``.npy`` stack, or a ``.npy`` stack with others.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     for name in ("10.png", "2.png", "notes.txt", "._2.png"):
+    ...         (pathlib.Path(tmp) / name).write_bytes(b"x")
+    ...     [p.name for p in capture_files(pathlib.Path(tmp) / "*")]
+    ['2.png', '10.png']
+    """
+    items = [captures] if isinstance(captures, str | Path) else list(captures)
+    if not items:
+        raise BistairError("no captures given")
+    files: list[Path] = []
+    for item in items:
+        text = str(item)
+        if any(c in text for c in "*?["):
+            found = [Path(m) for m in glob.glob(text)]
+            images = sorted((p for p in found if _is_image(p)), key=lambda p: natural_key(str(p)))
+            if not images:
+                raise BistairError(f"no PNG, TIFF or BMP images match {text}")
+            files += images
+            continue
+        path = Path(item)
+        if not path.exists():
+            raise BistairError(f"captures {path} not found")
+        if path.is_dir():
+            images = list_images(path)
+            if not images:
+                raise BistairError(f"no PNG, TIFF or BMP images in {path}")
+            files += images
+        elif path.suffix.lower() in (*IMAGE_SUFFIXES, ".npy"):
+            files.append(path)
+        else:
+            raise BistairError(f"captures {path} must be images (PNG, TIFF, BMP), a folder of "
+                               "them or a .npy stack")
+    if len(files) > 1 and any(f.suffix.lower() == ".npy" for f in files):
+        raise BistairError("a .npy capture stack must be given alone")
+    return files
+
+
+def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
+    """A capture stack (frames, height, width) from :func:`capture_files`; the frames at
+    the indices ``skip`` are left out (not read).
+
+    Raises
+    ------
+    BistairError
+        What :func:`capture_files` and :func:`read_image` refuse, and frames of different
+        sizes or bit depths.
+    """
+    files = capture_files(captures)
+    skip = set(skip)
+    if files[0].suffix.lower() == ".npy":
+        path = files[0]
         try:
-            stack = np.load(path, allow_pickle=False)
+            stack = np.load(path, allow_pickle=False, mmap_mode="r")
         except Exception as exc:
             raise BistairError(f"cannot read {path}: {str(exc).splitlines()[0]}") from None
         if stack.ndim != 3:
             raise BistairError(f"{path} holds shape {stack.shape}, expected (frames, H, W)")
-        return stack
-    files = list_images(path)
-    if not files:
-        raise BistairError(f"no PNG, TIFF or BMP images in {path}")
+        keep = [i for i in range(stack.shape[0]) if i not in skip]
+        return np.ascontiguousarray(stack[keep] if skip else stack)
+    files = [f for i, f in enumerate(files) if i not in skip]
     frames = [read_image(f) for f in files]
     first = frames[0]
     for f, img in zip(files, frames, strict=True):
@@ -105,18 +185,41 @@ def load_spec(path: str | Path) -> BaseSpec:
     return spec_from_dict(read_json(path, "spec file"))
 
 
-def read_with_spec(captures: str | Path, spec: BaseSpec | str | Path | None
+def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
                    ) -> tuple[np.ndarray, BaseSpec]:
-    """The capture stack and its spec (``CAPTURES/spec.json``, or beside a ``.npy`` stack,
-    unless given)."""
-    captures = Path(captures)
-    if not captures.exists():
-        raise BistairError(f"captures {captures} not found")
+    """The capture stack and the spec that describes it.
+
+    ``spec`` defaults to ``spec.json`` in the captures' folder (the folder given, or the
+    folder of the first file). Frames the spec marks ``ignore`` are not read: the spec
+    returned lists the frames of the stack returned.
+
+    Raises
+    ------
+    BistairError
+        A spec that cannot be read, captures that cannot be read, or a frame count that
+        differs from the spec's.
+    """
+    files = capture_files(captures)
     if spec is None:
-        spec = captures / "spec.json" if captures.is_dir() else captures.with_name("spec.json")
+        first = captures if isinstance(captures, str | Path) else next(iter(captures))
+        first = Path(first)
+        spec = first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
     if not isinstance(spec, BaseSpec):
         spec = load_spec(spec)
-    return read_captures(captures), spec
+    skip = [i for i, name in enumerate(spec.frames) if name == "ignore"]
+    npy = files[0].suffix.lower() == ".npy"
+    stack = read_captures(files) if npy else None
+    count = stack.shape[0] if npy else len(files)
+    if count != spec.frame_count:
+        raise BistairError(f"the {spec.method} spec needs {spec.frame_count} frames, the "
+                           f"captures have {count}")
+    if npy:
+        stack = np.delete(stack, skip, axis=0) if skip else stack
+    else:
+        stack = read_captures(files, skip)
+    if skip:
+        spec = spec.replace(frame_order=tuple(n for n in spec.frames if n != "ignore"))
+    return stack, spec
 
 
 def write_image(path: str | Path, image: np.ndarray) -> None:
@@ -126,6 +229,23 @@ def write_image(path: str | Path, image: np.ndarray) -> None:
         tifffile.imwrite(path, image)
     else:
         iio.imwrite(path, image)
+
+
+def check_output(out: str | Path, captures: Captures | None = None) -> Path:
+    """Refuse an output path that is empty or is the captures' own folder (writing there
+    would add files to the next decode of that folder); returns it as a Path."""
+    if str(out).strip() == "":
+        raise BistairError("the output path is empty")
+    out = Path(out)
+    if captures is not None:
+        items = [captures] if isinstance(captures, str | Path) else list(captures)
+        folders = {Path(i).resolve() if Path(i).is_dir() else Path(i).resolve().parent
+                   for i in items if not any(c in str(i) for c in "*?[")}
+        folders |= {Path(str(i)).parent.resolve() for i in items if any(c in str(i) for c in "*?[")}
+        if out.resolve() in folders:
+            raise BistairError(f"the output folder {out} is the captures' own folder: choose "
+                               "another (the outputs would be read as captures next time)")
+    return out
 
 
 @contextlib.contextmanager

@@ -52,12 +52,13 @@ def preview_images(result: DecodeResult) -> dict[str, np.ndarray]:
     }
 
 
-def write_previews(result: DecodeResult, folder: str | Path) -> list[Path]:
-    """Write the preview PNGs of a result into ``folder``; returns their paths."""
+def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -> list[Path]:
+    """Write the preview PNGs of a result into ``folder`` (``STEM + suffix + .png``);
+    returns their paths."""
     folder = Path(folder)
     paths = []
     for stem, rgb in preview_images(result).items():
-        path = folder / f"{stem}.png"
+        path = folder / f"{stem}{suffix}.png"
         iio.imwrite(path, rgb)
         paths.append(path)
     return paths

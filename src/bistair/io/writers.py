@@ -23,19 +23,25 @@ import imageio.v3 as iio
 import numpy as np
 from plyfile import PlyData, PlyElement
 
-from ..core.result import DecodeResult
+from ..core.result import AxesResult, DecodeResult
 from .files import output_file
 from .jsonfile import write_json
 from .previews import colorize, write_previews
 
 
-def write_result(result: DecodeResult, folder: str | Path, previews: bool = True) -> None:
+def write_result(result: DecodeResult | AxesResult, folder: str | Path,
+                 previews: bool = True) -> None:
     """Write a decode's arrays (``NAME.npy``), ``info.json`` and, with ``previews``, the PNG
-    previews into an existing folder."""
+    previews into an existing folder. A decode of both axes writes each axis's files with
+    the suffix ``_x`` or ``_y`` (``coord_x.npy``, ``order_y.png``, ...) and ``mask.npy``
+    where both are valid."""
     folder = Path(folder)
     for name, arr in result.arrays().items():
         np.save(folder / f"{name}.npy", arr)
-    if previews:
+    if previews and isinstance(result, AxesResult):
+        write_previews(result.x, folder, suffix="_x")
+        write_previews(result.y, folder, suffix="_y")
+    elif previews:
         write_previews(result, folder)
     write_json(folder / "info.json", result.info)
 
