@@ -13,8 +13,9 @@ so blur and noise put pixels beside every edge one order off (the method's known
 
 Shifted (``gray_offset = 0.5``; Wu Z. et al., Opt. Express 27(16), 2019): the code's edges
 sit half a period off the phase jumps, ``g = floor(x/T + 1/2)`` over ``fringes + 1``
-levels; ``k = g`` where ``phi < pi`` and ``g - 1`` where ``phi >= pi``, so no pixel reads the
-code next to one of its edges.
+levels; ``k = g`` where ``phi < pi`` and ``g - 1`` where ``phi >= pi``. Its misreads move
+from the phase jumps to mid-fringe, where the phase is continuous: the region strategy
+outvotes them.
 
 Second period (``second_period = T2``; the layout of kamino410/phase-shifting, with OpenCV's
 Gray code): the order read from the code is checked against the phase of a second N-step
@@ -28,6 +29,11 @@ Gray code of half-period resolution whose last bit has its edges mid-fringe. Wit
 from the first ``B`` bits and ``k2 = floor((K2 + 1)/2)`` from all of them, the three-zone
 rule picks the code whose edges are far from the pixel: ``k2`` where ``phi < pi/2``,
 ``k2 - 1`` where ``phi >= 3*pi/2``, ``k1`` in between.
+
+Stage 3 takes each pixel's order from the code (``strategy="pixel"``, the classic decode) or
+votes it over each fringe region, the pixels far from the code's edges counting most
+(``strategy="region"``), which removes the misreads beside the edges of a plain or shifted
+code.
 
 Bits are binarised against the fringes' average intensity, or against the inverse patterns
 when the spec has them (robust to albedo and ambient light); with inverses, a pixel whose
@@ -56,6 +62,8 @@ import numpy as np
 from ..core.captures import Prepared
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, wrap
+from ..core.regions import core_weight, fringe_regions
+from ..core.resolve import code_evidence, phase_from_regions
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
@@ -208,10 +216,30 @@ def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
     return best, best_err < 0.5 * separation
 
 
-def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec) -> Orders:
-    """Stage 3: the code is the order."""
-    abs_phase = np.where(code.code >= 0, fs.phi + TWO_PI * code.code, np.nan)
-    return Orders(abs_phase, {"noise": fs.noise, "bits": spec.code_bits + spec.complementary})
+def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
+                  strategy: str = "pixel") -> Orders:
+    """Stage 3: the code is the order, per pixel (``pixel``, the classic decode), or voted
+    per fringe region with the pixels far from the code's edges counting most (``region``:
+    a code misread beside its edges is outvoted by the rest of its fringe)."""
+    if strategy not in ("pixel", "region"):
+        raise BistairError(f"unknown strategy {strategy!r} (use 'pixel' or 'region')")
+    info = {"strategy": strategy, "noise": fs.noise,
+            "bits": spec.code_bits + spec.complementary}
+    k = code.code
+    if strategy == "pixel":
+        return Orders(np.where(k >= 0, fs.phi + TWO_PI * k, np.nan), info)
+    labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
+    weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
+
+    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+        return labels, n, code_evidence(labels, n, k, spec.fringes, weight)
+
+    def agrees(order: np.ndarray) -> np.ndarray:
+        return (k == order) | (k < 0)
+
+    abs_phase = phase_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
+                                   info)
+    return Orders(abs_phase, info)
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:

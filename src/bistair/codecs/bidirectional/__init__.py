@@ -50,7 +50,7 @@ from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import phase_from_regions
 from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
-from ...spec import PeriodSpec, field
+from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
 from .bands import (
     BandLayout,
@@ -92,8 +92,9 @@ class BidirectionalSpec(PeriodSpec):
         span = self.partitions * self.stairs * self.period
         if span < self.coded_length:
             raise BistairError(
-                f"partitions*stairs*period = {self.partitions}*{self.stairs}*{self.period} = "
-                f"{span} px is narrower than the {self.coded_length}-px coded axis"
+                f"partitions*stairs*period = {self.partitions}*{self.stairs}*"
+                f"{format_period(self.period)} = {format_period(span)} px is narrower than the "
+                f"{self.coded_length}-px coded axis"
             )
         if not 1 <= self.local_rows < self.group_rows:
             raise BistairError(
