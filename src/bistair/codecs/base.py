@@ -26,7 +26,7 @@ Examples
 >>> fringes = codec.phase_map(patterns, spec)
 >>> code = codec.code_map(patterns, spec)
 >>> code.code[0, ::30].tolist(), codec.options
-([0, 1, 2, 3, 4, 5, 6, 7], ('min_modulation',))
+([0, 1, 2, 3, 4, 5, 6, 7], ('min_modulation', 'strategy'))
 """
 
 from __future__ import annotations
