@@ -197,6 +197,33 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> 
                    f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
 
 
+@cli.command("import-calibration")
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="calibration file to write (JSON)")
+@click.option("--projector-size", required=True, metavar="WxH",
+              help="projector size WIDTHxHEIGHT")
+@click.option("--camera-size", default=None, metavar="WxH",
+              help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
+              "image_width + image_height, ... in the files]")
+@click.option("--keys", default=None, metavar="NAME=KEY,...",
+              help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
+              "projector=M2,projector_dist=D2,R=R,T=T]; "
+              "camera_size=KEY names the size key")
+@reports_errors
+def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
+                       camera_size: str | None, keys: str | None) -> None:
+    """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
+    intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
+    R, T map the camera frame to the projector frame; T in millimetres."""
+    from .jobs import import_calibration as run
+
+    cal = run(files, out, projector_size, camera_size, keys)
+    click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
+               f"{cal.projector.width}x{cal.projector.height}, baseline {cal.baseline:.2f} mm; "
+               f"wrote {out}")
+
+
 @cli.command()
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
