@@ -234,16 +234,22 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
 @click.option("--depth", type=click.Path(path_type=Path), default=None,
               help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
 @click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="keep points with depth z in [MIN, MAX] mm (camera frame)")
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
-                depth: Path | None, strategy: str | None) -> None:
+                depth: Path | None, strategy: str | None, depth_range: str | None) -> None:
     """Decode, triangulate with a calibration, write a coloured PLY and a depth map."""
-    from .jobs import reconstruct_folder
+    from .jobs import parse_depth_range, reconstruct_folder
 
     depth = depth or out.with_name(out.stem + "-depth")
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {} if strategy is None else {"strategy": strategy}
-    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth, **options)
-    click.echo(f"{int(rec.mask.sum())} points; wrote {out} and {depth}/depth.npy")
+    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
+                             min_depth=low, max_depth=high, **options)
+    dropped = rec.info.get("outside_range", 0)
+    note = f" ({dropped} outside the depth range)" if depth_range is not None else ""
+    click.echo(f"{int(rec.mask.sum())} points{note}; wrote {out} and {depth}/depth.npy")
 
 
 @cli.command()

@@ -34,7 +34,7 @@ from ..geometry.calibrate import PoseCapture, calibrate_poses
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
-from ..geometry.triangulate import Reconstruction, check_fit, reconstruct
+from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.files import (
     load_spec,
     natural_key,
@@ -121,6 +121,7 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
     ``CAPTURES/spec.json``; ``options`` go to the decoder. Nothing is written on error."""
+    check_depth_range(min_depth, max_depth)
     stack, spec = read_with_spec(captures, spec)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)

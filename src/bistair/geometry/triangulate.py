@@ -21,7 +21,7 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import cv2
@@ -38,12 +38,14 @@ _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
 @dataclass
 class Reconstruction:
     """Per camera pixel: ``points`` (H, W, 3) float32 mm in the camera frame and ``depth``
-    (H, W) float32 ``z`` (NaN where invalid), ``colors`` (H, W, 3) uint8, ``mask``."""
+    (H, W) float32 ``z`` (NaN where invalid), ``colors`` (H, W, 3) uint8, ``mask``; ``info``
+    counts pixels (``outside_range``: triangulated, but dropped by the depth range)."""
 
     points: np.ndarray
     depth: np.ndarray
     colors: np.ndarray
     mask: np.ndarray
+    info: dict[str, Any] = field(default_factory=dict)
 
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
@@ -136,6 +138,20 @@ def check_fit(result: DecodeResult, calibration: Calibration,
     return coded
 
 
+def check_depth_range(min_depth: float, max_depth: float) -> None:
+    """Refuse a depth range that is not ``0 <= min_depth < max_depth`` (NaN included).
+
+    >>> check_depth_range(400.0, float("inf"))
+    >>> check_depth_range(-1.0, 800.0)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the depth range needs 0 <= min_depth < max_depth, got -1.0:800.0
+    """
+    if not 0 <= min_depth < max_depth:
+        raise BistairError(f"the depth range needs 0 <= min_depth < max_depth, got "
+                           f"{min_depth}:{max_depth}")
+
+
 def reconstruct(result: DecodeResult, calibration: Calibration, spec: BaseSpec | str,
                 orientation: str | None = None, min_depth: float = 0.0,
                 max_depth: float = np.inf, **options: Any) -> Reconstruction:
@@ -143,24 +159,28 @@ def reconstruct(result: DecodeResult, calibration: Calibration, spec: BaseSpec |
 
     ``spec`` is the spec of the captures (or just its orientation); ``orientation``, if
     given, is what the caller expects the spec to code. Depths outside ``[min_depth,
-    max_depth]`` are dropped. ``options`` go to :func:`triangulate`. Colours are the white
-    frame if the spec has one, else the fringes' average.
+    max_depth]`` are dropped (``0 <= min_depth < max_depth``). ``options`` go to
+    :func:`triangulate`. Colours are the white frame if the spec has one, else the fringes'
+    average.
     """
     coded = check_fit(result, calibration, spec, orientation)
+    check_depth_range(min_depth, max_depth)
     h, w = result.coord.shape
     valid = np.flatnonzero(result.mask.ravel() & np.isfinite(result.coord.ravel()))
     pix = np.column_stack([valid % w, valid // w]).astype(float)
     pts, sens = triangulate(pix, result.coord.ravel()[valid], calibration, coded,
                             sensitivity=True, **options)
     _check_geometry(pts, sens, calibration, coded)
+    found = np.isfinite(pts[:, 2])
     with np.errstate(invalid="ignore"):
-        keep = np.isfinite(pts[:, 2]) & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
+        keep = found & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
     points = np.full((h * w, 3), np.nan, np.float32)
     points[valid[keep]] = pts[keep]
     points = points.reshape(h, w, 3)
     mask = np.isfinite(points[..., 2])
     return Reconstruction(points, points[..., 2].copy(), _grey_colors(
-        result, spec if isinstance(spec, BaseSpec) else None), mask)
+        result, spec if isinstance(spec, BaseSpec) else None), mask,
+        {"outside_range": int(found.sum() - keep.sum())})
 
 
 def _check_geometry(points: np.ndarray, sens: np.ndarray, calibration: Calibration,
