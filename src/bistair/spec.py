@@ -17,9 +17,10 @@ Examples
 >>> spec_from_dict(spec.to_dict()) == spec
 True
 >>> spec_from_dict({"method": "bidirectional", "width": 1080, "height": 1080, "period": 30})
+... # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-bistair.errors.BistairError: spec misses field(s): steps, orientation, phase_offset, shift_sign, partitions, stairs, group_rows, local_rows (a spec read from a file must name every field that shapes its patterns)
+bistair.errors.BistairError: spec misses field(s): steps, orientation, phase_offset, ...
 """
 
 from __future__ import annotations
@@ -105,8 +106,9 @@ class BaseSpec:
     def default_frames(self) -> tuple[str, ...]:
         """The method's frames, then the white frame if asked for."""
         if self.orientation == "both":
-            own = tuple(f"{AXES[axis]}/{name}" for axis, spec in self.axes()
-                        for name in spec.method_frames())
+            own = tuple(f"{tag}/{name}" for axis, tag in AXES.items() for name in
+                        dataclasses.replace(self, orientation=axis, frame_order=())
+                        .method_frames())
         else:
             own = self.method_frames()
         return own + (("white",) if self.white else ())
@@ -129,10 +131,8 @@ class BaseSpec:
             return ((self.orientation, self),)
         out = []
         for axis, tag in AXES.items():
-            order = ()
-            if self.frame_order:
-                order = tuple(n[2:] if n.startswith(f"{tag}/") else
-                              (n if n in ROLES else "ignore") for n in self.frame_order)
+            order = tuple(n[2:] if n.startswith(f"{tag}/") else
+                          (n if n in ROLES else "ignore") for n in self.frames)
             out.append((axis, dataclasses.replace(self, orientation=axis, frame_order=order)))
         return tuple(out)
 
