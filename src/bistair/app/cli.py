@@ -236,19 +236,34 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
 @click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="keep points with depth z in [MIN, MAX] mm (camera frame)")
+@click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
+              metavar="PX", help="specs of both axes: drop pixels whose projector column and "
+              "row lie farther than this (projector pixels) from the camera ray's projection")
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
-                depth: Path | None, strategy: str | None, depth_range: str | None) -> None:
-    """Decode, triangulate with a calibration, write a coloured PLY and a depth map."""
+                depth: Path | None, strategy: str | None, depth_range: str | None,
+                epipolar_tolerance: float) -> None:
+    """Decode, triangulate with a calibration, write a coloured PLY and a depth map.
+
+    With a spec of both axes (orientation both), each point fits both projector
+    coordinates, and pixels whose coordinates no point on their camera ray shows are
+    dropped as wrong decodes."""
     from .jobs import parse_depth_range, reconstruct_folder
 
     depth = depth or out.with_name(out.stem + "-depth")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {} if strategy is None else {"strategy": strategy}
     rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
-                             min_depth=low, max_depth=high, **options)
-    dropped = rec.info.get("outside_range", 0)
-    note = f" ({dropped} outside the depth range)" if depth_range is not None else ""
+                             min_depth=low, max_depth=high,
+                             epipolar_tolerance=epipolar_tolerance, **options)
+    notes = []
+    if "both_axes" in rec.info:
+        notes.append(f"{rec.info['both_axes']} pixels with both axes, {rec.info['one_axis']} "
+                     f"with the {rec.info['baseline_axis']} alone, {rec.info['off_epipolar']} "
+                     f"off the epipolar line dropped")
+    if depth_range is not None:
+        notes.append(f"{rec.info['outside_range']} outside the depth range")
+    note = f" ({'; '.join(notes)})" if notes else ""
     click.echo(f"{int(rec.mask.sum())} points{note}; wrote {out} and {depth}/depth.npy")
 
 

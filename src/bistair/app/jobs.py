@@ -27,7 +27,7 @@ import numpy as np
 
 from ..codecs import decode, encode
 from ..core.captures import to_bit_depth
-from ..core.result import DecodeResult
+from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.board import Board
 from ..geometry.calibrate import PoseCapture, calibrate_poses
@@ -117,18 +117,25 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
                        calibration: Calibration | str | Path, out_ply: str | Path,
                        depth_dir: str | Path | None = None, orientation: str | None = None,
                        min_depth: float = 0.0, max_depth: float = np.inf,
-                       **options: Any) -> Reconstruction:
+                       epipolar_tolerance: float = 1.5, **options: Any) -> Reconstruction:
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
-    ``CAPTURES/spec.json``; ``options`` go to the decoder. Nothing is written on error."""
+    ``CAPTURES/spec.json``; ``options`` go to the decoder. A spec of both axes triangulates
+    with both projector coordinates (``epipolar_tolerance``: see
+    :func:`~bistair.geometry.triangulate.reconstruct`). Nothing is written on error."""
     check_depth_range(min_depth, max_depth)
+    if not epipolar_tolerance > 0:
+        raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
     stack, spec = read_with_spec(captures, spec)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)
-    blank = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8, period=1.0, method="")
+    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8,
+                                                    period=1.0, method="")
+    if spec.orientation == "both":
+        blank = AxesResult(blank, blank)
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
     rec = reconstruct(decode(stack, spec, **options), calibration, spec, orientation,
-                      min_depth, max_depth)
+                      min_depth, max_depth, epipolar_tolerance)
     pts, cols = rec.cloud()
     if depth_dir is None:
         write_ply(out_ply, pts, cols)
