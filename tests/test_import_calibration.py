@@ -119,6 +119,24 @@ def test_renamed_keys_rotation_vector_and_other_size_keys(tmp_path, monkeypatch,
         assert_same(load_calibration(out), cal)
 
 
+def test_hand_written_yaml_with_plain_sequences(tmp_path):
+    """YAML a person or another tool wrote: sequences instead of !!opencv-matrix, a 1.0
+    header, image_width + image_height."""
+    cal = _example_calibration()
+
+    def seq(a: np.ndarray) -> str:
+        return repr(np.asarray(a).tolist())
+
+    text = "\n".join([
+        "%YAML:1.0", "image_width: 640", "image_height: 480",
+        f"M1: {seq(cal.camera.K)}", f"D1: {seq(cal.camera.dist[:4])}",
+        f"M2: {seq(cal.projector.K)}", f"D2: {seq(cal.projector.dist)}",
+        f"R: {seq(cv2.Rodrigues(cal.R)[0].ravel())}", f"T: {seq(cal.T)}", "name: rig 1", ""])
+    (tmp_path / "rig.yaml").write_text(text)
+    got = read_opencv_calibration([tmp_path / "rig.yaml"], (1280, 800))
+    assert_same(got, cal, tol=1e-12)
+
+
 def test_camera_size_option_wins_and_rounded_rotation_is_made_exact(tmp_path):
     cal = _example_calibration()
     items = {**stereo_items(cal), "image_size": [320, 240]}

@@ -256,6 +256,12 @@ def test_depth_range_keeps_the_sphere_and_drops_the_plane(small_capture, tmp_pat
     assert len(PlyData.read(str(out))["vertex"]) == inside.sum()
     dropped = int(full.mask.sum() - inside.sum())
     assert f"{inside.sum()} points ({dropped} outside the depth range)" in stdout
+    code, stdout, err = cli_run(monkeypatch, capsys, "reconstruct", root / "caps.npy",
+                                "--calibration", root / "calib.json", "--out", out,
+                                "--depth", depth, "--depth-range", "680:inf")
+    assert code == 0, err
+    far = np.load(depth / "depth.npy")
+    assert np.isfinite(far[plane]).mean() > 0.95 and not np.isfinite(far[sphere]).any()
 
 
 @pytest.mark.parametrize("value, message", [
