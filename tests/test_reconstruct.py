@@ -11,6 +11,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 import pytest
+from conftest import cli_run
 from plyfile import PlyData
 
 import bistair
@@ -228,3 +229,61 @@ def test_bad_inputs_leave_nothing_behind(small_capture, tmp_path):
     assert one_line(exc) == ("calibration is for a 1920x1080 projector, the spec for "
                              "1280x800")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["big.json", "broken.json"]
+
+
+# -- depth range ------------------------------------------------------------------------------
+def test_depth_range_keeps_the_sphere_and_drops_the_plane(small_capture, tmp_path, monkeypatch,
+                                                          capsys):
+    root, rig = small_capture
+    truth = trace(rig, preset("sphere-on-plane", camera_size=(160, 128))[1],
+                  Imaging(seed=5)).truth  # the scene of small_capture
+    full = reconstruct_folder(root / "caps.npy", None, root / "calib.json",
+                              tmp_path / "full.ply")
+    out, depth = tmp_path / "near.ply", tmp_path / "near-depth"
+    code, stdout, err = cli_run(monkeypatch, capsys, "reconstruct", root / "caps.npy",
+                                "--calibration", root / "calib.json", "--out", out,
+                                "--depth", depth, "--depth-range", "400:650")
+    assert code == 0, err
+    near = np.load(depth / "depth.npy")
+    sphere, plane = truth.mask & (truth.object_id == 1), truth.mask & (truth.object_id == 2)
+    # the sphere spans z 470-570 mm, the plane sits at 700 mm
+    assert np.isfinite(near).sum() > 0.95 * sphere.sum()
+    assert not np.isfinite(near[plane]).any()
+    with np.errstate(invalid="ignore"):
+        inside = (full.depth >= 400) & (full.depth <= 650)
+    assert np.array_equal(np.isfinite(near), inside)
+    assert np.array_equal(near[inside], full.depth[inside])
+    assert len(PlyData.read(str(out))["vertex"]) == inside.sum()
+    dropped = int(full.mask.sum() - inside.sum())
+    assert f"{inside.sum()} points ({dropped} outside the depth range)" in stdout
+    code, stdout, err = cli_run(monkeypatch, capsys, "reconstruct", root / "caps.npy",
+                                "--calibration", root / "calib.json", "--out", out,
+                                "--depth", depth, "--depth-range", "680:inf")
+    assert code == 0, err
+    far = np.load(depth / "depth.npy")
+    assert np.isfinite(far[plane]).mean() > 0.95 and not np.isfinite(far[sphere]).any()
+
+
+@pytest.mark.parametrize("value, message", [
+    ("650:400", "--depth-range MIN:MAX needs MIN < MAX, got 650:400"),
+    ("500:500", "--depth-range MIN:MAX needs MIN < MAX, got 500:500"),
+    ("-5:800", "--depth-range MIN must be a depth of 0 mm or more, got -5:800"),
+    ("near:far", "--depth-range must be MIN:MAX in mm, e.g. 400:800, got 'near:far'"),
+    ("400", "--depth-range must be MIN:MAX in mm, e.g. 400:800, got '400'"),
+    ("400:800:900", "--depth-range must be MIN:MAX in mm"),
+    ("nan:800", "--depth-range MIN:MAX needs MIN < MAX, got nan:800"),
+])
+def test_bad_depth_range_is_one_line(small_capture, tmp_path, monkeypatch, capsys, value,
+                                     message):
+    root, _ = small_capture
+    code, stdout, err = cli_run(monkeypatch, capsys, "reconstruct", root / "caps.npy",
+                                "--calibration", root / "calib.json",
+                                "--out", tmp_path / "c.ply", f"--depth-range={value}")
+    assert code == 2 and stdout == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"Error: {message}")
+    assert list(tmp_path.iterdir()) == []
+    with pytest.raises(BistairError) as exc:
+        reconstruct_folder(root / "caps.npy", None, root / "calib.json", tmp_path / "c.ply",
+                           min_depth=700.0, max_depth=600.0)
+    assert one_line(exc) == "the depth range needs 0 <= min_depth < max_depth, got 700.0:600.0"

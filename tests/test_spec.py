@@ -2,6 +2,7 @@
 
 import json
 
+import numpy as np
 import pytest
 
 import bistair
@@ -78,3 +79,20 @@ def test_spec_file_errors(tmp_path):
     bad.write_text("{not json")
     with pytest.raises(BistairError, match="not valid JSON"):
         load_spec(bad)
+
+
+@pytest.mark.parametrize("method, params", [
+    ("graycode", dict(period=8)), ("multifreq", dict(periods=(64, 16, 8))),
+    ("bidirectional", dict(period=8, partitions=2)), ("phase-coding", dict(period=8)),
+    ("lv", dict(period=8))])
+def test_both_axes_decode_in_the_default_frame_order(method, params):
+    """Without a frame_order, each axis spec still sees the other axis's frames (ignored)."""
+    spec = bistair.make_spec(method, width=64, height=32, orientation="both", white=1, **params)
+    assert spec.frame_order == () and spec.frames[-1] == "white"
+    for _, sub in spec.axes():
+        assert len(sub.frames) == spec.frame_count
+        assert sum(name != "ignore" for name in sub.frames) == len(sub.method_frames()) + 1
+    result = bistair.decode(bistair.encode(spec), spec)
+    assert result.mask.all()
+    assert np.abs(result.coord_x - np.arange(64)[None, :]).max() < 1e-4
+    assert np.abs(result.coord_y - np.arange(32)[:, None]).max() < 1e-4

@@ -106,8 +106,9 @@ class BaseSpec:
     def default_frames(self) -> tuple[str, ...]:
         """The method's frames, then the white frame if asked for."""
         if self.orientation == "both":
-            own = tuple(f"{AXES[axis]}/{name}" for axis, spec in self.axes()
-                        for name in spec.method_frames())
+            own = tuple(f"{tag}/{name}" for axis, tag in AXES.items() for name in
+                        dataclasses.replace(self, orientation=axis, frame_order=())
+                        .method_frames())
         else:
             own = self.method_frames()
         return own + (("white",) if self.white else ())
@@ -130,10 +131,8 @@ class BaseSpec:
             return ((self.orientation, self),)
         out = []
         for axis, tag in AXES.items():
-            order = ()
-            if self.frame_order:
-                order = tuple(n[2:] if n.startswith(f"{tag}/") else
-                              (n if n in ROLES else "ignore") for n in self.frame_order)
+            order = tuple(n[2:] if n.startswith(f"{tag}/") else
+                          (n if n in ROLES else "ignore") for n in self.frames)
             out.append((axis, dataclasses.replace(self, orientation=axis, frame_order=order)))
         return tuple(out)
 

@@ -215,6 +215,33 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> 
                    f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
 
 
+@cli.command("import-calibration")
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="calibration file to write (JSON)")
+@click.option("--projector-size", required=True, metavar="WxH",
+              help="projector size WIDTHxHEIGHT")
+@click.option("--camera-size", default=None, metavar="WxH",
+              help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
+              "image_width + image_height, ... in the files]")
+@click.option("--keys", default=None, metavar="NAME=KEY,...",
+              help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
+              "projector=M2,projector_dist=D2,R=R,T=T]; "
+              "camera_size=KEY names the size key")
+@reports_errors
+def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
+                       camera_size: str | None, keys: str | None) -> None:
+    """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
+    intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
+    R, T map the camera frame to the projector frame; T in millimetres."""
+    from .jobs import import_calibration as run
+
+    cal = run(files, out, projector_size, camera_size, keys)
+    click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
+               f"{cal.projector.width}x{cal.projector.height}, baseline {cal.baseline:.2f} mm; "
+               f"wrote {out}")
+
+
 @cli.command()
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
@@ -225,16 +252,37 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> 
 @click.option("--depth", type=click.Path(path_type=Path), default=None,
               help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
 @click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="keep points with depth z in [MIN, MAX] mm (camera frame)")
+@click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
+              metavar="PX", help="specs of both axes: drop pixels whose projector column and "
+              "row lie farther than this (projector pixels) from the camera ray's projection")
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
-                depth: Path | None, strategy: str | None) -> None:
-    """Decode, triangulate with a calibration, write a coloured PLY and a depth map."""
-    from .jobs import reconstruct_folder
+                depth: Path | None, strategy: str | None, depth_range: str | None,
+                epipolar_tolerance: float) -> None:
+    """Decode, triangulate with a calibration, write a coloured PLY and a depth map.
+
+    With a spec of both axes (orientation both), each point fits both projector
+    coordinates, and pixels whose coordinates no point on their camera ray shows are
+    dropped as wrong decodes."""
+    from .jobs import parse_depth_range, reconstruct_folder
 
     depth = depth or out.with_name(out.stem + "-depth")
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {} if strategy is None else {"strategy": strategy}
-    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth, **options)
-    click.echo(f"{int(rec.mask.sum())} points; wrote {out} and {depth}/depth.npy")
+    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
+                             min_depth=low, max_depth=high,
+                             epipolar_tolerance=epipolar_tolerance, **options)
+    notes = []
+    if "both_axes" in rec.info:
+        notes.append(f"{rec.info['both_axes']} pixels with both axes, {rec.info['one_axis']} "
+                     f"with the {rec.info['baseline_axis']} alone, {rec.info['off_epipolar']} "
+                     f"off the epipolar line dropped")
+    if depth_range is not None:
+        notes.append(f"{rec.info['outside_range']} outside the depth range")
+    note = f" ({'; '.join(notes)})" if notes else ""
+    click.echo(f"{int(rec.mask.sum())} points{note}; wrote {out} and {depth}/depth.npy")
 
 
 @cli.command()

@@ -1,5 +1,7 @@
 """The jobs on folders behind the command line: write a pattern set, decode a capture folder,
-reconstruct, measure height against a reference plane, calibrate from board captures.
+reconstruct, measure height against a reference plane, calibrate from board captures, import
+an OpenCV calibration; and the parsers of their option strings (``WxH``, ``MIN:MAX``,
+``NAME=KEY,...``).
 
 Each job reads its inputs, works in memory and writes its outputs atomically (a temporary
 folder or file moved in at the end), so a failed job leaves nothing behind.
@@ -17,6 +19,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +33,8 @@ from ..geometry.board import Board
 from ..geometry.calibrate import PoseCapture, calibrate_poses
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
-from ..geometry.triangulate import Reconstruction, check_fit, reconstruct
+from ..geometry.opencv import read_opencv_calibration
+from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.files import (
     Captures,
     check_output,
@@ -132,17 +136,25 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
                        calibration: Calibration | str | Path, out_ply: str | Path,
                        depth_dir: str | Path | None = None, orientation: str | None = None,
                        min_depth: float = 0.0, max_depth: float = np.inf,
-                       **options: Any) -> Reconstruction:
+                       epipolar_tolerance: float = 1.5, **options: Any) -> Reconstruction:
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
-    ``CAPTURES/spec.json``; ``options`` go to the decoder. Nothing is written on error."""
+    ``CAPTURES/spec.json``; ``options`` go to the decoder. A spec of both axes triangulates
+    with both projector coordinates (``epipolar_tolerance``: see
+    :func:`~bistair.geometry.triangulate.reconstruct`). Nothing is written on error."""
+    check_depth_range(min_depth, max_depth)
+    if not epipolar_tolerance > 0:
+        raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
     stack, spec = read_with_spec(captures, spec)
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)
-    blank = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8, period=1.0, method="")
+    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8,
+                                                    period=1.0, method="")
+    if spec.orientation == "both":
+        blank = AxesResult(blank, blank)
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
     rec = reconstruct(decode(stack, spec, **options), calibration, spec, orientation,
-                      min_depth, max_depth)
+                      min_depth, max_depth, epipolar_tolerance)
     pts, cols = rec.cloud()
     if depth_dir is None:
         write_ply(out_ply, pts, cols)
@@ -236,3 +248,108 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
     if out is not None:
         save_calibration(cal, out)
     return cal
+
+
+def import_calibration(files: Sequence[str | Path], out: str | Path,
+                       projector_size: tuple[int, int] | str,
+                       camera_size: tuple[int, int] | str | None = None,
+                       keys: Mapping[str, str] | str | None = None) -> Calibration:
+    """Read an OpenCV FileStorage calibration (YAML or XML, keys of several files merged)
+    and write it as a bistair calibration file ``out`` (atomically).
+
+    Sizes are ``(width, height)`` or ``"WxH"``; ``keys`` renames parts (a mapping or
+    ``"camera=M1,T=T"``), see :func:`~bistair.geometry.opencv.read_opencv_calibration`.
+    Nothing is written on error.
+    """
+    if isinstance(projector_size, str):
+        projector_size = parse_size(projector_size, "--projector-size")
+    if isinstance(camera_size, str):
+        camera_size = parse_size(camera_size, "--camera-size")
+    if isinstance(keys, str):
+        keys = parse_keys(keys)
+    cal = read_opencv_calibration(list(files), projector_size, camera_size, keys)
+    save_calibration(cal, out)
+    return cal
+
+
+# -- option strings --------------------------------------------------------------------------
+def parse_size(text: str, name: str = "size") -> tuple[int, int]:
+    """``"WxH"`` as ``(width, height)``, positive integers.
+
+    Raises
+    ------
+    BistairError
+        If ``text`` is not two positive whole numbers joined by ``x``.
+
+    Examples
+    --------
+    >>> parse_size("1920x1080")
+    (1920, 1080)
+    >>> parse_size("1920")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: size must be WIDTHxHEIGHT in pixels, e.g. 1920x1080, got '1920'
+    """
+    parts = text.strip().lower().split("x")
+    if len(parts) != 2 or not all(p.strip().isdigit() and int(p) > 0 for p in parts):
+        raise BistairError(f"{name} must be WIDTHxHEIGHT in pixels, e.g. 1920x1080, got "
+                           f"{text!r}")
+    return int(parts[0]), int(parts[1])
+
+
+def parse_keys(text: str) -> dict[str, str]:
+    """``"NAME=KEY,NAME=KEY"`` as a dictionary (names checked by the reader).
+
+    Raises
+    ------
+    BistairError
+        If an item is not ``NAME=KEY`` or a name repeats.
+
+    Examples
+    --------
+    >>> parse_keys("camera=K_cam, T=translation")
+    {'camera': 'K_cam', 'T': 'translation'}
+    """
+    out: dict[str, str] = {}
+    for item in text.split(","):
+        name, sep, key = (part.strip() for part in item.partition("="))
+        if not sep or not name or not key:
+            raise BistairError(f"--keys must be NAME=KEY items joined by commas, e.g. "
+                               f"camera=M1,T=T; got {item.strip()!r}")
+        if name in out:
+            raise BistairError(f"--keys names {name} twice")
+        out[name] = key
+    return out
+
+
+def parse_depth_range(text: str) -> tuple[float, float]:
+    """``"MIN:MAX"`` (mm) as ``(min, max)`` with ``0 <= min < max`` (``max`` may be ``inf``).
+
+    Raises
+    ------
+    BistairError
+        If the text is not two numbers joined by ``:`` or they are not an interval of
+        depths.
+
+    Examples
+    --------
+    >>> parse_depth_range("400:650.5")
+    (400.0, 650.5)
+    >>> parse_depth_range("650:400")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: --depth-range MIN:MAX needs MIN < MAX, got 650:400
+    """
+    low, sep, high = text.partition(":")
+    try:
+        if not sep:
+            raise ValueError
+        lo, hi = float(low), float(high)
+    except ValueError:
+        raise BistairError(f"--depth-range must be MIN:MAX in mm, e.g. 400:800, got "
+                           f"{text!r}") from None
+    if not lo < hi:  # also refuses NaN
+        raise BistairError(f"--depth-range MIN:MAX needs MIN < MAX, got {text}")
+    if not 0 <= lo < np.inf:
+        raise BistairError(f"--depth-range MIN must be a depth of 0 mm or more, got {text}")
+    return lo, hi

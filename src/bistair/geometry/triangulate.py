@@ -8,6 +8,12 @@ distortion-free ray-plane intersection and is refined by vectorised Newton steps
 projector's own projection, so distortion is honoured exactly. Points are in the camera
 frame, millimetres.
 
+Both axes. With the projector column and row decoded (``orientation="both"``), the depth is
+the one whose projection lies nearest to the decoded pair (Gauss-Newton on the depth, the
+same projection with distortion), and the distance left over, from the pair to the image of
+the camera ray (its epipolar line), tells a wrong decode: no point on the ray shows that
+pair. Where only the coordinate along the baseline is valid, one axis is used.
+
 Examples
 --------
 >>> cal = _toy_calibration()
@@ -21,13 +27,13 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import cv2
 import numpy as np
 
-from ..core.result import DecodeResult
+from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..spec import BaseSpec
 from .calibration import Calibration, Device
@@ -38,12 +44,14 @@ _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
 @dataclass
 class Reconstruction:
     """Per camera pixel: ``points`` (H, W, 3) float32 mm in the camera frame and ``depth``
-    (H, W) float32 ``z`` (NaN where invalid), ``colors`` (H, W, 3) uint8, ``mask``."""
+    (H, W) float32 ``z`` (NaN where invalid), ``colors`` (H, W, 3) uint8, ``mask``; ``info``
+    counts pixels (``outside_range``: triangulated, but dropped by the depth range)."""
 
     points: np.ndarray
     depth: np.ndarray
     colors: np.ndarray
     mask: np.ndarray
+    info: dict[str, Any] = field(default_factory=dict)
 
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
@@ -64,25 +72,17 @@ def _project_coded(dev: Device, pts: np.ndarray, axis: int) -> tuple[np.ndarray,
     return (u, v) if axis == 0 else (v, u)
 
 
-def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
-                orientation: str = "columns", iterations: int = 12, tolerance: float = 1e-4,
-                sensitivity: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """3-D points (camera frame, mm) of camera ``pixels`` ``(N, 2)`` whose decoded projector
-    coordinate along the coded axis is ``coord`` ``(N,)``; NaN rows where there is no
-    solution in front of both devices inside the projector image (to ``tolerance`` px).
-
-    With ``sensitivity``, also the depth change per projector pixel, ``|dz/dcoord|``."""
-    cam, proj = calibration.camera, calibration.projector
-    axis = 0 if orientation == "columns" else 1
+def _camera_rays(pixels: np.ndarray, cam: Device) -> np.ndarray:
+    """Rays ``(x, y, 1)`` ``(N, 3)`` of camera pixels ``(N, 2)``, undistorted."""
     pix = np.asarray(pixels, np.float64).reshape(-1, 1, 2)
-    target = np.asarray(coord, np.float64).ravel()
-    if not len(target):
-        return (np.zeros((0, 3)), np.zeros(0)) if sensitivity else np.zeros((0, 3))
     norm = cv2.undistortPoints(pix, cam.K, cam.dist, criteria=_UNDISTORT).reshape(-1, 2)
-    ray = np.column_stack([norm, np.ones(len(norm))])
-    a = ray @ calibration.R.T  # projector-frame point = z * a + T
-    t = calibration.T
-    # distortion-free start: the ray meets the plane of projector points with this coordinate
+    return np.column_stack([norm, np.ones(len(norm))])
+
+
+def _depth_on_axis(a: np.ndarray, t: np.ndarray, proj: Device, target: np.ndarray,
+                   axis: int, iterations: int) -> np.ndarray:
+    """Depths ``z`` where the projector-frame points ``z * a + t`` project to ``target``
+    along ``axis``: the distortion-free ray-plane intersection, then Newton steps."""
     m = (target - proj.K[axis, 2]) / proj.K[axis, axis]
     with np.errstate(divide="ignore", invalid="ignore"):
         z = (m * t[2] - t[axis]) / (a[:, axis] - m * a[:, 2])
@@ -94,6 +94,27 @@ def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
             z = z - dz
             if not np.nanmax(np.abs(dz) / np.abs(z), initial=0.0) > 1e-12:
                 break
+    return z
+
+
+def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
+                orientation: str = "columns", iterations: int = 12, tolerance: float = 1e-4,
+                sensitivity: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """3-D points (camera frame, mm) of camera ``pixels`` ``(N, 2)`` whose decoded projector
+    coordinate along the coded axis is ``coord`` ``(N,)``; NaN rows where there is no
+    solution in front of both devices inside the projector image (to ``tolerance`` px).
+
+    With ``sensitivity``, also the depth change per projector pixel, ``|dz/dcoord|``."""
+    cam, proj = calibration.camera, calibration.projector
+    axis = 0 if orientation == "columns" else 1
+    target = np.asarray(coord, np.float64).ravel()
+    if not len(target):
+        return (np.zeros((0, 3)), np.zeros(0)) if sensitivity else np.zeros((0, 3))
+    ray = _camera_rays(pixels, cam)
+    a = ray @ calibration.R.T  # projector-frame point = z * a + T
+    t = calibration.T
+    z = _depth_on_axis(a, t, proj, target, axis, iterations)
+    with np.errstate(divide="ignore", invalid="ignore"):
         pts_p = z[:, None] * a + t
         coded, other = _project_coded(proj, pts_p, axis)
         span = proj.size[1 - axis]
@@ -107,6 +128,92 @@ def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
         return points, np.where(ok, 1.0 / np.abs(slope), np.nan)
 
 
+def baseline_orientation(calibration: Calibration) -> str:
+    """The projector axis along the baseline, whose coordinate carries the depth:
+    ``"columns"`` or ``"rows"``.
+
+    At the projector's principal point the epipolar lines (the images of camera rays) run
+    along ``(fx * Tx, fy * Ty)``; the axis with the larger component wins.
+
+    >>> baseline_orientation(_toy_calibration())
+    'columns'
+    """
+    proj, t = calibration.projector, calibration.T
+    return "columns" if abs(proj.K[0, 0] * t[0]) >= abs(proj.K[1, 1] * t[1]) else "rows"
+
+
+def triangulate_axes(pixels: np.ndarray, coord_x: np.ndarray, coord_y: np.ndarray,
+                     calibration: Calibration, epipolar_tolerance: float = 1.5,
+                     iterations: int = 20, residual: bool = False
+                     ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """3-D points (camera frame, mm) of camera ``pixels`` ``(N, 2)`` whose decoded projector
+    column and row are ``coord_x`` and ``coord_y`` ``(N,)``.
+
+    Each point is at the depth along its camera ray whose projection into the projector
+    (with the projector's distortion) is nearest to ``(coord_x, coord_y)``: least squares of
+    both projector residuals, Gauss-Newton on the depth, started from the one-axis solution
+    of the coordinate along the baseline (:func:`baseline_orientation`).
+
+    Parameters
+    ----------
+    pixels : camera pixel coordinates ``(N, 2)``.
+    coord_x, coord_y : decoded projector column and row per pixel.
+    calibration : the rig.
+    epipolar_tolerance : projector pixels the decoded pair may lie from the projection of
+        the ray (the camera pixel's epipolar line), across the baseline at the best fit.
+        Farther, no point on the ray shows both coordinates: a wrong decode, dropped.
+    iterations : Gauss-Newton steps at most.
+    residual : also return that distance per pixel (NaN where there is no fit).
+
+    Returns
+    -------
+    points : ``(N, 3)``, NaN rows for pixels dropped by the tolerance, behind a device or
+        outside the projector image; with ``residual``, ``(points, distance)``.
+
+    Examples
+    --------
+    >>> cal = _toy_calibration()
+    >>> point = np.array([10.0, -20.0, 600.0])
+    >>> uv = cal.camera.K @ point / point[2]
+    >>> xp = cal.projector.K @ (cal.R @ point + cal.T)
+    >>> x, y = xp[0] / xp[2], xp[1] / xp[2]
+    >>> triangulate_axes(uv[None, :2], [x], [y], cal).round(6).tolist()
+    [[10.0, -20.0, 600.0]]
+    >>> pts, dist = triangulate_axes(uv[None, :2], [x], [y + 30], cal, residual=True)
+    >>> bool(np.isnan(pts).all()), round(float(dist[0]), 1)  # one fringe off on the rows
+    (True, 30.0)
+    """
+    cam, proj = calibration.camera, calibration.projector
+    target = np.column_stack([np.asarray(coord_x, np.float64).ravel(),
+                              np.asarray(coord_y, np.float64).ravel()])
+    if not len(target):
+        return (np.zeros((0, 3)), np.zeros(0)) if residual else np.zeros((0, 3))
+    axis = 0 if baseline_orientation(calibration) == "columns" else 1
+    ray = _camera_rays(pixels, cam)
+    a = ray @ calibration.R.T  # projector-frame point = z * a + T
+    t = calibration.T
+
+    def project(z: np.ndarray) -> np.ndarray:
+        return np.column_stack(_project_coded(proj, z[:, None] * a + t, 0))
+
+    z = _depth_on_axis(a, t, proj, target[:, axis], axis, 12)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for _ in range(iterations):
+            step = 1e-6 * np.abs(z) + 1e-9
+            jac = (project(z + step) - project(z - step)) / (2 * step[:, None])
+            dz = np.sum(jac * (project(z) - target), axis=1) / np.sum(jac * jac, axis=1)
+            z = z - dz
+            if not np.nanmax(np.abs(dz) / np.abs(z), initial=0.0) > 1e-12:
+                break
+        fit = project(z)
+        dist = np.hypot(*(fit - target).T)
+        ok = ((z > 0) & (z * a[:, 2] + t[2] > 0) & (dist <= epipolar_tolerance)
+              & (fit >= -0.5).all(axis=1) & (fit[:, 0] <= proj.width - 0.5)
+              & (fit[:, 1] <= proj.height - 0.5))
+        points = np.where(ok[:, None], z[:, None] * ray, np.nan)
+    return (points, dist) if residual else points
+
+
 def _grey_colors(result: DecodeResult, spec: BaseSpec | None) -> np.ndarray:
     if result.texture is not None:
         grey = np.asarray(result.texture, float)
@@ -116,17 +223,22 @@ def _grey_colors(result: DecodeResult, spec: BaseSpec | None) -> np.ndarray:
     return np.repeat(grey[..., None], 3, axis=2)
 
 
-def check_fit(result: DecodeResult, calibration: Calibration,
+def check_fit(result: DecodeResult | AxesResult, calibration: Calibration,
               spec: BaseSpec | str, orientation: str | None = None) -> str:
-    """The coded orientation, after checking that captures, spec and calibration belong
-    together (one-line :class:`BistairError` otherwise)."""
+    """The coded orientation (``"columns"``, ``"rows"`` or ``"both"``), after checking that
+    captures, spec and calibration belong together (one-line :class:`BistairError`
+    otherwise)."""
     coded = spec if isinstance(spec, str) else spec.orientation
-    if coded not in ("columns", "rows"):
-        raise BistairError(f"orientation must be 'columns' or 'rows', got {coded!r}")
+    if coded not in ("columns", "rows", "both"):
+        raise BistairError(f"orientation must be 'columns', 'rows' or 'both', got {coded!r}")
     if orientation is not None and orientation != coded:
         raise BistairError(f"the spec codes {coded}, but {orientation} were asked for")
+    axes = isinstance(result, AxesResult)
+    if axes != (coded == "both"):
+        raise BistairError("a spec of both axes needs the decode of both axes" if not axes
+                           else f"the decode holds both axes, the spec codes {coded} only")
     cam, proj = calibration.camera, calibration.projector
-    h, w = result.coord.shape
+    h, w = (result.coord_x if axes else result.coord).shape
     if (w, h) != cam.size:
         raise BistairError(f"calibration is for {cam.width}x{cam.height} camera images, "
                            f"captures are {w}x{h}")
@@ -136,36 +248,100 @@ def check_fit(result: DecodeResult, calibration: Calibration,
     return coded
 
 
-def reconstruct(result: DecodeResult, calibration: Calibration, spec: BaseSpec | str,
-                orientation: str | None = None, min_depth: float = 0.0,
-                max_depth: float = np.inf, **options: Any) -> Reconstruction:
+def check_depth_range(min_depth: float, max_depth: float) -> None:
+    """Refuse a depth range that is not ``0 <= min_depth < max_depth`` (NaN included).
+
+    >>> check_depth_range(400.0, float("inf"))
+    >>> check_depth_range(-1.0, 800.0)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the depth range needs 0 <= min_depth < max_depth, got -1.0:800.0
+    """
+    if not 0 <= min_depth < max_depth:
+        raise BistairError(f"the depth range needs 0 <= min_depth < max_depth, got "
+                           f"{min_depth}:{max_depth}")
+
+
+def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
+                spec: BaseSpec | str, orientation: str | None = None, min_depth: float = 0.0,
+                max_depth: float = np.inf, epipolar_tolerance: float = 1.5,
+                **options: Any) -> Reconstruction:
     """Triangulate every valid pixel of a decode.
 
     ``spec`` is the spec of the captures (or just its orientation); ``orientation``, if
     given, is what the caller expects the spec to code. Depths outside ``[min_depth,
-    max_depth]`` are dropped. ``options`` go to :func:`triangulate`. Colours are the white
-    frame if the spec has one, else the fringes' average.
+    max_depth]`` are dropped (``0 <= min_depth < max_depth``). ``options`` go to
+    :func:`triangulate`. Colours are the white frame if the spec has one, else the fringes'
+    average.
+
+    A decode of both axes (:class:`~bistair.core.result.AxesResult`, spec orientation
+    ``"both"``) is triangulated with both projector coordinates where both are valid
+    (:func:`triangulate_axes`; a pixel whose pair lies more than ``epipolar_tolerance``
+    projector pixels off its epipolar line is dropped as a wrong decode), and with the
+    coordinate along the baseline alone (:func:`baseline_orientation`) where only that one
+    is valid. ``info`` then counts ``both_axes``, ``one_axis`` and ``off_epipolar`` pixels.
     """
     coded = check_fit(result, calibration, spec, orientation)
-    h, w = result.coord.shape
-    valid = np.flatnonzero(result.mask.ravel() & np.isfinite(result.coord.ravel()))
-    pix = np.column_stack([valid % w, valid // w]).astype(float)
-    pts, sens = triangulate(pix, result.coord.ravel()[valid], calibration, coded,
-                            sensitivity=True, **options)
-    _check_geometry(pts, sens, calibration, coded)
+    check_depth_range(min_depth, max_depth)
+    if not epipolar_tolerance > 0:
+        raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
+    if isinstance(result, AxesResult):
+        valid, pts, info = _both_axes(result, calibration, epipolar_tolerance, options)
+        first = result.x
+    else:
+        valid = np.flatnonzero(result.mask.ravel() & np.isfinite(result.coord.ravel()))
+        pts, sens = triangulate(_pixels(valid, result.coord.shape[1]),
+                                result.coord.ravel()[valid], calibration, coded,
+                                sensitivity=True, **options)
+        _check_geometry(pts, sens, calibration, coded)
+        info, first = {}, result
+    h, w = first.coord.shape
+    found = np.isfinite(pts[:, 2])
     with np.errstate(invalid="ignore"):
-        keep = np.isfinite(pts[:, 2]) & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
+        keep = found & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
     points = np.full((h * w, 3), np.nan, np.float32)
     points[valid[keep]] = pts[keep]
     points = points.reshape(h, w, 3)
     mask = np.isfinite(points[..., 2])
+    info["outside_range"] = int(found.sum() - keep.sum())
     return Reconstruction(points, points[..., 2].copy(), _grey_colors(
-        result, spec if isinstance(spec, BaseSpec) else None), mask)
+        first, spec if isinstance(spec, BaseSpec) else None), mask, info)
+
+
+def _pixels(flat: np.ndarray, width: int) -> np.ndarray:
+    """``(x, y)`` ``(N, 2)`` of flat pixel indices."""
+    return np.column_stack([flat % width, flat // width]).astype(float)
+
+
+def _both_axes(result: AxesResult, calibration: Calibration, epipolar_tolerance: float,
+               options: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, dict[str, Any]]:
+    """``(flat pixel indices, points, info)`` of a decode of both axes: every pixel with a
+    valid coordinate along the baseline, triangulated with both coordinates where the other
+    is valid too."""
+    along = baseline_orientation(calibration)
+    main, cross = (result.x, result.y) if along == "columns" else (result.y, result.x)
+    ok_main = main.mask & np.isfinite(main.coord)
+    ok_cross = cross.mask & np.isfinite(cross.coord)
+    valid = np.flatnonzero(ok_main.ravel())
+    pix = _pixels(valid, main.coord.shape[1])
+    pts, sens = triangulate(pix, main.coord.ravel()[valid], calibration, along,
+                            sensitivity=True, **options)
+    _check_geometry(pts, sens, calibration, along, both=True)
+    two = ok_cross.ravel()[valid]
+    pts[two], dist = triangulate_axes(pix[two], result.coord_x.ravel()[valid[two]],
+                                      result.coord_y.ravel()[valid[two]], calibration,
+                                      epipolar_tolerance, residual=True)
+    info = {"baseline_axis": along, "both_axes": int(two.sum()),
+            "one_axis": int((~two).sum()),
+            "off_epipolar": int(np.sum(~(dist <= epipolar_tolerance))),
+            "other_axis_only": int(np.sum(ok_cross & ~ok_main))}
+    return valid, pts, info
 
 
 def _check_geometry(points: np.ndarray, sens: np.ndarray, calibration: Calibration,
-                    coded: str) -> None:
-    """Refuse a coded axis that carries almost no depth in this rig (baseline across it)."""
+                    coded: str, both: bool = False) -> None:
+    """Refuse a coded axis that carries almost no depth in this rig (baseline across it);
+    with ``both``, ``coded`` is the better of the two axes."""
     ok = np.isfinite(sens)
     if ok.sum() < 10:
         return
@@ -175,9 +351,11 @@ def _check_geometry(points: np.ndarray, sens: np.ndarray, calibration: Calibrati
     ratio = float(np.median(sens[ok]) / ideal)
     if ratio > 8:
         other = "rows" if coded == "columns" else "columns"
+        advice = ("neither axis does better: is the baseline along the optical axes?" if both
+                  else f"capture {other} instead")
         raise BistairError(f"projector {coded} barely change with depth in this rig "
                            f"({np.median(sens[ok]):.1f} mm per projector pixel, {ratio:.0f}x "
-                           f"worse than along the baseline): capture {other} instead")
+                           f"worse than along the baseline): {advice}")
 
 
 def _toy_calibration() -> Calibration:
