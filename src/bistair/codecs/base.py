@@ -39,7 +39,14 @@ from typing import Any
 import numpy as np
 
 from ..core.captures import Prepared, prepare
-from ..core.checks import EdgeCheck, convention_problem, edge_alignment
+from ..core.checks import (
+    EdgeCheck,
+    axis_problem,
+    convention_problem,
+    edge_alignment,
+    jump_problem,
+    outside_problem,
+)
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
 from ..core.result import AxesResult, DecodeResult, result_from_phase
@@ -110,6 +117,9 @@ class Codec:
     ``comparable(width, height, period, steps)`` gives the spec parameters of the method's
     pattern set that compares with the others on a projector (for the benchmark and the
     simulator); ``variants`` names decoder options worth comparing too (label -> options).
+    ``aligned``: the decoder needs the coded axis to run along the image's rows of the
+    column layout (bands of a code down the image), so captures whose phase changes more
+    across that axis are refused; for the others it is a warning.
     """
 
     name: str
@@ -121,6 +131,7 @@ class Codec:
     measure_columns: MeasureFn = measure_shifts
     comparable: Callable[[int, int, int, int], dict[str, Any]] | None = None
     variants: dict[str, dict[str, Any]] = field(default_factory=dict)
+    aligned: bool = False
 
     @property
     def options(self) -> tuple[str, ...]:
@@ -200,18 +211,31 @@ class Codec:
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
+        turned = axis_problem(fs.phi, fs.valid, spec.orientation)
+        if self.aligned:
+            _refuse(turned)
         code = self.code_columns(cols, spec, fs, min_modulation)
-        warnings = check_convention(fs, code, spec)
+        warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
+        _refuse(jump_problem(orders.info.get("jump_violations", 0),
+                             orders.info.get("jump_links", 0)))
         result = result_from_phase(self.name, fs, orders.abs_phase, spec.period,
                                    code=code.code, info=orders.info, length=spec.coded_length)
+        _refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
+                                spec.coded_length))
+        result.info["valid_pixels"] = int(result.mask.sum())
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":
             result = result.transposed()
         result.texture = prepared.white
         return result
+
+
+def _refuse(problem: str | None) -> None:
+    if problem is not None:
+        raise BistairError(f"the captures do not fit the spec: {problem}")
 
 
 def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:

@@ -30,6 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.captures import Prepared
+from ..core.checks import stair_misfit
 from ..core.measure import FringeSet
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..core.resolve import code_evidence, phase_from_regions
@@ -179,6 +180,10 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
+    if stair_misfit(theta, fs.valid, stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
+        raise BistairError("the captures do not fit the spec: the code phases sit halfway "
+                           "between the code's levels: are code-cos and code-sin swapped (or "
+                           "levels wrong)?")
     return CodeMap(codes, {"code_phase": theta}, cycle=spec.levels)
 
 

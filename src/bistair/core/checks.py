@@ -124,3 +124,76 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
                f"{wrap(check.crossing + edge_phase) % TWO_PI:.2f} rad, not at "
                f"{edge_phase:.2f} rad: is phase_offset {suggestion}?")
     return ("refuse" if abs(check.crossing) > np.pi / 3 else "warn", message)
+
+
+def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str) -> str | None:
+    """A one-line reason to refuse when the wrapped phase (column layout: the coded axis
+    along the rows) changes more down the columns than along the rows, i.e. the fringes run
+    along the image's coded axis instead of across it.
+
+    >>> x = np.arange(128.0)
+    >>> phi = np.tile((2 * np.pi * x / 16) % (2 * np.pi), (64, 1)).astype(np.float32)
+    >>> ok = np.ones(phi.shape, bool)
+    >>> axis_problem(phi, ok, "columns") is None, axis_problem(phi.T, ok.T, "columns")[:34]
+    (True, 'the phase changes down the image (')
+    """
+    sub = (slice(None, None, 2), slice(None, None, 2))
+    p, v = phi[sub], valid[sub]
+    along = np.abs(wrap(np.diff(p, axis=1)))[v[:, 1:] & v[:, :-1]]
+    across = np.abs(wrap(np.diff(p, axis=0)))[v[1:] & v[:-1]]
+    if min(along.size, across.size) < 500:
+        return None
+    a, c = float(np.median(along)), float(np.median(across))
+    if c <= a:
+        return None
+    axis, other = ("x", "rows") if orientation == "columns" else ("y", "columns")
+    down = "down" if orientation == "columns" else "across"
+    return (f"the phase changes {down} the image ({c:.3f} rad/px) more than along its {axis} "
+            f"axis ({a:.3f}), the spec's coded axis: is orientation {other}? (a turned "
+            "camera's images must be turned back)")
+
+
+def outside_problem(decoded: int, outside: int, length: int) -> str | None:
+    """A one-line reason to refuse when many decoded pixels land outside the projector.
+
+    >>> outside_problem(900, 5000, 1080)[:40]
+    'the coordinates of 85% of the decoded pi'
+    >>> outside_problem(90000, 40, 1080) is None
+    True
+    """
+    total = decoded + outside
+    if outside < 100 or outside <= 0.1 * total:
+        return None
+    return (f"the coordinates of {100 * outside / total:.0f}% of the decoded pixels fall "
+            f"outside the {length}-px projector: is the period (or the projector size) right?")
+
+
+def jump_problem(violations: int, links: int) -> str | None:
+    """A one-line reason to refuse when the fringe orders do not step by one across many
+    phase jumps (the code does not fit the spec's levels).
+
+    >>> jump_problem(600, 2000)[:36]
+    'the fringe orders do not step by one'
+    """
+    if links < 200 or violations <= 0.1 * links:
+        return None
+    return (f"the fringe orders do not step by one across {100 * violations / links:.0f}% of "
+            "the phase jumps: does the spec fit the captures (method, levels, stairs, "
+            "partitions, period, frame order)?")
+
+
+def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> float:
+    """Median distance of the stair phases from the nearest level, in halves of that
+    level's distance to its neighbour (0: on the levels, 1: halfway between two).
+
+    >>> lv = np.array([-2.0, 0.0, 2.0])
+    >>> round(stair_misfit(np.array([[0.1, 1.0, -2.0]]), np.ones((1, 3), bool), lv), 2)
+    0.1
+    """
+    t = theta[valid][:: max(1, int(valid.sum()) // 200000)].astype(np.float64)
+    if t.size == 0:
+        return 0.0
+    gap = (np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * 9).min(axis=1)
+    d = np.abs(wrap(t[:, None] - levels[None, :]))
+    nearest = d.argmin(axis=1)
+    return float(np.median(d[np.arange(t.size), nearest] / (0.5 * gap[nearest])))

@@ -107,7 +107,7 @@ def capture_files(captures: Captures) -> list[Path]:
     >>> import tempfile, pathlib
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     for name in ("10.png", "2.png", "notes.txt", "._2.png"):
-    ...         (pathlib.Path(tmp) / name).write_bytes(b"x")
+    ...         _ = (pathlib.Path(tmp) / name).write_bytes(b"x")
     ...     [p.name for p in capture_files(pathlib.Path(tmp) / "*")]
     ['2.png', '10.png']
     """

@@ -44,6 +44,7 @@ import math
 import numpy as np
 
 from ...core.captures import Prepared
+from ...core.checks import stair_misfit
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
@@ -134,6 +135,10 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
     ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
+    if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
+        raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
+                           "between the levels of the code: are stair-cos and stair-sin "
+                           "swapped (or partitions and stairs wrong)?")
     return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod}, cycle=spec.stairs)
 
 
@@ -209,4 +214,5 @@ CODEC = Codec(
     order_columns=order_columns,
     comparable=comparable,
     variants={"paper decoder": {"strategy": "paper"}},
+    aligned=True,
 )
