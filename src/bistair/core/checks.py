@@ -178,8 +178,8 @@ def jump_problem(violations: int, links: int) -> str | None:
     if links < 200 or violations <= 0.1 * links:
         return None
     return (f"the fringe orders do not step by one across {100 * violations / links:.0f}% of "
-            "the phase jumps: does the spec fit the captures (method, levels, stairs, "
-            "partitions, period, frame order)?")
+            "the phase jumps, so the code is not read reliably: does the spec fit the "
+            "captures (method, levels, stairs, partitions, period, frame order)?")
 
 
 def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> float:

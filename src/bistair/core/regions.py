@@ -72,6 +72,61 @@ def _backward_runs(raw: np.ndarray, ok: np.ndarray, sigma: np.ndarray) -> np.nda
     return out.reshape(raw.shape)
 
 
+def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
+                 relative: float = 0.3, half: int = 3) -> tuple[np.ndarray, np.ndarray]:
+    """Links across which the fringes' spacing or slant jumps: (vertical links (H-1, W),
+    horizontal links (H, W-1)) to cut.
+
+    Where one surface hides another the wrapped phase may happen to run on across the edge,
+    but its gradient (the fringe period and slant in the image) jumps. Both gradient
+    components are averaged over windows of ``half`` pixels along the row on each side of a
+    horizontal link, or around the two ends of a vertical link; a link is cut where the
+    averages differ by more than ``relative`` of the larger gradient and by more than four
+    times their noise (``sigma``: per-pixel phase noise, radians).
+    """
+    h, w = phi.shape
+    noise = np.broadcast_to(np.asarray(sigma, np.float32), (h, w))
+
+    def wrapped(a: np.ndarray, b: np.ndarray, ok: np.ndarray) -> np.ndarray:
+        return (((b - a + np.pi) % TWO_PI) - np.pi).astype(np.float32) * ok
+
+    ok_x = (valid[:, 1:] & valid[:, :-1]).astype(np.float32)
+    gx = np.zeros((h, w), np.float32)
+    nx = np.zeros((h, w), np.float32)
+    gx[:, :-1] = wrapped(phi[:, :-1], phi[:, 1:], ok_x)
+    nx[:, :-1] = ok_x
+    ok_y = (valid[1:] & valid[:-1]).astype(np.float32)
+    gy = np.zeros((h, w), np.float32)
+    ny = np.zeros((h, w), np.float32)
+    gy[:-1] = wrapped(phi[:-1], phi[1:], ok_y)
+    ny[:-1] = ok_y
+    sums = [np.pad(np.cumsum(a, axis=1), ((0, 0), (1, 0))) for a in (gx, nx, gy, ny)]
+
+    def window(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Mean gradients and the samples behind them over columns [lo, hi)."""
+        lo, hi = np.clip(lo, 0, w), np.clip(hi, 0, w)
+        sx, cx, sy, cy = (c[:, hi] - c[:, lo] for c in sums)
+        return sx / np.maximum(cx, 1), sy / np.maximum(cy, 1), np.minimum(cx, cy)
+
+    def cut(a: tuple, b: tuple, noise_a: np.ndarray, noise_b: np.ndarray) -> np.ndarray:
+        (ax, ay, na), (bx, by, nb) = a, b
+        step = np.hypot(ax - bx, ay - by)
+        size = np.maximum(np.hypot(ax, ay), np.hypot(bx, by))
+        spread = 2.0 * np.maximum(noise_a / np.sqrt(np.maximum(na, 1)),
+                                  noise_b / np.sqrt(np.maximum(nb, 1)))
+        return ((step > relative * size) & (step > 4.0 * spread)
+                & (na >= half) & (nb >= half))
+
+    x = np.arange(w)
+    around = window(x - half, x + half)  # gradients around each pixel
+    vert = cut(tuple(v[:-1] for v in around), tuple(v[1:] for v in around),
+               noise[:-1], noise[1:])
+    xl = np.arange(w - 1)
+    left, right = window(xl - half, xl), window(xl + 1, xl + 1 + half)
+    horiz = cut(left, right, noise[:, :-1], noise[:, 1:])
+    return vert, horiz
+
+
 def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
     """+1 if the phase mostly grows along rows (left to right), -1 if it falls.
 
@@ -104,10 +159,10 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                    ) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
 
-    Links are cut at wraps, at steps above ``cut`` and, along the rows, where the phase runs
-    backwards (against :func:`fringe_direction`) by more than noise explains
-    (``phase_noise``: per-pixel phase noise in radians, 0.02 when not given): that is where
-    one surface meets another.
+    Links are cut at wraps, at steps above ``cut``, where the fringe period jumps
+    (:func:`period_jumps`) and, along the rows, where the phase runs backwards (against
+    :func:`fringe_direction`) by more than noise explains (``phase_noise``: per-pixel phase
+    noise in radians, 0.02 when not given): that is where one surface meets another.
 
     Returns ``(labels, n)``: int32 labels 1..n, 0 outside any region. Regions smaller than
     ``min_size`` pixels are dropped (left 0) so that noise islands never vote.
@@ -120,7 +175,11 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     else:  # noise of the difference of two neighbours
         sigma = np.sqrt(2.0) * np.maximum(phase_noise[:, :-1], phase_noise[:, 1:])
     sign = fringe_direction(phi, valid)
+    jump_v, jump_h = period_jumps(phi, valid, 0.02 if phase_noise is None else phase_noise)
     vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
+    drop_up |= jump_v & vert
+    drop_down |= jump_v & vert
+    vert &= ~jump_v
     if sign > 0:
         horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
                                                   valid[:, 1:], cut, sigma)
@@ -128,6 +187,9 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
         horiz, drop_right, drop_left = _link_cuts(phi[:, 1:], phi[:, :-1], valid[:, 1:],
                                                   valid[:, :-1], cut, sigma[:, ::-1])
         horiz, drop_right, drop_left = horiz[:, ::-1], drop_right[:, ::-1], drop_left[:, ::-1]
+    drop_left |= jump_h & horiz
+    drop_right |= jump_h & horiz
+    horiz &= ~jump_h
     keep = valid.copy()
     keep[:-1] &= ~drop_up
     keep[1:] &= ~drop_down

@@ -25,7 +25,8 @@ import numpy as np
 
 from ..codecs import REGISTRY, decode, encode, make_spec
 from ..core.phase import TWO_PI
-from ..core.result import DecodeResult
+from ..core.result import DecodeResult, make_result
+from ..errors import BistairError
 from ..sim import expose
 from ..spec import BaseSpec
 from .metrics import score
@@ -84,14 +85,21 @@ class Comparison:
 def run(trace: Any, specs: dict[str, tuple[BaseSpec, dict[str, Any]]],
         progress: Callable[[str], None] | None = None, imaging: Any = None) -> Comparison:
     """Expose ``trace`` with every spec's patterns (under ``imaging``, default the trace's
-    own: noise, blur, gamma and light do not change the geometry), decode and score."""
+    own: noise, blur, gamma and light do not change the geometry), decode and score. A
+    decode that refuses the captures scores as nothing decoded (``info["refused"]`` says
+    why)."""
     truth = trace.truth
     rows = []
     for label, (spec, options) in specs.items():
         if progress:
             progress(label)
         images = expose(trace, encode(spec), imaging or trace.imaging)
-        result = decode(images, spec, **options)
+        try:
+            result = decode(images, spec, **options)
+        except BistairError as exc:  # a refusal: nothing decoded, and why
+            shape = images.shape[1:]
+            result = make_result(spec.method, np.zeros(shape), np.full(shape, -1), spec.period,
+                                 np.zeros(shape), info={"refused": str(exc)})
         scores = score(result, truth.coord(spec), truth.mask, truth.object_id)
         rows.append(Row(label, spec, result, scores))
     ref = next((r for r in rows if r.spec.method == REFERENCE), None)

@@ -9,6 +9,10 @@ paper-sim          1080x1080   one big mask and three small objects, 1-3 fringes
 two-masks          1920x1080   two isolated face-like masks
 mask-prism         1920x1080   one mask and one prism carrying about 3 fringes
 two-sculptures     1920x1080   two isolated mesh sculptures (a bust and a vase)
+objects-on-plane   1920x1080   a sphere, a box, a prism and two small ellipsoids on a plane
+                               (sized for 11 x 11 = 121 fringes of 16 px)
+mugs-on-wall       1920x1080   two mugs in front of a wall, one partly hiding the other:
+                               occlusion edges without shadow gaps on their right sides
 =================  ==========  ========================================================
 
 Objects are isolated on a dark background unless a plane is named. :func:`preset_spec`
@@ -116,6 +120,37 @@ def _two_sculptures() -> Scene:
     ])
 
 
+def _objects_on_plane() -> Scene:
+    return Scene([
+        Sphere(center=(-70, -40, 600), radius=42, albedo=0.6),
+        Box(center=(60, -45, 615), size=(60, 50, 40), rotation=euler(y=25, z=8), albedo=0.5),
+        Prism(center=(-40, 70, 620), width=40, depth=16, length=60, rotation=euler(z=80),
+              albedo=0.7),
+        Ellipsoid(center=(55, 55, 625), radii=(9, 14, 8), albedo=0.65),
+        Ellipsoid(center=(95, 40, 625), radii=(5, 10, 5), albedo=0.55),
+        Plane(center=(0, 0, 640), size=(800, 700), albedo=0.75),
+    ])
+
+
+def _mugs_on_wall() -> Scene:
+    return Scene([
+        Mesh(mesh=_mug(), center=(-55, 0, 600), albedo=0.7),
+        Mesh(mesh=_mug(), center=(25, 10, 650), rotation=euler(y=30), albedo=0.55),
+        Plane(center=(0, 0, 720), size=(900, 800), albedo=0.8),
+    ])
+
+
+def _mug():
+    import trimesh
+
+    body = trimesh.creation.cylinder(radius=42, height=105, sections=96)
+    body.apply_transform(_pose(euler(x=90), (0, 0, 0)))  # axis along y, upright
+    handle = trimesh.creation.torus(major_radius=24, minor_radius=7, major_sections=48,
+                                    minor_sections=16)
+    handle.apply_transform(_pose(euler(x=90), (-50, 0, 0)))
+    return trimesh.util.concatenate([body, handle])
+
+
 _PRESETS: dict[str, tuple[Callable[[], Scene], dict[str, Any], dict[str, Any]]] = {
     "plane": (_plane, {}, dict(width=1920, height=1080, partitions=8, stairs=8)),
     "sphere-on-plane": (_sphere_on_plane, {},
@@ -125,6 +160,9 @@ _PRESETS: dict[str, tuple[Callable[[], Scene], dict[str, Any], dict[str, Any]]] 
     "mask-prism": (_mask_prism, {}, dict(width=1920, height=1080, partitions=8, stairs=8)),
     "two-sculptures": (_two_sculptures, {},
                        dict(width=1920, height=1080, partitions=8, stairs=8)),
+    "objects-on-plane": (_objects_on_plane, {},
+                         dict(width=1920, height=1080, partitions=11, stairs=11, period=16)),
+    "mugs-on-wall": (_mugs_on_wall, {}, dict(width=1920, height=1080, partitions=8, stairs=8)),
 }
 
 
@@ -142,7 +180,8 @@ def preset(name: str, **overrides: Any) -> tuple[Rig, Scene]:
 
 
 def preset_spec(name: str, method: str = "bidirectional", **params: Any) -> BaseSpec:
-    """The period-30 pattern set a preset was sized for (``params`` override it)."""
+    """The pattern set a preset was sized for (period 30 unless it says otherwise;
+    ``params`` override it)."""
     if name not in _PRESETS:
         raise ValueError(f"unknown preset {name!r} (known: {', '.join(_PRESETS)})")
     return make_spec(method, **{"period": 30, **_PRESETS[name][2], **params})

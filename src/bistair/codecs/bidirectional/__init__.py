@@ -167,7 +167,8 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         prof = row_profiles(labels, theta, weight, ratio)
         runs = row_runs(prof, levels)
-        splits = band_splits(runs)
+        heights = group_heights(runs, n, profile_centroids(prof, n))
+        splits = band_splits(runs, heights, spec.local_rows / spec.group_rows)
         if splits:  # surfaces stacked in one fringe region: decode them apart
             labels, n = split_regions(labels, n, splits)
             prof = row_profiles(labels, theta, weight, ratio)

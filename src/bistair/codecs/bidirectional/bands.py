@@ -224,31 +224,51 @@ def _drop_transitions(runs: Runs) -> Runs:
     return runs.take(~drop)
 
 
-def band_splits(runs: Runs) -> list[tuple[int, int]]:
+def band_splits(runs: Runs, heights: np.ndarray, local_share: float
+                ) -> list[tuple[int, int]]:
     """Where a region's band values change pair down its profile: two surfaces (say one
     object above another) joined into one fringe region. Returns ``(region, first row of the
     lower part)`` pairs.
 
-    Down one surface the bands alternate between two values, so a run whose value is neither
-    of the two before it starts another surface, if what follows confirms it: the run after
-    next repeats its value, the next run is new as well, or the run is a merged band.
+    Down one surface the bands alternate between two values (or, where ``k mod S`` equals
+    ``k // S``, form one merged band as long as the surface). A new surface starts at
+
+    - a run whose value is neither of the two before it, if what follows confirms it: the
+      run after next repeats its value, the next run is new as well, or the run is a merged
+      band;
+    - a run of another value after a merged band, if the run after next repeats it;
+    - a merged band after alternating bands.
+
+    A merged band is longer than 1.3 times the longer band of a group of the region's
+    height (``heights``: camera rows per group, per region; ``local_share``: the local
+    band's share of a group). Rows left out between the runs (the blurred edge where one surface hides the
+    other) do not matter; runs under two rows long do not count.
     """
-    splits = []
-    if runs.uid.size < 3:
+    splits: list[tuple[int, int]] = []
+    if runs.uid.size < 2:
         return splits
-    uid, reg = runs.uid, runs.region
-    for i in range(2, uid.size):
-        if reg[i] != reg[i - 2] or not (runs.top_ok[i] and runs.top_ok[i - 1]):
+    uid, reg, length = runs.uid, runs.region, runs.length
+    solid = length >= 2.0
+    h = np.asarray(heights, float)[reg]
+    merged = np.isfinite(h) & (length >= 1.3 * max(local_share, 1 - local_share) * h)
+
+    def same(*idx: int) -> bool:
+        return all(0 <= j < uid.size and reg[j] == reg[idx[0]] and solid[j] for j in idx)
+
+    for i in range(1, uid.size):
+        if not same(i - 1, i) or uid[i] == uid[i - 1]:
             continue
-        if uid[i] in (uid[i - 1], uid[i - 2]):
-            continue
-        nxt = i + 1 < uid.size and reg[i + 1] == reg[i] and runs.top_ok[i + 1]
-        nxt2 = nxt and i + 2 < uid.size and reg[i + 2] == reg[i] and runs.top_ok[i + 2]
-        confirmed = (
-            (nxt2 and uid[i + 2] == uid[i])
-            or (nxt and uid[i + 1] not in (uid[i - 1], uid[i - 2]))
-            or runs.length[i] >= runs.length[i - 2] + runs.length[i - 1]
-        )
+        if same(i - 2, i - 1, i) and not merged[i - 1] and uid[i] != uid[i - 2]:
+            confirmed = ((same(i, i + 2) and uid[i + 2] == uid[i])
+                         or (same(i, i + 1) and uid[i + 1] not in (uid[i - 1], uid[i - 2]))
+                         or merged[i])
+        elif merged[i - 1]:  # a run of another value after a merged band
+            confirmed = same(i, i + 2) and uid[i + 2] == uid[i] and not merged[i]
+        else:
+            confirmed = False
+        if not confirmed and merged[i] and same(i - 2, i - 1, i) and not merged[i - 1] \
+                and uid[i - 2] == uid[i]:
+            confirmed = True  # a merged band after alternating bands
         if confirmed and (not splits or splits[-1][0] != reg[i] or splits[-1][1] < runs.y0[i - 1]):
             splits.append((int(reg[i]), int(runs.y0[i])))
     return splits
