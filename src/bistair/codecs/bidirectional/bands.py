@@ -241,8 +241,8 @@ def band_splits(runs: Runs, heights: np.ndarray, local_share: float
 
     A merged band is longer than 1.3 times the longer band of a group of the region's
     height (``heights``: camera rows per group, per region; ``local_share``: the local
-    band's share of a group). Rows left out between the runs (the blurred edge where one surface hides the
-    other) do not matter; runs under two rows long do not count.
+    band's share of a group). Rows left out between the runs (the blurred edge where one
+    surface hides the other) do not matter; runs under two rows long do not count.
     """
     splits: list[tuple[int, int]] = []
     if runs.uid.size < 2:
