@@ -30,6 +30,7 @@ from .captures import (
     validity,
 )
 from .phase import residuals, wrapped_phase
+from .regions import fringe_regions
 
 
 @dataclass(frozen=True)
@@ -106,22 +107,55 @@ def _along_fringe_noise(frames: np.ndarray) -> float:
 
 
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,
-            check: bool = True, shift_sign: int = 1, phase_offset: float = 0.0) -> FringeSet:
+            check: bool = True, shift_sign: int = 1, phase_offset: float = 0.0,
+            coherent: bool = True) -> FringeSet:
     """Measure frames ``start .. start+steps-1`` of a prepared stack as an N-step set.
 
     ``shift_sign`` and ``phase_offset`` are the rig's phase convention
-    (:func:`~bistair.core.phase.wrapped_phase`). Valid pixels have enough modulation
-    (:func:`~bistair.core.captures.validity`), are not saturated and, when the capture has
-    white and black frames, enough contrast between them (twice the modulation threshold).
+    (:func:`~bistair.core.phase.wrapped_phase`). Valid pixels are not saturated, have, when
+    the capture has white and black frames, twice the modulation threshold of contrast
+    between them, and have enough modulation:
+
+    - at least the threshold (:func:`~bistair.core.captures.modulation_threshold`: four
+      times the noise, at least 1% of full scale, or ``min_modulation`` if given), or
+    - with ``coherent`` and no ``min_modulation``, at least half of it (twice the noise,
+      at least 0.5%) where the pixel belongs to a fringe region
+      (:func:`~bistair.core.regions.fringe_regions`) that holds ten pixels above the full
+      threshold or a hundred pixels in all: the dim parts of a lit surface, not noise,
+      whose phases do not join into regions (:func:`coherent_pixels`).
+
     With ``check``, captures with (almost) no valid pixel are refused as dark or saturated.
     """
     frames = prepared.frames[start:start + steps]
     phi, avg, mod = wrapped_phase(frames, shift_sign, phase_offset)
     noise = noise_level(frames, phi, avg, mod, shift_sign, phase_offset)
     threshold = modulation_threshold(noise, min_modulation)
-    valid = validity(mod, saturation(prepared.clipped, avg, mod), threshold)
+    saturated = saturation(prepared.clipped, avg, mod)
+    lowest = threshold if (min_modulation is not None or not coherent) else \
+        max(0.005, 2.0 * noise)
+    valid = validity(mod, saturated, lowest)
     if prepared.white is not None and prepared.black is not None:
-        valid &= (prepared.white - prepared.black) >= 2.0 * threshold
+        valid &= (prepared.white - prepared.black) >= 2.0 * lowest
+    if lowest < threshold:
+        sigma = noise / (np.maximum(mod, 1e-6) * np.sqrt(steps / 2.0))
+        valid = coherent_pixels(phi, valid, valid & (mod >= threshold), sigma)
     if check:
         check_decodable(valid, prepared.clipped)
     return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
+
+
+def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
+                    phase_noise: np.ndarray, min_strong: int = 10,
+                    min_size: int = 100) -> np.ndarray:
+    """The ``strong`` pixels and the ``weak`` ones in fringe regions of the weak mask that
+    hold at least ``min_strong`` strong pixels or ``min_size`` pixels in all.
+
+    Noise has random phases: its pixels do not join into fringe regions, so a dim pixel
+    whose phase runs on smoothly with a region's is part of a lit surface.
+    """
+    labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
+    size = np.bincount(labels.ravel(), minlength=n + 1)
+    bright = np.bincount(labels.ravel(), weights=strong.ravel(), minlength=n + 1)
+    keep = (bright >= min_strong) | (size >= min_size)
+    keep[0] = False
+    return strong | (weak & keep[labels])

@@ -144,17 +144,25 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     Rows where the stair pair's modulation (over the fringes', which takes out albedo and
     shading) falls below 0.7 of the region's band cores (its 80th percentile row) are
     blurred band transitions and are skipped: two band phasors mixed cancel in part, and
-    their mixed phase would read as a stair level in between.
+    their mixed phase would read as a stair level in between. Each row's modulation is
+    taken relative to what its level shows across the capture (its 80th percentile), as
+    an uncompensated projector gamma gives some levels less modulation than others.
     """
     c, s, wsum = prof.cos, prof.sin, prof.weight
     region, row = prof.region, prof.row
     row_theta = np.arctan2(s, c)
-    kept = prof.level >= 0.7 * _region_percentile(region, prof.level, 0.8)
+    core = prof.level >= 0.7 * _region_percentile(region, prof.level, 0.8)
+    levels = observed_levels(row_theta[core], wsum[core], levels)
+    read = nearest_level(row_theta, levels)
+    expected = np.ones(levels.size)
+    for j in np.unique(read[core]):
+        expected[j] = np.percentile(prof.level[core & (read == j)], 80)
+    level = prof.level / np.maximum(expected[read], 1e-6)
+    kept = level >= 0.7 * _region_percentile(region, level, 0.8)
     dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
     idx = np.flatnonzero(kept)
     region_k, row_k = region[idx], row[idx]
-    levels = observed_levels(row_theta[idx], wsum[idx], levels)
-    uid = nearest_level(row_theta[idx], levels)
+    uid = read[idx]
     same = np.zeros(idx.size, bool)
     same[1:] = region_k[1:] == region_k[:-1]
     gap = np.zeros(idx.size, np.int64)
@@ -196,19 +204,30 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
 
 
 def _drop_transitions(runs: Runs) -> Runs:
-    """Remove 1-2 row runs that are not bands.
+    """Remove runs that are not bands.
 
-    Squeezed between two different bands they are blurred transitions (their rows go half to
-    each neighbour); at the top or bottom end of a region they are its ragged edge, and the
-    band next to them is then cut by the edge, not bounded by another band.
+    Squeezed between two different bands, a run of 1-2 rows, or one under 0.4 of both its
+    neighbours' lengths whose level lies between theirs, is their blurred transition: the
+    stair phase across a band boundary blends the two levels, so it passes the levels in
+    between (its rows go half to each neighbour). At the top or bottom end of a region a
+    1-2 row run is its ragged edge, and the band next to it is then cut by the edge, not
+    bounded by another band.
     """
     n = runs.uid.size
     if n < 2:
         return runs
-    short = runs.length <= 2.0
     prev_uid = np.r_[-1, runs.uid[:-1]]
     next_uid = np.r_[runs.uid[1:], -1]
+    prev_len = np.r_[0.0, runs.length[:-1]]
+    next_len = np.r_[runs.length[1:], 0.0]
+    to_here = wrap(runs.theta - np.r_[runs.theta[:1], runs.theta[:-1]])
+    to_next = wrap(np.r_[runs.theta[1:], runs.theta[-1:]] - np.r_[runs.theta[:1],
+                                                                 runs.theta[:-1]])
+    between = (to_here * to_next > 0) & (np.abs(to_here) < np.abs(to_next))
+    short = (runs.length <= 2.0) | (between & (runs.length <= 0.4 * np.minimum(prev_len,
+                                                                                next_len)))
     inner = short & runs.top_ok & runs.bottom_ok & (prev_uid != next_uid)
+    short = runs.length <= 2.0
     top_end = short & ~runs.top_ok & runs.bottom_ok
     bottom_end = short & runs.top_ok & ~runs.bottom_ok
     drop = inner | top_end | bottom_end
