@@ -155,7 +155,8 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
-                   min_size: int = 20, phase_noise: np.ndarray | None = None
+                   min_size: int = 20, phase_noise: np.ndarray | None = None,
+                   boundaries: tuple[np.ndarray, np.ndarray] | None = None
                    ) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
 
@@ -163,6 +164,8 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     (:func:`period_jumps`) and, along the rows, where the phase runs backwards (against
     :func:`fringe_direction`) by more than noise explains (``phase_noise``: per-pixel phase
     noise in radians, 0.02 when not given): that is where one surface meets another.
+    ``boundaries`` adds links to cut that a codec found itself (vertical links (H-1, W),
+    horizontal links (H, W-1)).
 
     Returns ``(labels, n)``: int32 labels 1..n, 0 outside any region. Regions smaller than
     ``min_size`` pixels are dropped (left 0) so that noise islands never vote.
@@ -176,6 +179,8 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
         sigma = np.sqrt(2.0) * np.maximum(phase_noise[:, :-1], phase_noise[:, 1:])
     sign = fringe_direction(phi, valid)
     jump_v, jump_h = period_jumps(phi, valid, 0.02 if phase_noise is None else phase_noise)
+    if boundaries is not None:
+        jump_v, jump_h = jump_v | boundaries[0], jump_h | boundaries[1]
     vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
     drop_up |= jump_v & vert
     drop_down |= jump_v & vert

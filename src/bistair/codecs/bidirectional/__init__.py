@@ -42,6 +42,7 @@ import dataclasses
 import math
 
 import numpy as np
+from scipy import ndimage
 
 from ...core.captures import Prepared
 from ...core.checks import stair_misfit
@@ -157,9 +158,47 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     return Orders(abs_phase, info)
 
 
+def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
+                stairs: int, reach: int) -> tuple[np.ndarray, np.ndarray]:
+    """Where the stair code changes along a row inside a fringe: the edge of one surface
+    against another whose fringe the wrapped phase runs on into (vertical links (H-1, W),
+    horizontal links (H, W-1) to cut).
+
+    Along a row the code only changes where the phase jumps, so a change of at least three
+    quarters of a local stair step (and four times its noise, ``noise``: per-pixel stair
+    phase noise) between the pairs of pixels either side of a link, away from the phase
+    jumps, in four or more rows on end, is an edge. Neighbouring fringes often share their
+    partition level, so the edge found in the local bands is carried ``reach`` rows up and
+    down across the partition bands between them.
+    """
+    h, w = phi.shape
+    step = TWO_PI / stairs
+    z = np.exp(1j * theta.astype(np.float32)) * valid
+    left = z[:, :-3] + z[:, 1:-2]
+    right = z[:, 2:-1] + z[:, 3:]
+    turn = np.abs(np.angle(right * np.conj(left)))
+    spread = np.sqrt(np.maximum(noise[:, :-3], noise[:, 3:]) ** 2
+                     + np.maximum(noise[:, 1:-2], noise[:, 2:-1]) ** 2)
+    mid = phi[:, 1:-2]
+    inside = (mid > 0.15 * TWO_PI) & (mid < 0.85 * TWO_PI)
+    ok = valid[:, :-3] & valid[:, 1:-2] & valid[:, 2:-1] & valid[:, 3:] & inside
+    edge = np.zeros((h, w - 1), bool)
+    edge[:, 1:-1] = ok & (turn > np.maximum(0.75 * step, 4.0 * spread))
+    if not edge.any():
+        return np.zeros((h - 1, w), bool), edge
+    wide = ndimage.binary_dilation(edge, np.ones((1, 3), bool))
+    edge &= ndimage.binary_opening(wide, np.ones((4, 1), bool))  # four rows on end
+    if reach > 0 and edge.any():
+        edge = ndimage.binary_dilation(edge, np.ones((2 * reach + 1, 1), bool))
+    return np.zeros((h - 1, w), bool), edge
+
+
 def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
                   spec: BidirectionalSpec, info: dict) -> np.ndarray:
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    # stair phase noise: the pair's two frames against the fringes' average
+    noise = fs.noise * np.sqrt(2.0) / np.maximum(stair_mod, 1e-6)
+    edges = stair_edges(fs.phi, theta, fs.valid, noise, spec.stairs, 12)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise, boundaries=edges)
     ratio = np.clip(stair_mod / np.maximum(fs.mod, 1e-6), 0.0, 2.0)
     weight = core_weight(fs.phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
