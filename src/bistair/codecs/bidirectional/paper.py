@@ -10,6 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
+from scipy import ndimage
 
 from ...core.measure import FringeSet
 from ...core.regions import fringe_regions
@@ -22,37 +23,73 @@ if TYPE_CHECKING:
 
 
 def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
-                  spec: BidirectionalSpec) -> np.ndarray:
-    """The paper's column scan (Sec. 2.3) and per-fringe mode (Sec. 3)."""
+                 spec: BidirectionalSpec, median: int = 5, min_run: int = 3) -> np.ndarray:
+    """The paper's column scan (Sec. 2.3) and per-fringe mode (Sec. 3).
+
+    The paper's steps: ``k_s`` by Eq. 19-20 (given); down each column, runs of equal
+    ``k_s`` and their lengths ``C``; a group starts where ``C`` grows (its difference is
+    above zero); in each group the long run is the local information ``k_s1``, the short
+    one the partition information ``k_s2``, and ``k = k_s1 + S*k_s2`` (Eq. 22); a run that
+    is "very large" is a merged band, ``k = (S+1)*k_s1``; then every fringe (a stripe
+    between two phase jumps) takes the mode of its orders.
+
+    Additions where the paper is silent, as an implementer of it would make them:
+
+    1. ``k_s`` is median-filtered down each column over ``median`` pixels before the scan,
+       so that single noisy pixels do not cut runs.
+    2. Runs shorter than ``min_run`` pixels (a band's blurred edge, noise) are left out of
+       the scan; their pixels join the run above them (or, at a column's top, below).
+    3. A "very large" run is one over 1.4 times the median run length a pixel sits in; a
+       column's valid stretch (between invalid pixels) starts a group.
+    4. Where the partitions and stairs differ in number (the paper has 6 x 6), runs are of
+       the nearest level of either stair rather than of ``k_s``.
+    """
     S, P = spec.stairs, spec.partitions
     h, w = ks.shape
-    v = fs.valid.T.ravel()
+    code = ks if P == S else np.where(fs.valid, nearest_level(theta.ravel(), union_levels(
+        P, S)).reshape(h, w), -1)
+    if median > 1:  # addition 1
+        code = np.where(fs.valid, ndimage.median_filter(code, size=(median, 1),
+                                                         mode="nearest"), -1)
+    v = (fs.valid & (code >= 0)).T.ravel()
+    q = code.T.ravel()
     t = theta.T.ravel()
-    # Runs of equal k_s; with P != S the levels of both stairs are told apart.
-    q = ks.T.ravel() if P == S else nearest_level(t, union_levels(P, S))
     col_start = np.zeros(v.size, bool)
     col_start[::h] = True
     seg_start = v & (col_start | ~np.r_[False, v[:-1]])
     start = seg_start | (v & np.r_[True, q[1:] != q[:-1]])
     pix = np.flatnonzero(v)
     run_of = np.cumsum(start)[pix] - 1
-    first = np.flatnonzero(start)
-    c_len = np.bincount(run_of)  # C: run lengths
-    run_theta = np.arctan2(np.bincount(run_of, np.sin(t[pix])), np.bincount(run_of, np.cos(t[pix])))
-    new_group = seg_start[first].copy()
+    length = np.bincount(run_of)
+    # addition 2: short runs join the run above them in their stretch
+    first_pix = np.flatnonzero(start)
+    keep = (length >= min_run) | seg_start[first_pix]
+    owner = np.maximum.accumulate(np.where(keep, np.arange(keep.size), 0))
+    owner = np.where(keep | seg_start[first_pix], np.arange(keep.size), owner)
+    segment = np.cumsum(seg_start[first_pix]) - 1
+    owner = np.where(segment[owner] == segment, owner, np.arange(keep.size))
+    run_of = owner[run_of]
+    runs = np.flatnonzero(keep | (owner == np.arange(keep.size)))
+    remap = np.full(keep.size, -1)
+    remap[runs] = np.arange(runs.size)
+    run_of = remap[run_of]
+    c_len = np.bincount(run_of, minlength=runs.size)  # C: run lengths
+    run_theta = np.arctan2(np.bincount(run_of, np.sin(t[pix]), runs.size),
+                           np.bincount(run_of, np.cos(t[pix]), runs.size))
+    new_group = seg_start[first_pix[runs]].copy()
     new_group[1:] |= c_len[1:] > c_len[:-1]  # difference of C above zero: a group starts
     # "When k_s1 and k_s2 are the same, the value of C is very large": such a run is a
-    # group of its own. Very large = 1.4 times the run length a typical pixel sits in.
+    # group of its own (addition 3).
     merged = c_len > 1.4 * np.median(c_len[run_of])
     new_group[1:] |= merged[:-1]
     group = np.cumsum(new_group) - 1
     g_first = np.flatnonzero(new_group)
     g_second = g_first + 1
     has_second = np.zeros(g_first.size, bool)
-    ok = g_second < first.size
+    ok = g_second < runs.size
     has_second[ok] = group[g_second[ok]] == group[g_first[ok]]
     has_second &= ~merged[g_first]
-    second_theta = np.where(has_second, run_theta[np.minimum(g_second, first.size - 1)],
+    second_theta = np.where(has_second, run_theta[np.minimum(g_second, runs.size - 1)],
                             run_theta[g_first])
     # The longer run opens a group: the local one unless the spec gives it fewer rows.
     local_first = 2 * spec.local_rows > spec.group_rows
