@@ -295,7 +295,7 @@ def _spans(truth, object_id):
 
 def test_presets_exist_and_take_overrides():
     assert scene_names() == ["plane", "sphere-on-plane", "paper-sim", "two-masks", "mask-prism",
-                             "two-sculptures"]
+                             "two-sculptures", "objects-on-plane", "mugs-on-wall"]
     rig, _ = preset("paper-sim", camera_size=(640, 512), roll_deg=2)
     assert rig.camera.size == (640, 512) and rig.projector.size == (1080, 1080)
     assert isinstance(rig.camera, Camera)
