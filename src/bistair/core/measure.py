@@ -123,5 +123,5 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     if prepared.white is not None and prepared.black is not None:
         valid &= (prepared.white - prepared.black) >= 2.0 * threshold
     if check:
-        check_decodable(valid, prepared.clipped)
+        check_decodable(valid, prepared.clipped, min_modulation, mod)
     return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
