@@ -101,7 +101,8 @@ for _codec in REGISTRY.values():
 @click.option("--strategy", default=None, help="fringe-order strategy (bidirectional: "
               "region [default] or paper)")
 @click.option("--min-modulation", type=float, default=None,
-              help="modulation threshold as a fraction of full scale [default: from noise]")
+              help="modulation threshold as a fraction of full scale, between 0 and 1 "
+              "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
