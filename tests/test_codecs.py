@@ -133,7 +133,7 @@ def test_gray_and_lv_helpers():
     ("multifreq", dict(periods=(30, 30)), "periods must differ"),
     ("lv", dict(period=10, levels=3), "need more than 3 levels"),
     ("phase-coding", dict(period=2), "at least 4"),
-    ("graycode", dict(period=30, complementary=2), "complementary and inverse"),
+    ("graycode", dict(period=30, complementary=2), "complementary must be 0 or 1, got 2"),
 ])
 def test_parameters_that_cannot_work(method, params, reason):
     with pytest.raises(BistairError, match=reason):

@@ -303,6 +303,44 @@ def test_presets_exist_and_take_overrides():
         preset("nope")
 
 
+@pytest.mark.parametrize(("field", "value", "message"), [
+    ("gamma", 0.0, "projector gamma (gamma) must be a finite number above 0, got 0.0"),
+    ("ambient", float("nan"), "ambient light (ambient) must be a finite number of at least 0"),
+    ("exposure", -1.0, "exposure (exposure) must be a finite number above 0"),
+    ("read_noise", -0.01, "read noise (read_noise) must be a finite number of at least 0"),
+    ("full_well", float("inf"), "full well (full_well) must be a finite number of at least 0"),
+    ("camera_blur", "1", "camera blur (camera_blur) must be a finite number of at least 0"),
+    ("projector_blur", -0.5, "projector blur (projector_blur) must be a finite number"),
+    ("max_incidence_deg", 95.0, "incidence limit (max_incidence_deg) must be at most 90"),
+    ("max_incidence_deg", 0.0, "incidence limit (max_incidence_deg) must be a finite number "
+                               "above 0"),
+    ("bits", 9, "camera bits (bits) must be 8, 10, 12, 14, 16 or None, got 9"),
+    ("bits", 8.0, "camera bits (bits) must be 8, 10, 12, 14, 16 or None, got 8.0"),
+    ("projector_bits", 0, "projector bits (projector_bits) must be a whole number from 1 to 16 "
+                          "or None, got 0"),
+    ("projector_sampling", "cubic", "projector_sampling must be 'nearest' or 'linear'"),
+    ("supersample", 0, "sub-rays per pixel side (supersample) must be a whole number from 1 to "
+                       "16, got 0"),
+    ("edge_margin", -1, "edge margin (edge_margin) must be a whole number of at least 0 or None"),
+    ("seed", -1, "seed must be a whole number of at least 0, got -1"),
+    ("float_output", 1, "float_output must be True or False, got 1"),
+    ("inverse_square", None, "inverse_square must be True or False, got None"),
+])
+def test_imaging_refuses_each_bad_field(field, value, message):
+    with pytest.raises(bistair.BistairError) as exc:
+        Imaging(**{field: value})
+    assert str(exc.value) == message or str(exc.value).startswith(message)
+    Imaging(**{field: Imaging.__dataclass_fields__[field].default})  # the default is fine
+
+
+@pytest.mark.parametrize("size", [(0, 0), (-5, 10), (7, 100), (640, 9000), (640.0, 480), (1,)])
+def test_simulated_devices_have_sensible_sizes(size):
+    with pytest.raises(bistair.BistairError, match="camera size"):
+        Rig.default(camera_size=size)
+    with pytest.raises(bistair.BistairError, match="projector size"):
+        Rig.default(projector_size=size)
+
+
 def test_paper_sim_has_a_big_object_and_small_ones_one_to_three_fringes_wide():
     rig, scene = preset("paper-sim", camera_size=(640, 512))
     truth = trace(rig, scene, Imaging()).truth

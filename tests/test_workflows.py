@@ -2,6 +2,7 @@
 the command line, with their bad-input paths (one line, exit 2, nothing written)."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -40,6 +41,9 @@ def test_small_demo_run(tmp_path, monkeypatch, capsys):
     assert 0 < ours["rmse_vs_reference"] < 0.1
     html = (out / "report.html").read_text()
     assert html.count("data:image/png;base64,") == 7  # six methods and the point cloud
+    headings = re.findall(r"<h3>(.*?)</h3>", html)  # the method labels, not file names
+    assert headings[1:] == [r["method"] for r in json.loads((out / "table.json").read_text())]
+    assert "bidirectional (paper decoder)" in headings and headings[0].startswith("point cloud")
     assert "met by the default bidirectional decoder" in text
 
 

@@ -147,7 +147,8 @@ class BaseSpec:
 
     def _validate_common(self) -> None:
         if self.width < 8 or self.height < 8:
-            raise BistairError(f"projector size {self.width}x{self.height} is too small")
+            raise BistairError(f"projector size {self.width}x{self.height} is too small (at "
+                               "least 8x8)")
         if self.steps < 3:
             raise BistairError(f"steps must be at least 3, got {self.steps}")
         if self.bits not in (8, 16):

@@ -101,7 +101,8 @@ for _codec in REGISTRY.values():
 @click.option("--strategy", default=None, help="fringe-order strategy (bidirectional: "
               "region [default] or paper)")
 @click.option("--min-modulation", type=float, default=None,
-              help="modulation threshold as a fraction of full scale [default: from noise]")
+              help="modulation threshold as a fraction of full scale, between 0 and 1 "
+              "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
@@ -200,16 +201,35 @@ def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int,
               help="calibration file to write (JSON)")
 @click.option("--board", type=click.Path(path_type=Path), default=None,
               help="board description [default: CAPTURES/board.json]")
-@click.option("--min-poses", type=int, default=3, show_default=True)
+@click.option("--min-poses", type=int, default=3, show_default=True,
+              help="fewest poses with the board found and mapped (3 or more)")
 @reports_errors
 def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> None:
-    """Calibrate camera and projector from board captures (both orientations per pose)."""
+    """Calibrate camera and projector from board captures (both orientations per pose).
+
+    Prints the reprojection errors and one standard deviation of every parameter."""
+    from ..geometry.calibrate import MIN_POSES
     from .jobs import calibrate_folder
 
+    if min_poses < MIN_POSES:
+        raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
+                       f"needs at least {MIN_POSES} board poses")
     cal = calibrate_folder(captures, out, board=board, min_poses=min_poses)
+    sigma = cal.uncertainty
     click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
-               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} mm, "
-               f"{len(cal.poses)} of {cal.poses_total} poses; wrote {out}")
+               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} +/- "
+               f"{sigma.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} poses; "
+               f"wrote {out}")
+    for name in ("camera", "projector"):
+        dev, sd = getattr(cal, name), getattr(sigma, name)
+        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
+        click.echo(f"  {name + ':':10s} " + ", ".join(
+            f"{key} {v:.2f} +/- {s:.2f}"
+            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
+    click.echo(f"  rotation +/- {sigma.angle:.3f} deg, T +/- "
+               f"({', '.join(f'{v:.2f}' for v in sigma.T)}) mm (one standard deviation, from "
+               f"correspondence noise of {sigma.noise[0]:.3f} px in the camera and "
+               f"{sigma.noise[1]:.3f} px in the projector per coordinate)")
     for pose in cal.poses:
         click.echo(f"  {pose['name']}: {pose['features']} features, camera "
                    f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")

@@ -47,9 +47,12 @@ def run_demo(out: str | Path, seed: int = 0, camera_size: tuple[int, int] = (128
     text = format_table(rows, comparison.objects)
     with output_folder(out) as tmp:
         bar.set_postfix_str("figures")
-        figures = [method_figure(row, comparison.truth, tmp / f"{_slug(row.label)}.png")
+        figures = [(row.label, method_figure(row, comparison.truth,
+                                             tmp / f"{_slug(row.label)}.png"))
                    for row in comparison.rows]
-        figures.insert(0, cloud_view(comparison.rows[0], rig, tmp / "point-cloud.png"))
+        figures.insert(0, (f"point cloud: {comparison.rows[0].label} with the rig's "
+                           "calibration", cloud_view(comparison.rows[0], rig,
+                                                     tmp / "point-cloud.png")))
         bar.update()
         bar.close()
         (tmp / "table.txt").write_text(text + "\n")

@@ -30,7 +30,7 @@ from ..core.captures import to_bit_depth
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.board import Board
-from ..geometry.calibrate import PoseCapture, calibrate_poses
+from ..geometry.calibrate import MIN_POSES, PoseCapture, calibrate_poses, check_min_poses
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
@@ -199,11 +199,15 @@ def read_pose(folder: Path, orientation: str) -> tuple[np.ndarray, np.ndarray, B
 
 
 def calibrate_folder(folder: str | Path, out: str | Path | None = None,
-                     board: Board | str | Path | None = None, min_poses: int = 3,
+                     board: Board | str | Path | None = None, min_poses: int = MIN_POSES,
                      **options: Any) -> Calibration:
     """Calibrate from board captures; write the calibration file to ``out`` (atomically) if
     given. ``options`` go to :func:`~bistair.geometry.calibrate.calibrate_poses` and
     :func:`~bistair.geometry.calibrate.calibrate_points` (``fix_k3``, ``refine``).
+
+    ``min_poses`` (at least :data:`~bistair.geometry.calibrate.MIN_POSES`, 3) poses must
+    show the board with its features mapped to the projector; the calibration carries the
+    standard deviations of its parameters (``uncertainty``).
 
     Capture layout::
 
@@ -218,6 +222,7 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
     :mod:`bistair.geometry.board` (``columns x rows`` inner corners or circles, ``spacing``
     in mm).
     """
+    check_min_poses(min_poses)
     folder = Path(folder)
     if not folder.is_dir():
         raise BistairError(f"calibration captures {folder} not found")

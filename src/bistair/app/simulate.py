@@ -49,6 +49,14 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     ``imaging`` goes to :class:`bistair.sim.Imaging` (``gamma``, ``read_noise``,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
     the projector's gamma.
+
+    Raises
+    ------
+    BistairError
+        An unknown scene or method, imaging parameters :class:`~bistair.sim.Imaging` refuses,
+        a camera size outside 8 to 8192 pixels per side
+        (:func:`~bistair.sim.rig.check_size`) or a gamma the patterns cannot pre-compensate;
+        nothing is written then.
     """
     if scene not in (*scene_names(), "calibration"):
         raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
@@ -60,8 +68,11 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
                            f"(known: {', '.join(known_methods())}, all)")
     try:
         im = Imaging(**imaging)
-    except (TypeError, ValueError) as exc:
+    except TypeError as exc:  # a parameter Imaging does not have
         raise BistairError(f"bad imaging parameters: {exc}") from None
+    if compensated and not 0.2 <= im.gamma <= 5.0:
+        raise BistairError(f"patterns cannot pre-compensate a projector gamma of {im.gamma:g} "
+                           "(a spec's gamma lies in [0.2, 5]); simulate it uncompensated")
     if scene == "calibration":
         return _calibration(methods, out, camera_size, compensated, im)
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.captures import Prepared, prepare
+from ..core.captures import Prepared, check_min_modulation, prepare
 from ..core.checks import (
     EdgeCheck,
     axis_problem,
@@ -205,6 +205,7 @@ class Codec:
             raise BistairError(
                 f"the {self.name} decoder has no option(s) {', '.join(sorted(unknown))}"
             )
+        check_min_modulation(options.get("min_modulation"))
         if spec.orientation == "both":
             x, y = (self.decode(images, axis_spec, **options) for _, axis_spec in spec.axes())
             return AxesResult(x, y)

@@ -119,17 +119,18 @@ class GrayCodeSpec(PeriodSpec):
 
     def validate(self) -> None:
         super().validate()
-        if self.complementary not in (0, 1) or self.inverse not in (0, 1):
-            raise BistairError("complementary and inverse must be 0 or 1")
+        for name in ("complementary", "inverse"):
+            if getattr(self, name) not in (0, 1):
+                raise BistairError(f"{name} must be 0 or 1, got {getattr(self, name)}")
         if self.gray_offset not in (0.0, 0.5):
             raise BistairError(f"gray_offset must be 0 or 0.5, got {self.gray_offset}")
         if self.gray_offset and self.complementary:
             raise BistairError("a shifted Gray code (gray_offset 0.5) cannot be complementary")
         if self.second_period:
-            turn = abs(((self.period / self.second_period) + 0.5) % 1.0 - 0.5)
             if not (math.isfinite(self.second_period) and self.second_period >= 4):
-                raise BistairError(f"second_period must be at least 4 projector pixels, got "
-                                   f"{self.second_period}")
+                raise BistairError(f"second_period must be 0 (none) or at least 4 projector "
+                                   f"pixels, got {self.second_period}")
+            turn = abs(((self.period / self.second_period) + 0.5) % 1.0 - 0.5)
             if turn < 0.2:
                 raise BistairError(
                     f"period / second_period = {self.period / self.second_period:.3f} is too "

@@ -36,7 +36,7 @@ from ..core.regions import RegionLinks, core_weight, fringe_regions, region_link
 from ..core.resolve import code_evidence, phase_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
-from ..spec import PeriodSpec, field
+from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
 
@@ -93,8 +93,15 @@ class LvSpec(PeriodSpec):
 
     def validate(self) -> None:
         super().validate()
-        if self.levels < 2 or self.window < 2:
-            raise BistairError("levels and window must be at least 2")
+        if not 2 <= self.levels <= 32:
+            raise BistairError(f"levels must lie in 2..32 (more leave too little phase per "
+                               f"level), got {self.levels}")
+        if self.fringes < 2:
+            raise BistairError(f"a {format_period(self.period)}-px period leaves fewer than 2 "
+                               f"fringes across the {self.coded_length}-px coded axis")
+        if not 2 <= self.window <= self.fringes:
+            raise BistairError(f"window must lie in 2..{self.fringes} (the fringes across the "
+                               f"coded axis), got {self.window}")
         if self.fringes > self.levels * (self.levels - 1) ** (self.window - 1) + self.window - 1:
             raise BistairError(
                 f"{self.fringes} fringes need more than {self.levels} levels for unique "

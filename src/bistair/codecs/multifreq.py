@@ -66,7 +66,8 @@ class MultiFreqSpec(BaseSpec):
                         choices=("auto", "hierarchical", "heterodyne"))
 
     def __post_init__(self) -> None:
-        if self.unwrap == "auto" and self.periods and self.orientation != "both":
+        if (self.unwrap == "auto" and self.periods and self.orientation != "both"
+                and all(math.isfinite(t) for t in self.periods)):
             rule = "hierarchical" if max(self.periods) >= self.coded_length else "heterodyne"
             object.__setattr__(self, "unwrap", rule)
         super().__post_init__()
@@ -77,8 +78,10 @@ class MultiFreqSpec(BaseSpec):
 
     def validate(self) -> None:
         super().validate()
-        if not self.periods or min(self.periods) < 4:
-            raise BistairError(f"periods must be at least 4 projector pixels, got {self.periods}")
+        if not self.periods or not all(math.isfinite(t) and t >= 4 for t in self.periods):
+            shown = ", ".join(format_period(t) for t in self.periods)
+            raise BistairError(f"periods must be finite and at least 4 projector pixels, got "
+                               f"({shown})")
         if len(set(self.periods)) != len(self.periods):
             raise BistairError(f"periods must differ, got {self.periods}")
         if self.unwrap not in ("hierarchical", "heterodyne"):

@@ -44,7 +44,7 @@ from ..core.regions import core_weight, fringe_regions
 from ..core.resolve import code_evidence, phase_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
-from ..spec import PeriodSpec, field
+from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
 
@@ -71,7 +71,8 @@ class PhaseCodingSpec(PeriodSpec):
         if self.form not in ("pair", "shifted"):
             raise BistairError(f"form must be pair or shifted, got {self.form!r}")
         if self.levels < 2:
-            raise BistairError(f"a {self.period}-px period leaves fewer than 2 fringes")
+            raise BistairError(f"a {format_period(self.period)}-px period leaves fewer than 2 "
+                               f"fringes across the {self.coded_length}-px coded axis")
 
 
 def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:

@@ -123,13 +123,43 @@ def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndar
 
 def modulation_threshold(noise: float, min_modulation: float | None = None) -> float:
     """The modulation a valid pixel needs (fraction of full scale): ``min_modulation`` if
-    given, else ``max(0.01, 4 * noise)`` (pure noise exceeds four sigma in about one pixel
-    in ten million).
+    given (checked by :func:`check_min_modulation`), else ``max(0.01, 4 * noise)`` (pure
+    noise exceeds four sigma in about one pixel in ten million).
 
     >>> modulation_threshold(0.005), modulation_threshold(0.001), modulation_threshold(0.0, 0.2)
     (0.02, 0.01, 0.2)
     """
-    return max(0.01, 4.0 * noise) if min_modulation is None else min_modulation
+    if min_modulation is None:
+        return max(0.01, 4.0 * noise)
+    check_min_modulation(min_modulation)
+    return float(min_modulation)
+
+
+def check_min_modulation(min_modulation: float | None) -> None:
+    """Refuse a modulation threshold outside ``(0, 1)`` (a fraction of full scale; ``None``
+    asks for the default from the noise).
+
+    Raises
+    ------
+    BistairError
+        If ``min_modulation`` is not a number strictly between 0 and 1 (0 would take pure
+        noise for fringes; a sinusoid within full scale has a modulation below 1).
+
+    Examples
+    --------
+    >>> check_min_modulation(0.05)
+    >>> check_min_modulation(float("nan"))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the minimum modulation must lie between 0 and 1 ..., got nan
+    """
+    if min_modulation is None:
+        return
+    ok = isinstance(min_modulation, int | float | np.number) and not isinstance(
+        min_modulation, bool)
+    if not (ok and 0.0 < min_modulation < 1.0):
+        raise BistairError(f"the minimum modulation must lie between 0 and 1 (a fraction of full "
+                           f"scale), got {min_modulation}")
 
 
 def validity(mod: np.ndarray, saturated: np.ndarray, threshold: float) -> np.ndarray:
@@ -137,12 +167,27 @@ def validity(mod: np.ndarray, saturated: np.ndarray, threshold: float) -> np.nda
     return (mod >= threshold) & ~saturated
 
 
-def check_decodable(valid: np.ndarray, clipped: np.ndarray) -> None:
+def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: float | None = None,
+                    mod: np.ndarray | None = None) -> None:
     """Refuse captures with (almost) nothing to decode, saying whether they are dark or blown
-    (``clipped``: pixels with a frame at full scale)."""
+    (``clipped``: pixels with a frame at full scale) or, when a ``min_modulation`` was asked
+    for, how much modulation the captures have (``mod``).
+
+    Examples
+    --------
+    >>> check_decodable(np.zeros((20, 20), bool), np.zeros((20, 20), bool), 0.6,
+    ...                 np.full((20, 20), 0.3))
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: no pixel has the minimum modulation 0.6 asked for (the most is 0.3)
+    """
     min_pixels = max(50, valid.size // 10000)
     if int(valid.sum()) >= min_pixels:
         return
+    if min_modulation is not None and mod is not None:
+        top = float(np.nanmax(mod)) if mod.size else 0.0
+        raise BistairError(f"no pixel has the minimum modulation {min_modulation:g} asked for "
+                           f"(the most is {top:.3g})")
     share = float(clipped.mean())
     if share > 0.25:
         raise BistairError(

@@ -140,7 +140,7 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         sigma = noise / (np.maximum(mod, 1e-6) * np.sqrt(steps / 2.0))
         valid = coherent_pixels(phi, valid, valid & (mod >= threshold), sigma)
     if check:
-        check_decodable(valid, prepared.clipped)
+        check_decodable(valid, prepared.clipped, min_modulation, mod)
     return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
 
 

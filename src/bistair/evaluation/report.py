@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import base64
 import html
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -13,48 +14,103 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from ..core.phase import TWO_PI  # noqa: E402
 from .benchmark import Row  # noqa: E402
 
 
 def method_figure(row: Row, truth: Any, path: str | Path) -> Path:
-    """Wrapped phase, code (``k_s``), fringe order, absolute phase and |error| of one method."""
+    """Write :func:`draw_method` of one method to ``path`` (PNG); returns ``path``."""
+    fig = draw_method(row, truth)
+    path = Path(path)
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+    return path
+
+
+# the legend of the order-error panel: colour (as in _order_errors) and meaning
+ORDER_LEGEND = (((150, 150, 150), "right order"), ((255, 0, 0), "wrong order"),
+                ((40, 80, 255), "not decoded"))
+
+
+def draw_method(row: Row, truth: Any) -> Figure:
+    """Wrapped phase, code (``k_s``), fringe order, absolute phase, |error| and order errors
+    of one method against the truth, each continuous panel with its colour bar and the order
+    errors with a legend.
+
+    Parameters
+    ----------
+    row : the method's decode and scores (:class:`~bistair.evaluation.benchmark.Row`).
+    truth : the ground truth (``coord(spec)`` and ``mask``, e.g. :class:`bistair.sim.Truth`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two rows of three panels, titled with the method's label and scores.
+
+    Examples
+    --------
+    >>> from bistair.codecs import decode, encode, make_spec
+    >>> from bistair.sim.warp import WarpScene, render_warp
+    >>> spec = make_spec("graycode", width=240, height=60, period=20)
+    >>> images, truth = render_warp(spec, WarpScene(size=(60, 120), noise=0, blur=0))
+    >>> result = decode(images, spec)
+    >>> row = Row("graycode", spec, result, {"coverage": 1.0, "order_error_rate": 0.0,
+    ...                                       "phase_rmse": 0.0})
+    >>> fig = draw_method(row, truth)
+    >>> [ax.get_ylabel() for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    ['rad', 'code level', 'fringe order', 'rad', 'rad (0.3 and above)']
+    >>> plt.close(fig)
+    """
     res = row.result
     coord = truth.coord(row.spec)
     err = np.abs(res.phase - coord * (TWO_PI / res.period))
     err[~(res.mask & truth.mask)] = np.nan
     code = np.where(res.code >= 0, res.code, np.nan).astype(float)
     order = np.where(res.order >= 0, res.order, np.nan).astype(float)
-    panels = [
-        ("wrapped phase", res.wrapped, "gray", (0, TWO_PI)),
-        ("code (k_s)", code, "viridis", None),
-        ("fringe order", order, "jet", None),
-        ("absolute phase", res.phase, "jet", None),
-        ("|error| (rad, 0-0.3)", np.minimum(err, 0.3), "magma", (0, 0.3)),
-        ("order errors (red)", _order_errors(err, res.mask, truth.mask), None, None),
+    panels = [  # title, image, colour map, value range, colour bar label
+        ("wrapped phase", res.wrapped, "gray", (0, TWO_PI), "rad"),
+        ("code (k_s)", code, "viridis", None, "code level"),
+        ("fringe order", order, "jet", None, "fringe order"),
+        ("absolute phase", res.phase, "jet", None, "rad"),
+        ("|error| (truth pixels decoded)", np.minimum(err, 0.3), "magma", (0, 0.3),
+         "rad (0.3 and above)"),
+        ("order errors", _order_errors(err, res.mask, truth.mask), None, None, None),
     ]
     step = max(1, min(err.shape) // 400)  # the panels are about 400 px tall anyway
-    fig, axes = plt.subplots(2, 3, figsize=(12, 7.2), constrained_layout=True)
-    for ax, (title, img, cmap, lim) in zip(axes.ravel(), panels, strict=True):
+    fig, axes = plt.subplots(2, 3, figsize=(12.5, 7.2), constrained_layout=True)
+    for ax, (title, img, cmap, lim, unit) in zip(axes.ravel(), panels, strict=True):
         # Downsample by taking every step-th pixel, but keep every order error visible.
         img = _block_max(img, step) if img.ndim == 3 else img[::step, ::step]
-        if cmap is None:
-            ax.imshow(img)
-        else:
-            cm = plt.get_cmap(cmap).with_extremes(bad="black")
-            kw = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
-            ax.imshow(np.ma.masked_invalid(img), cmap=cm, interpolation="nearest", **kw)
         ax.set_title(title, fontsize=10)
         ax.set_axis_off()
+        if cmap is None:
+            ax.imshow(img)
+            ax.legend(handles=[Patch(color=np.array(rgb) / 255, label=text)
+                               for rgb, text in ORDER_LEGEND],
+                      loc="upper center", bbox_to_anchor=(0.5, -0.01), ncol=3, fontsize=8,
+                      frameon=False)
+            continue
+        cm = plt.get_cmap(cmap).with_extremes(bad="black")
+        kw = {} if lim is None else {"vmin": lim[0], "vmax": lim[1]}
+        shown = ax.imshow(np.ma.masked_invalid(img), cmap=cm, interpolation="nearest", **kw)
+        bar = fig.colorbar(shown, ax=ax, shrink=0.85, extend="max" if unit.endswith(
+            "and above)") else "neither")
+        bar.set_label(unit, fontsize=9)
+        bar.ax.tick_params(labelsize=8)
+        if lim == (0, TWO_PI):
+            bar.set_ticks([0, np.pi, TWO_PI], labels=["0", "π", "2π"])
+        elif unit in ("code level", "fringe order"):
+            bar.locator = MaxNLocator(integer=True)
+            bar.update_ticks()
     s = row.scores
     fig.suptitle(f"{row.label}: {row.frames} frames, coverage {100 * s['coverage']:.2f}%, "
                  f"order errors {100 * s['order_error_rate']:.3f}%, "
-                 f"RMSE {s['phase_rmse']:.4f} rad", fontsize=11)
-    path = Path(path)
-    fig.savefig(path, dpi=80)
-    plt.close(fig)
-    return path
+                 f"RMSE {s['phase_rmse']:.4f} rad (black: no value)", fontsize=11)
+    return fig
 
 
 def _order_errors(err: np.ndarray, mask: np.ndarray, truth_mask: np.ndarray) -> np.ndarray:
@@ -72,14 +128,31 @@ def _block_max(rgb: np.ndarray, step: int) -> np.ndarray:
     return rgb[:h, :w].reshape(h // step, step, w // step, step, 3).max(axis=(1, 3))
 
 
-def _embed(path: Path) -> str:
+def _embed(path: Path, alt: str) -> str:
     data = base64.b64encode(path.read_bytes()).decode("ascii")
-    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(path.stem)}">'
+    return f'<img src="data:image/png;base64,{data}" alt="{html.escape(alt)}">'
 
 
 def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, Any]],
-                 objects: list[int], figures: list[Path], notes: str = "") -> Path:
-    """A single HTML file with the comparison table and the figures embedded."""
+                 objects: list[int], figures: Sequence[tuple[str, Path]],
+                 notes: str = "") -> Path:
+    """A single HTML file with the comparison table and the figures embedded.
+
+    Parameters
+    ----------
+    path : the HTML file to write.
+    title, intro : the page's heading and first paragraph (``intro`` may hold HTML).
+    rows, objects : :func:`~bistair.evaluation.benchmark.table` rows and the object ids,
+        largest first (all but the first are the small objects).
+    figures : ``(heading, PNG file)`` per figure, e.g. the method's label such as
+        ``"bidirectional (paper decoder)"``.
+    notes : a paragraph after the table.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
     small = objects[1:]
     head = "".join(f"<th>{h}</th>" for h in (
         "method", "frames", "coverage", "order error rate", "phase RMSE vs truth (rad)",
@@ -91,7 +164,8 @@ def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, 
                  f"{r['rmse_vs_reference']:.4f}",
                  *(f"{100 * r['objects'][i]:.1f}%" for i in small)]
         body.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
-    figs = "\n".join(f"<h3>{html.escape(p.stem)}</h3>{_embed(p)}" for p in figures)
+    figs = "\n".join(f"<h3>{html.escape(heading)}</h3>{_embed(p, heading)}"
+                     for heading, p in figures)
     doc = f"""<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8"><title>{html.escape(title)}</title>
 <style>body{{font-family:sans-serif;margin:2em;max-width:1300px}}

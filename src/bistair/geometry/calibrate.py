@@ -10,6 +10,33 @@ camera and the projector are calibrated like two cameras with the same model poi
 errors are those of the final (stereo) model. Reading the capture folders is
 :func:`bistair.app.jobs.calibrate_folder`.
 
+How many poses: at least :data:`MIN_POSES` = 3. A view of a plane fixes a homography
+(8 numbers), 6 of which go to the board's pose, so each view gives 2 constraints on a
+device's pinhole intrinsics (Zhang, IEEE TPAMI 22(11), 2000, Sec. 3.1). OpenCV's model has
+4 of them (``fx, fy, cx, cy``, no skew): one view leaves the focal length traded against the
+board's distance (one pose "calibrated" a 1200 px camera at 26,000 px and a 200 mm baseline
+at 13 m), two determine them with nothing to spare, so noise and a bad pose go unseen, and
+three are the fewest with redundancy (6 constraints for 4 unknowns; Zhang's condition
+``n >= 3`` for a unique solution). The distortion ``(k1, k2, p1, p2)`` is fixed by how the
+points bend within each view, and the pair's ``R, T`` by any one pose, so the projector,
+calibrated from the same poses, needs no more; three poses also leave the uncertainty
+below with residual degrees of freedom to estimate the noise from.
+
+Uncertainty (:class:`~bistair.geometry.calibration.Uncertainty`): the covariance of the
+estimate linearised at the solution, ``Cov = M diag(s^2) M^T`` where ``M`` maps the
+correspondence errors to the parameter errors (``-(J^T J)^-1 J^T`` for the joint
+refinement, ``J`` the Jacobian of all reprojections with respect to both devices'
+intrinsics, ``R, T`` and the board poses) and ``s`` is the correspondence noise estimated
+from the residuals, separately for the camera and the projector. This is the formula of
+``cv2.calibrateCameraExtended``'s ``stdDeviationsIntrinsics`` applied to the stereo model
+that gives the result: on noisy synthetic views the true errors of the focal lengths and the
+baseline are spread with one of these standard deviations (tests/test_calib.py). The
+single-device deviations of ``calibrateCameraExtended`` overstate the joint estimate's
+(they ignore that both devices see the same board poses), and a jackknife over poses with
+the intrinsics fixed understates the baseline's (its error comes mostly from the
+intrinsics). Errors common to all poses (a board printed at the wrong scale, a biased
+feature detector, an unmodelled lens) are not in it.
+
 Examples
 --------
 >>> from bistair.sim.boards import synthetic_views
@@ -36,7 +63,9 @@ import numpy as np
 
 from ..errors import BistairError
 from .board import Board
-from .calibration import Calibration, Device
+from .calibration import Calibration, Device, Uncertainty
+
+MIN_POSES = 3  # the fewest board poses that calibrate a pair (see the module's notes)
 
 
 def calibrate_points(object_points: Sequence[np.ndarray], camera_points: Sequence[np.ndarray],
@@ -54,7 +83,22 @@ def calibrate_points(object_points: Sequence[np.ndarray], camera_points: Sequenc
     fix_k3 : keep ``k3 = 0`` (advisable unless many well-spread poses).
     refine : after calibrating each device alone, refine all parameters jointly in
         ``cv2.stereoCalibrate``; otherwise the intrinsics stay fixed there.
+
+    Returns
+    -------
+    Calibration
+        With the per-pose errors and the :class:`~bistair.geometry.calibration.Uncertainty`
+        of every parameter (see the module's notes).
+
+    Raises
+    ------
+    BistairError
+        Fewer than :data:`MIN_POSES` poses, OpenCV failing, or poses that leave some
+        parameter undetermined.
     """
+    if len(object_points) < MIN_POSES:
+        raise BistairError(f"{len(object_points)} board poses cannot calibrate a camera and a "
+                           f"projector: at least {MIN_POSES} are needed")
     obj = [np.asarray(o, np.float32).reshape(-1, 3) for o in object_points]
     cam = [np.asarray(p, np.float32).reshape(-1, 2) for p in camera_points]
     proj = [np.asarray(p, np.float32).reshape(-1, 2) for p in projector_points]
@@ -85,10 +129,175 @@ def calibrate_points(object_points: Sequence[np.ndarray], camera_points: Sequenc
     poses = tuple({"name": name, "features": int(k), "camera_rms": float(np.sqrt(a / k)),
                    "projector_rms": float(np.sqrt(b / k))}
                   for name, a, b, k in zip(names, sc, sp, n, strict=True))
-    return Calibration(Device(*camera_size, kc, dc.ravel(), float(np.sqrt(sc.sum() / n.sum()))),
-                       Device(*projector_size, kp, dp.ravel(),
-                              float(np.sqrt(sp.sum() / n.sum()))),
-                       rot, t.ravel(), float(rms), poses)
+    cal = Calibration(Device(*camera_size, kc, dc.ravel(), float(np.sqrt(sc.sum() / n.sum()))),
+                      Device(*projector_size, kp, dp.ravel(),
+                             float(np.sqrt(sp.sum() / n.sum()))),
+                      rot, t.ravel(), float(rms), poses)
+    sigma = uncertainty(cal, obj, cam, proj, [np.ravel(r) for r in rvecs],
+                        [np.ravel(v) for v in tvecs], fix_k3=fix_k3, refine=refine)
+    return cal.replace(uncertainty=sigma)
+
+
+def uncertainty(cal: Calibration, object_points: Sequence[np.ndarray],
+                camera_points: Sequence[np.ndarray], projector_points: Sequence[np.ndarray],
+                rvecs: Sequence[np.ndarray], tvecs: Sequence[np.ndarray], fix_k3: bool = True,
+                refine: bool = True) -> Uncertainty:
+    """Standard deviations of a calibration's parameters from its correspondences.
+
+    Parameters
+    ----------
+    cal : the calibration (``X_p = R @ X_c + T``).
+    object_points, camera_points, projector_points : per pose, as for
+        :func:`calibrate_points`.
+    rvecs, tvecs : per pose, the board's pose in the camera frame (OpenCV vectors).
+    fix_k3 : ``k3`` was held at 0.
+    refine : all parameters were refined jointly (else each device's intrinsics come from
+        its own calibration and ``R, T`` from the pair with them fixed).
+
+    Returns
+    -------
+    Uncertainty
+        One standard deviation of each parameter, linearised at the solution, with the
+        correspondence noise estimated from the residuals of each device (see the module's
+        notes).
+
+    Raises
+    ------
+    BistairError
+        If the poses leave some parameter undetermined (a singular normal matrix).
+
+    Examples
+    --------
+    :func:`calibrate_points` calls it:
+
+    >>> from bistair.sim.boards import synthetic_views
+    >>> cam = Device(640, 480, [[800.0, 0, 320], [0, 800, 240], [0, 0, 1]])
+    >>> proj = Device(800, 600, [[1000.0, 0, 400], [0, 1000, 300], [0, 0, 1]])
+    >>> truth = Calibration(cam, proj, cv2.Rodrigues(np.array([0.0, 0.3, 0.0]))[0],
+    ...                     [-150.0, 0.0, 45.0])
+    >>> views = synthetic_views(truth, Board(columns=8, rows=6, spacing=15), 5,
+    ...                         np.random.default_rng(1), noise=0.1)
+    >>> cal = calibrate_points(*views, (640, 480), (800, 600))
+    >>> sigma = cal.uncertainty
+    >>> [0.08 < noise < 0.12 for noise in sigma.noise]  # the noise added, per coordinate
+    [True, True]
+    >>> bool(abs(cal.baseline - truth.baseline) < 3 * sigma.baseline)
+    True
+    """
+    n_int = 9 if not fix_k3 else 8  # fx, fy, cx, cy, k1, k2, p1, p2[, k3]
+    jac, own, res, on_cam = _jacobian(cal, object_points, camera_points, projector_points,
+                                      rvecs, tvecs, n_int)
+    if refine:
+        sens = _least_squares(jac)
+    else:  # each device alone, then R, T and the poses with the intrinsics fixed
+        cam_cols = np.r_[0:n_int, 2 * n_int + 6:jac.shape[1]]
+        alone = np.zeros((2 * n_int, len(res)))
+        alone[:n_int, on_cam] = _least_squares(jac[on_cam][:, cam_cols])[:n_int]
+        alone[n_int:, ~on_cam] = _least_squares(own)[:n_int]
+        rest = _least_squares(jac[:, 2 * n_int:])
+        sens = np.vstack([alone, rest + rest @ jac[:, :2 * n_int] @ alone])
+    # noise per device: solve for the variances that give the residual sums expected under
+    # the residual maker I + J M (its blocks' squared norms, from p x p products)
+    rows = (on_cam, ~on_cam)
+    normal = [jac[r].T @ jac[r] for r in rows]  # J_d^T J_d
+    gram = [np.ascontiguousarray(sens[:, r]) for r in rows]
+    gram = [m @ m.T for m in gram]  # M_d M_d^T
+    spread = np.array([[np.sum(normal[i] * gram[j]) for j in range(2)] for i in range(2)])
+    for i, r in enumerate(rows):
+        spread[i, i] += r.sum() + 2 * np.sum(jac[r] * sens[:, r].T)
+    sums = np.array([np.sum(res[r] ** 2) for r in rows])
+    var = np.linalg.solve(spread, sums)
+    var = np.where(var > 0, var, np.maximum(sums / np.diag(spread), 0.0))  # exact data
+    cov = var[0] * gram[0] + var[1] * gram[1]
+    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    devices = [np.append(sd[k * n_int:(k + 1) * n_int], np.zeros(9 - n_int)) for k in (0, 1)]
+    base = 2 * n_int
+    turn = _rotation_jacobian(cal.R)
+    rot_cov = turn @ cov[base:base + 3, base:base + 3] @ turn.T
+    t_cov = cov[base + 3:base + 6, base + 3:base + 6]
+    direction = cal.T / np.linalg.norm(cal.T)
+    return Uncertainty(devices[0], devices[1], np.rad2deg(np.sqrt(np.diag(rot_cov))),
+                       np.sqrt(np.diag(t_cov)), float(np.sqrt(direction @ t_cov @ direction)),
+                       tuple(float(v) for v in np.sqrt(var)))
+
+
+def _jacobian(cal: Calibration, object_points: Sequence[np.ndarray],
+              camera_points: Sequence[np.ndarray], projector_points: Sequence[np.ndarray],
+              rvecs: Sequence[np.ndarray], tvecs: Sequence[np.ndarray], n_int: int
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Jacobian of every reprojection of the stereo model and the residuals.
+
+    Parameters, in order: the camera's ``n_int`` intrinsics (``fx, fy, cx, cy, k1, ...``),
+    the projector's, the rotation vector of ``R``, ``T``, then per pose the board's rotation
+    and translation vectors in the camera frame. Returns the Jacobian (rows: every camera
+    coordinate, then every projector coordinate), the projector rows' Jacobian with respect
+    to the projector's intrinsics and its own per-pose board poses (the projector calibrated
+    alone), the residuals and which rows are the camera's.
+    """
+    n_poses = len(object_points)
+    width = 2 * n_int + 6 + 6 * n_poses
+    rvec = cv2.Rodrigues(cal.R)[0]
+    tvec = cal.T.reshape(3, 1)
+    cam_rows, proj_rows, own_rows, cam_res, proj_res = [], [], [], [], []
+    for i, (obj, c, p, rv, tv) in enumerate(zip(object_points, camera_points, projector_points,
+                                                rvecs, tvecs, strict=True)):
+        obj = np.asarray(obj, float).reshape(-1, 3)
+        pose = slice(2 * n_int + 6 + 6 * i, 2 * n_int + 12 + 6 * i)
+        rv, tv = np.asarray(rv, float).reshape(3, 1), np.asarray(tv, float).reshape(3, 1)
+        pc, jc = cv2.projectPoints(obj, rv, tv, cal.camera.K, cal.camera.dist)
+        rows = np.zeros((len(jc), width))
+        rows[:, :n_int] = jc[:, 6:6 + n_int]
+        rows[:, pose] = jc[:, :6]
+        cam_rows.append(rows)
+        cam_res.append(pc.reshape(-1) - np.asarray(c, float).reshape(-1))
+        # projector pose: R_p = R @ R_c, t_p = R @ t_c + T
+        rp, tp, dr_drc, _, dr_dr, _, dt_drc, dt_dtc, dt_dr, dt_dt = cv2.composeRT(rv, tv, rvec,
+                                                                                   tvec)
+        pp, jp = cv2.projectPoints(obj, rp, tp, cal.projector.K, cal.projector.dist)
+        jr, jt = jp[:, :3], jp[:, 3:6]
+        rows = np.zeros((len(jp), width))
+        rows[:, n_int:2 * n_int] = jp[:, 6:6 + n_int]
+        rows[:, 2 * n_int:2 * n_int + 3] = jr @ dr_dr + jt @ dt_dr
+        rows[:, 2 * n_int + 3:2 * n_int + 6] = jt @ dt_dt
+        rows[:, pose] = np.hstack([jr @ dr_drc + jt @ dt_drc, jt @ dt_dtc])
+        proj_rows.append(rows)
+        own = np.zeros((len(jp), n_int + 6 * n_poses))
+        own[:, :n_int] = jp[:, 6:6 + n_int]
+        own[:, n_int + 6 * i:n_int + 6 * i + 6] = jp[:, :6]
+        own_rows.append(own)
+        proj_res.append(pp.reshape(-1) - np.asarray(p, float).reshape(-1))
+    jac = np.vstack(cam_rows + proj_rows)
+    res = np.concatenate(cam_res + proj_res)
+    on_cam = np.arange(len(res)) < sum(len(r) for r in cam_res)
+    return jac, np.vstack(own_rows), res, on_cam
+
+
+def _least_squares(jac: np.ndarray) -> np.ndarray:
+    """``-(J^T J)^-1 J^T``: how a least-squares fit's parameters follow its data's errors.
+
+    Raises :class:`BistairError` if some parameter is not determined."""
+    scale = np.linalg.norm(jac, axis=0)
+    if not (scale > 0).all():
+        raise BistairError("the board poses leave some calibration parameter undetermined")
+    scaled = jac / scale
+    normal = scaled.T @ scaled
+    if np.linalg.cond(normal) > 1e13:
+        raise BistairError("the board poses leave the calibration undetermined: tilt the board "
+                           "differently in each pose and cover the image corners")
+    return -np.linalg.solve(normal, scaled.T) / scale[:, None]
+
+
+def _rotation_jacobian(rot: np.ndarray, step: float = 1e-6) -> np.ndarray:
+    """How the rotation error ``w`` (``R_true = exp([w]x) @ R``) follows the rotation vector
+    of ``R`` (central differences; ``w`` read from the skew part of the small turn)."""
+    base = cv2.Rodrigues(rot)[0].ravel()
+    out = np.empty((3, 3))
+    for k in range(3):
+        turn = [cv2.Rodrigues(base + sign * step * np.eye(3)[k])[0] @ rot.T for sign in (1, -1)]
+        diff = (turn[0] - turn[1]) / (2 * step)
+        out[:, k] = 0.5 * np.array([diff[2, 1] - diff[1, 2], diff[0, 2] - diff[2, 0],
+                                    diff[1, 0] - diff[0, 1]])
+    return out
 
 
 def sample_local(values: np.ndarray, points: np.ndarray, radius: int, min_pixels: int = 12,
@@ -172,14 +381,32 @@ def feature_spacing(points: np.ndarray, columns: int) -> float:
 
 
 def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
-                    projector_size: tuple[int, int], min_poses: int = 3,
+                    projector_size: tuple[int, int], min_poses: int = MIN_POSES,
                     min_mapped: float = 0.5, **options: Any) -> Calibration:
     """Detect the board, map its features through the phases and calibrate
     (:func:`calibrate_points`; ``options`` go there).
 
-    A pose is used when the board is found in its white frame and at least ``min_mapped`` of
-    its features get projector coordinates in both orientations.
+    Parameters
+    ----------
+    poses : the captures of every pose.
+    board : the board they show.
+    projector_size : ``(width, height)``.
+    min_poses : the fewest usable poses to calibrate from (at least :data:`MIN_POSES`).
+    min_mapped : a pose is used when the board is found in its white frame and at least
+        this share of its features get projector coordinates in both orientations.
+
+    Returns
+    -------
+    Calibration
+        With the board and the number of poses given.
+
+    Raises
+    ------
+    BistairError
+        ``min_poses`` below :data:`MIN_POSES`, images of different sizes, fewer than
+        ``min_poses`` poses with the board found and mapped, or a failed calibration.
     """
+    check_min_poses(min_poses)
     if not poses:
         raise BistairError("no calibration poses")
     size = poses[0].white.shape
@@ -214,5 +441,21 @@ def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
                            "valid on the board?)")
     cal = calibrate_points(obj, cam, proj, (size[1], size[0]), projector_size, names,
                            **options)
-    return Calibration(cal.camera, cal.projector, cal.R, cal.T, cal.rms, cal.poses,
-                       board.to_dict(), len(poses))
+    return cal.replace(board=board.to_dict(), poses_total=len(poses))
+
+
+def check_min_poses(min_poses: int) -> None:
+    """Refuse a pose minimum below :data:`MIN_POSES`.
+
+    Examples
+    --------
+    >>> check_min_poses(1)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: min_poses 1 is too few: a camera-projector calibration ...
+    """
+    if isinstance(min_poses, bool) or not isinstance(min_poses, int | np.integer):
+        raise BistairError(f"min_poses must be a whole number, got {min_poses!r}")
+    if min_poses < MIN_POSES:
+        raise BistairError(f"min_poses {min_poses} is too few: a camera-projector calibration "
+                           f"needs at least {MIN_POSES} board poses")

@@ -12,7 +12,15 @@ Calibration file (JSON, :func:`save_calibration`)::
      "projector": {... the same, for the projector ...},
      "R": 3x3, "T": [tx, ty, tz], "baseline": |T| (mm), "rms": stereo RMS (px),
      "poses": [{"name": ..., "features": n, "camera_rms": px, "projector_rms": px}, ...],
-     "poses_used": n, "poses_total": m, "board": {...}}
+     "poses_used": n, "poses_total": m, "board": {...},
+     "uncertainty": {"camera": {"fx": px, "fy": px, "cx": px, "cy": px, "dist": [5 numbers]},
+                     "projector": {... the same ...}, "rotation_deg": [3 numbers],
+                     "T": [3 numbers] (mm), "baseline": mm,
+                     "noise": {"camera": px, "projector": px}}}
+
+``"uncertainty"`` holds one standard deviation of each calibrated quantity
+(:class:`Uncertainty`, from :func:`bistair.geometry.calibrate.calibrate_points`); it is
+``null`` or absent in files from elsewhere.
 
 Examples
 --------
@@ -23,11 +31,18 @@ Examples
 (150.0, [0.1, 0.0, 0.0, 0.0, 0.0])
 >>> Calibration.from_dict(cal.to_dict()).T.tolist()
 [-150.0, 0.0, 0.0]
+>>> sigma = Uncertainty(np.full(9, 0.5), np.full(9, 0.7), [0.01, 0.02, 0.02], [0.1, 0.1, 0.3],
+...                     0.12, (0.1, 0.15))
+>>> back = Calibration.from_dict(cal.replace(uncertainty=sigma).to_dict()).uncertainty
+>>> back.baseline, round(back.angle, 4), back.projector[:4].tolist()
+(0.12, 0.03, [0.7, 0.7, 0.7, 0.7])
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -72,6 +87,79 @@ class Device:
                 "dist": self.dist.tolist(), "rms": self.rms}
 
 
+INTRINSICS = ("fx", "fy", "cx", "cy")
+
+
+@dataclass(frozen=True, eq=False)
+class Uncertainty:
+    """One standard deviation of each quantity of a calibration.
+
+    ``camera`` and ``projector`` hold ``(fx, fy, cx, cy)`` in pixels then the distortion
+    ``(k1, k2, p1, p2, k3)`` (0 for a coefficient held fixed); ``rotation`` the rotation
+    error of ``R`` about the projector's x, y and z axes (degrees); ``T`` its components and
+    ``baseline`` its length (mm); ``noise`` the correspondence noise (standard deviation per
+    image coordinate, pixels) that the residuals show in the camera and in the projector,
+    which the deviations are scaled by.
+    """
+
+    camera: np.ndarray
+    projector: np.ndarray
+    rotation: np.ndarray
+    T: np.ndarray
+    baseline: float
+    noise: tuple[float, float] = (math.nan, math.nan)
+
+    def __post_init__(self) -> None:
+        for name, size in (("camera", 9), ("projector", 9), ("rotation", 3), ("T", 3)):
+            object.__setattr__(self, name, np.asarray(getattr(self, name), float).reshape(size))
+        object.__setattr__(self, "baseline", float(self.baseline))
+        object.__setattr__(self, "noise", tuple(float(v) for v in self.noise))
+
+    @property
+    def angle(self) -> float:
+        """Root-mean-square angle of the rotation error (degrees)."""
+        return float(np.linalg.norm(self.rotation))
+
+    def to_dict(self) -> dict[str, Any]:
+        def device(sd: np.ndarray) -> dict[str, Any]:
+            return {**dict(zip(INTRINSICS, map(float, sd[:4]), strict=True)),
+                    "dist": sd[4:].tolist()}
+
+        return {"camera": device(self.camera), "projector": device(self.projector),
+                "rotation_deg": self.rotation.tolist(), "T": self.T.tolist(),
+                "baseline": self.baseline,
+                "noise": {name: value if math.isfinite(value) else None
+                          for name, value in zip(("camera", "projector"), self.noise,
+                                                 strict=True)}}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Uncertainty:
+        """Validate and build from the ``"uncertainty"`` object of a calibration file."""
+        where = "uncertainty."
+        if not isinstance(data, Mapping):
+            raise BistairError("calibration field 'uncertainty' must be an object or null")
+        devices = []
+        for name in ("camera", "projector"):
+            dev = data.get(name)
+            if not isinstance(dev, Mapping):
+                raise BistairError(f"calibration misses the object '{where}{name}'")
+            devices.append(np.array([*(_sigma(dev, k, ((),), f"{where}{name}.")
+                                       for k in INTRINSICS),
+                                     *_sigma(dev, "dist", ((5,),), f"{where}{name}.")]))
+        noise = data.get("noise")
+        noise = noise if isinstance(noise, Mapping) else {}
+        return cls(*devices, _sigma(data, "rotation_deg", ((3,),), where),
+                   _sigma(data, "T", ((3,),), where),
+                   float(_sigma(data, "baseline", ((),), where)),
+                   tuple(_number_or_nan(noise.get(name)) for name in ("camera", "projector")))
+
+
+def _number_or_nan(value: Any) -> float:
+    """A number from a file, NaN for anything else (JSON has no NaN: null stands for it)."""
+    ok = isinstance(value, int | float) and not isinstance(value, bool)
+    return float(value) if ok else math.nan
+
+
 @dataclass(frozen=True, eq=False)
 class Calibration:
     """A calibrated camera and projector; ``X_p = R @ X_c + T`` (mm)."""
@@ -84,6 +172,7 @@ class Calibration:
     poses: tuple[dict[str, Any], ...] = ()
     board: dict[str, Any] | None = None
     poses_total: int | None = None
+    uncertainty: Uncertainty | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "R", np.asarray(self.R, float).reshape(3, 3))
@@ -93,6 +182,10 @@ class Calibration:
     def baseline(self) -> float:
         """Distance between the camera and projector centres (mm)."""
         return float(np.linalg.norm(self.T))
+
+    def replace(self, **changes: Any) -> Calibration:
+        """A copy with some fields changed."""
+        return dataclasses.replace(self, **changes)
 
     @classmethod
     def from_rig(cls, rig: Any) -> Calibration:
@@ -108,7 +201,8 @@ class Calibration:
                 "projector": self.projector.to_dict(), "R": self.R.tolist(),
                 "T": self.T.tolist(), "baseline": self.baseline, "rms": self.rms,
                 "poses": list(self.poses), "poses_used": len(self.poses),
-                "poses_total": self.poses_total, "board": self.board}
+                "poses_total": self.poses_total, "board": self.board,
+                "uncertainty": None if self.uncertainty is None else self.uncertainty.to_dict()}
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Calibration:
@@ -121,8 +215,10 @@ class Calibration:
         rot = _array(data, "R", ((3, 3),))
         if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) or np.linalg.det(rot) < 0:
             raise BistairError("calibration field 'R' is not a rotation matrix")
+        sigma = data.get("uncertainty")
         return cls(*devices, rot, _array(data, "T", ((3,),)), data.get("rms"),
-                   tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"))
+                   tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"),
+                   None if sigma is None else Uncertainty.from_dict(sigma))
 
 
 def _array(data: Mapping[str, Any], key: str, shapes: tuple[tuple[int, ...], ...],
@@ -137,6 +233,15 @@ def _array(data: Mapping[str, Any], key: str, shapes: tuple[tuple[int, ...], ...
     if arr.shape not in shapes or not np.isfinite(arr).all():
         want = " or ".join("x".join(map(str, s)) or "1" for s in shapes)
         raise BistairError(f"calibration field '{where}{key}' must be {want} finite number(s)")
+    return arr
+
+
+def _sigma(data: Mapping[str, Any], key: str, shapes: tuple[tuple[int, ...], ...],
+           where: str) -> np.ndarray:
+    """The field ``key`` as standard deviations: finite and not negative."""
+    arr = _array(data, key, shapes, where)
+    if (arr < 0).any():
+        raise BistairError(f"calibration field '{where}{key}' must not be negative")
     return arr
 
 

@@ -27,6 +27,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -35,6 +36,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.captures import to_bit_depth
+from ..errors import BistairError
 from .rig import Rig, dot
 from .shapes import Scene
 from .truth import Truth
@@ -72,6 +74,10 @@ class Imaging:
     - ``bits``: 8 gives uint8 codes, 10/12/14/16 uint16 codes, ``None`` float32 without
       quantisation; ``float_output`` returns the codes divided by full scale as float32.
     - ``seed``: the noise generator's seed.
+
+    Every field is checked when the object is made: a value outside its range (a negative
+    noise, a NaN blur, a gamma of 0, unknown bits, ...) raises
+    :class:`~bistair.errors.BistairError` with one line naming the field.
     """
 
     gamma: float = 2.2
@@ -92,12 +98,73 @@ class Imaging:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.bits not in (None, 8, 10, 12, 14, 16):
-            raise ValueError(f"bits must be 8, 10, 12, 14, 16 or None, got {self.bits}")
+        """Refuse parameters that cannot form an image.
+
+        Raises
+        ------
+        BistairError
+            One line naming the field (a ``ValueError``).
+
+        Examples
+        --------
+        >>> Imaging(read_noise=-0.01)  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        bistair.errors.BistairError: read noise (read_noise) must be a finite number of at least ...
+        """
+        for name, low, strict in _NUMBERS:
+            _check_number(name, getattr(self, name), low, strict)
+        if self.max_incidence_deg > 90:
+            raise BistairError(f"incidence limit (max_incidence_deg) must be at most 90 degrees, "
+                               f"got {self.max_incidence_deg}")
+        if self.bits is not None and _whole(self.bits) not in (8, 10, 12, 14, 16):
+            raise BistairError(f"camera bits (bits) must be 8, 10, 12, 14, 16 or None, got "
+                               f"{self.bits!r}")
+        wholes = (("projector_bits", "projector bits", 1, 16, True),
+                  ("supersample", "sub-rays per pixel side", 1, 16, False),
+                  ("edge_margin", "edge margin", 0, None, True), ("seed", "seed", 0, None, False))
+        for name, label, low, high, optional in wholes:
+            value = getattr(self, name)
+            number = _whole(value)
+            if optional and value is None:
+                continue
+            if number is None or number < low or (high is not None and number > high):
+                span = f"from {low} to {high}" if high is not None else f"of at least {low}"
+                named = label if label == name else f"{label} ({name})"
+                raise BistairError(f"{named} must be a whole number {span}"
+                                   f"{' or None' if optional else ''}, got {value!r}")
         if self.projector_sampling not in ("nearest", "linear"):
-            raise ValueError("projector_sampling must be 'nearest' or 'linear'")
-        if self.supersample < 1:
-            raise ValueError("supersample must be at least 1")
+            raise BistairError(f"projector_sampling must be 'nearest' or 'linear', got "
+                               f"{self.projector_sampling!r}")
+        for name in ("float_output", "inverse_square"):
+            if not isinstance(getattr(self, name), bool | np.bool_):
+                raise BistairError(f"{name} must be True or False, got {getattr(self, name)!r}")
+
+
+# the numbers of Imaging: field, lowest value, whether it is excluded
+_NUMBERS = (("gamma", 0.0, True), ("ambient", 0.0, False), ("exposure", 0.0, True),
+            ("read_noise", 0.0, False), ("full_well", 0.0, False), ("camera_blur", 0.0, False),
+            ("projector_blur", 0.0, False), ("max_incidence_deg", 0.0, True))
+_LABELS = {"gamma": "projector gamma", "ambient": "ambient light", "exposure": "exposure",
+           "read_noise": "read noise", "full_well": "full well", "camera_blur": "camera blur",
+           "projector_blur": "projector blur", "max_incidence_deg": "incidence limit"}
+
+
+def _check_number(name: str, value: object, low: float, strict: bool) -> None:
+    """Refuse an Imaging number that is not finite or lies below ``low`` (or at it)."""
+    ok = (isinstance(value, int | float | np.number) and not isinstance(value, bool)
+          and math.isfinite(value) and (value > low if strict else value >= low))
+    if not ok:
+        bound = f"above {low:g}" if strict else f"of at least {low:g}"
+        raise BistairError(f"{_LABELS[name]} ({name}) must be a finite number {bound}, got "
+                           f"{value!r}")
+
+
+def _whole(value: object) -> int | None:
+    """``value`` as an int if it is a whole number (not a bool), else None."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | np.integer):
+        return None
+    return int(value)
 
 
 @dataclass(frozen=True, eq=False)

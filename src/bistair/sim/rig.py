@@ -25,6 +25,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..errors import BistairError
+
 _NO_DIST = (0.0, 0.0, 0.0, 0.0, 0.0)
 _EYE = np.eye(3)
 
@@ -93,6 +95,40 @@ def undistort(xd: np.ndarray, yd: np.ndarray, dist: Sequence[float],
         if max(np.abs(ex).max(initial=0.0), np.abs(ey).max(initial=0.0)) < 1e-15:
             break
     return x, y
+
+
+MIN_SIDE, MAX_SIDE = 8, 8192  # pixels per side of a simulated device
+
+
+def check_size(size: Sequence[int], device: str = "camera") -> tuple[int, int]:
+    """A simulated device's ``(width, height)``: whole numbers of pixels from
+    :data:`MIN_SIDE` (what a decode needs) to :data:`MAX_SIDE` per side (ray tracing takes
+    about 150 bytes per pixel: 8192 x 8192 needs some 10 GB).
+
+    Raises
+    ------
+    BistairError
+        If ``size`` is not two whole numbers in that range.
+
+    Examples
+    --------
+    >>> check_size((640, 512))
+    (640, 512)
+    >>> check_size((0, 0))
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: camera size 0x0 must be 8 to 8192 whole pixels per side
+    """
+    try:
+        width, height = size
+    except (TypeError, ValueError):
+        raise BistairError(f"{device} size must be (width, height), got {size!r}") from None
+    sides = [v if isinstance(v, int | np.integer) and not isinstance(v, bool) else None
+             for v in (width, height)]
+    if any(v is None or not MIN_SIDE <= v <= MAX_SIDE for v in sides):
+        raise BistairError(f"{device} size {width}x{height} must be {MIN_SIDE} to {MAX_SIDE} whole "
+                           "pixels per side")
+    return int(width), int(height)
 
 
 @dataclass(frozen=True, eq=False)
@@ -242,8 +278,8 @@ class Rig:
         camera_dist, projector_dist : OpenCV ``(k1, k2, p1, p2, k3)``.
         projector_principal : ``(cx, cy)``, default the image centre.
         """
-        cw, ch = camera_size
-        pw, ph = projector_size
+        cw, ch = check_size(camera_size, "camera")
+        pw, ph = check_size(projector_size, "projector")
         fc = 1.875 * cw if camera_focal is None else float(camera_focal)
         camera = Camera(cw, ch, fc, fc, (cw - 1) / 2, (ch - 1) / 2, tuple(camera_dist))
         if convergence_deg is None:

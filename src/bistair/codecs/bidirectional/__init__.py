@@ -81,6 +81,7 @@ class BidirectionalSpec(PeriodSpec):
         return (*self.shift_frames(), "stair-cos", "stair-sin")
 
     def validate(self) -> None:
+        """Each int field's own range first, then how the fields fit together."""
         super().validate()
         if self.stairs < 2:
             raise BistairError(f"stairs must be at least 2, got {self.stairs}")
@@ -89,28 +90,31 @@ class BidirectionalSpec(PeriodSpec):
                 f"partitions must be at least 2 (use phase-coding for one stair), got "
                 f"{self.partitions}"
             )
-        if max(self.stairs, self.partitions) > 32:
-            raise BistairError("stairs and partitions above 32 leave too little phase per level")
-        span = self.partitions * self.stairs * self.period
-        if span < self.coded_length:
+        for name in ("stairs", "partitions"):
+            if getattr(self, name) > 32:
+                raise BistairError(f"{name} must be at most 32 (more levels leave too little "
+                                   f"phase per level), got {getattr(self, name)}")
+        if not 3 <= self.group_rows <= self.other_length:
             raise BistairError(
-                f"partitions*stairs*period = {self.partitions}*{self.stairs}*"
-                f"{format_period(self.period)} = {format_period(span)} px is narrower than the "
-                f"{self.coded_length}-px coded axis"
+                f"group rows must lie in 3..{self.other_length} (the projector's "
+                f"{'width' if self.orientation == 'rows' else 'height'}), got {self.group_rows}"
             )
         if not 1 <= self.local_rows < self.group_rows:
             raise BistairError(
-                f"local rows must lie in 1..{self.group_rows - 1} (group rows "
-                f"{self.group_rows}), got {self.local_rows}"
+                f"local rows must lie in 1..{self.group_rows - 1} (fewer than the "
+                f"{self.group_rows} group rows), got {self.local_rows}"
             )
         if 2 * self.local_rows == self.group_rows:
             raise BistairError(
                 f"local rows ({self.local_rows}) equal partition rows "
                 f"({self.group_rows - self.local_rows}): the bands could not be told apart"
             )
-        if self.group_rows < 3 or self.group_rows > self.other_length:
+        span = self.partitions * self.stairs * self.period
+        if span < self.coded_length:
             raise BistairError(
-                f"group rows must lie in 3..{self.other_length}, got {self.group_rows}"
+                f"partitions*stairs*period = {self.partitions}*{self.stairs}*"
+                f"{format_period(self.period)} = {format_period(span)} px is narrower than the "
+                f"{self.coded_length}-px coded axis"
             )
 
 

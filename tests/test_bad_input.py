@@ -1,0 +1,168 @@
+"""Every refusal of the command line in one table: (arguments, fragment of the message).
+
+Each row runs ``bistair`` in-process and must exit with code 2, print exactly one non-empty
+line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
+uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
+patterns with their spec (they decode) and ``{poses}`` for calibration captures of two poses
+that show no board.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from conftest import cli_run
+
+import bistair
+from bistair.app.jobs import save_patterns
+from bistair.io.files import write_image
+
+SIM = ["simulate", "--scene", "plane", "--method", "graycode", "--out", "{out}"]
+BIDI = ["patterns", "bidirectional", "--out", "{out}"]
+DECODE = ["decode", "{pats}", "--out", "{out}"]
+CALIBRATE = ["calibrate", "{poses}", "--out", "{out}"]
+
+ROWS = [
+    # simulate: camera size, every imaging option, scene and method
+    (SIM + ["--camera", "0x0"], "camera size 0x0 must be 8 to 8192 whole pixels per side"),
+    (SIM + ["--camera", "-5x10"], "camera size -5x10 must be 8 to 8192 whole pixels per side"),
+    (SIM + ["--camera", "100000x100000"], "camera size 100000x100000 must be 8 to 8192 whole"),
+    (SIM + ["--camera", "640"], "expected WIDTHxHEIGHT, e.g. 1280x1024"),
+    (SIM + ["--noise", "-1"], "read noise (read_noise) must be a finite number of at least 0, "
+                              "got -1.0"),
+    (SIM + ["--noise", "nan"], "read noise (read_noise) must be a finite number of at least 0, "
+                               "got nan"),
+    (SIM + ["--blur", "-1"], "camera blur (camera_blur) must be a finite number of at least 0"),
+    (SIM + ["--blur", "inf"], "camera blur (camera_blur) must be a finite number of at least 0"),
+    (SIM + ["--ambient", "nan"], "ambient light (ambient) must be a finite number of at least 0"),
+    (SIM + ["--ambient", "-0.5"], "ambient light (ambient) must be a finite number of at least"),
+    (SIM + ["--gamma", "0"], "projector gamma (gamma) must be a finite number above 0, got 0.0"),
+    (SIM + ["--gamma", "-1", "--uncompensated"], "projector gamma (gamma) must be a finite "
+                                                 "number above 0, got -1.0"),
+    (SIM + ["--gamma", "9"], "patterns cannot pre-compensate a projector gamma of 9"),
+    (SIM + ["--bits", "7"], "Invalid value for '--bits': '7' is not one of"),
+    (SIM + ["--seed", "-1"], "seed must be a whole number of at least 0, got -1"),
+    (["simulate", "--scene", "calibration", "--method", "multifreq", "--camera", "4x4",
+      "--out", "{out}"], "camera size 4x4 must be 8 to 8192 whole pixels per side"),
+    (["simulate", "--scene", "moon", "--method", "all", "--out", "{out}"],
+     "unknown scene 'moon'"),
+    (["simulate", "--scene", "plane", "--method", "fourier", "--out", "{out}"],
+     "unknown method(s) fourier"),
+    # demo
+    (["demo", "--camera", "0x0", "--out", "{out}"], "camera size 0x0 must be 8 to 8192 whole"),
+    (["demo", "--seed", "-1", "--out", "{out}"], "seed must be a whole number of at least 0"),
+    # decode --min-modulation: a fraction of full scale, strictly between 0 and 1
+    (DECODE + ["--min-modulation", "-1"], "the minimum modulation must lie between 0 and 1 "
+                                          "(a fraction of full scale), got -1.0"),
+    (DECODE + ["--min-modulation", "0"], "the minimum modulation must lie between 0 and 1"),
+    (DECODE + ["--min-modulation", "1"], "the minimum modulation must lie between 0 and 1"),
+    (DECODE + ["--min-modulation", "2"], "the minimum modulation must lie between 0 and 1 "
+                                         "(a fraction of full scale), got 2.0"),
+    (DECODE + ["--min-modulation", "nan"], "the minimum modulation must lie between 0 and 1 "
+                                           "(a fraction of full scale), got nan"),
+    (DECODE + ["--min-modulation", "0.9"], "no pixel has the minimum modulation 0.9 asked for "
+                                           "(the most is 0.5"),
+    # calibrate: at least 3 poses, asked for and usable
+    (CALIBRATE + ["--min-poses", "1"], "--min-poses 1 is too few: a camera-projector "
+                                       "calibration needs at least 3 board poses"),
+    (CALIBRATE + ["--min-poses", "2"], "--min-poses 2 is too few"),
+    (CALIBRATE + ["--min-poses", "-3"], "--min-poses -3 is too few"),
+    (CALIBRATE, "board found in 0 of 2 poses, need at least 3"),
+    # patterns: each field's own range before it enters another field's message
+    (BIDI + ["--group-rows", "0"], "group rows must lie in 3..1080 (the projector's height), "
+                                   "got 0"),
+    (BIDI + ["--group-rows", "2"], "group rows must lie in 3..1080"),
+    (BIDI + ["--group-rows", "5000"], "group rows must lie in 3..1080"),
+    (BIDI + ["--orientation", "rows", "--width", "400", "--group-rows", "500"],
+     "group rows must lie in 3..400 (the projector's width), got 500"),
+    (BIDI + ["--local-rows", "0"], "local rows must lie in 1..29 (fewer than the 30 group "
+                                   "rows), got 0"),
+    (BIDI + ["--group-rows", "12", "--local-rows", "12"], "local rows must lie in 1..11"),
+    (BIDI + ["--local-rows", "15"], "local rows (15) equal partition rows (15)"),
+    (BIDI + ["--stairs", "1"], "stairs must be at least 2, got 1"),
+    (BIDI + ["--stairs", "1", "--partitions", "40"], "stairs must be at least 2, got 1"),
+    (BIDI + ["--partitions", "40"], "partitions must be at most 32"),
+    (BIDI + ["--partitions", "0"], "partitions must be at least 2 (use phase-coding for one "
+                                   "stair), got 0"),
+    (BIDI + ["--period", "29"], "narrower than the 1080-px coded axis"),
+    (BIDI + ["--period", "3"], "period must be at least 4 projector pixels, got 3.0"),
+    (BIDI + ["--period", "nan"], "spec field 'period' must be a number, got 'nan'"),
+    (BIDI + ["--width", "0"], "projector size 0x1080 is too small (at least 8x8)"),
+    (BIDI + ["--height", "-5"], "projector size 1080x-5 is too small (at least 8x8)"),
+    (BIDI + ["--steps", "2"], "steps must be at least 3, got 2"),
+    (BIDI + ["--offset", "0.8"], "offset 0.8 and amplitude 0.5 must satisfy"),
+    (BIDI + ["--gamma", "9"], "gamma must lie in [0.2, 5], got 9.0"),
+    (BIDI + ["--bits", "12"], "Invalid value for '--bits': '12' is not one of '8', '16'"),
+    (["patterns", "lv", "--levels", "1", "--out", "{out}"], "levels must lie in 2..32 (more "
+                                                           "leave too little phase per level)"),
+    (["patterns", "lv", "--levels", "40", "--out", "{out}"], "levels must lie in 2..32"),
+    (["patterns", "lv", "--window", "1", "--out", "{out}"], "window must lie in 2..36 (the "
+                                                           "fringes across the coded axis)"),
+    (["patterns", "lv", "--window", "50", "--out", "{out}"], "window must lie in 2..36"),
+    (["patterns", "lv", "--levels", "3", "--out", "{out}"], "36 fringes need more than 3 "
+                                                           "levels for unique 4-code windows"),
+    (["patterns", "lv", "--period", "1080", "--out", "{out}"], "a 1080-px period leaves fewer "
+                                                              "than 2 fringes"),
+    (["patterns", "phase-coding", "--period", "1080", "--out", "{out}"],
+     "a 1080-px period leaves fewer than 2 fringes"),
+    (["patterns", "phase-coding", "--form", "triple", "--out", "{out}"],
+     "Invalid value for '--form'"),
+    (["patterns", "graycode", "--complementary", "2", "--out", "{out}"],
+     "Invalid value for '--complementary'"),
+    (["patterns", "graycode", "--second-period", "3", "--out", "{out}"],
+     "second_period must be 0 (none) or at least 4 projector pixels, got 3.0"),
+    (["patterns", "graycode", "--second-period", "15", "--out", "{out}"],
+     "period / second_period = 2.000 is too close to a whole number"),
+    (["patterns", "multifreq", "--periods", "0", "--out", "{out}"],
+     "periods must be finite and at least 4 projector pixels, got (0)"),
+    (["patterns", "multifreq", "--periods", "1080,30,30", "--out", "{out}"],
+     "periods must differ"),
+    (["patterns", "multifreq", "--periods", "1080,inf", "--out", "{out}"],
+     "spec field 'periods' must be a number, got 'inf'"),
+    (["patterns", "multifreq", "--periods", "180,30", "--unwrap", "hierarchical", "--out",
+      "{out}"], "hierarchical unwrapping needs a period covering the 1080-px axis"),
+]
+
+
+@pytest.fixture(scope="module")
+def inputs(tmp_path_factory):
+    """A decodable folder of graycode patterns and two calibration poses without a board."""
+    root = tmp_path_factory.mktemp("inputs")
+    save_patterns(bistair.make_spec("graycode", width=64, height=48, period=16), root / "pats")
+    (root / "poses").mkdir()
+    (root / "poses" / "board.json").write_text(json.dumps(
+        {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20.0}))
+    for orientation in ("columns", "rows"):
+        spec = bistair.make_spec("multifreq", width=96, height=64, periods=(96, 16),
+                                 orientation=orientation, white=1)
+        images = np.round(bistair.encode(spec) * 200 + 20).astype(np.uint8)
+        for pose in ("pose-00", "pose-01"):
+            folder = root / "poses" / pose / orientation
+            folder.mkdir(parents=True)
+            for i, image in enumerate(images):
+                write_image(folder / f"{i:02d}.png", image)
+            (folder / "spec.json").write_text(spec.to_json())
+    return root
+
+
+def row_id(args: list[str]) -> str:
+    """The command and the options that make the row (not the common ones)."""
+    for common in (SIM, BIDI, DECODE, CALIBRATE):
+        if args[:len(common)] == common:
+            args = [*common[:2 if common is BIDI else 1], *args[len(common):]]
+            break
+    return " ".join(a for a in args if "{" not in a and a != "--out")
+
+
+@pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
+def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
+    out = tmp_path / "out"
+    paths = {"out": out, "pats": inputs / "pats", "poses": inputs / "poses"}
+    code, _, err = cli_run(monkeypatch, capsys, *(a.format(**paths) for a in args))
+    lines = [line for line in err.splitlines() if line.strip()]
+    assert code == 2, err
+    assert len(lines) == 1 and lines[0].startswith("Error: "), err
+    assert message in lines[0], lines[0]
+    assert not out.exists()
