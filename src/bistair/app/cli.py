@@ -69,14 +69,19 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
             if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
                 opt.update(is_flag=False, flag_value="1")
         params.append(click.Option([f"--{f.name.replace('_', '-')}", f.name], **opt))
+    params.append(click.Option(["--gamma-file"], type=click.Path(path_type=Path), default=None,
+                               help="gamma.json from 'bistair gamma': pre-compensate the "
+                               "measured projector gamma (instead of --gamma)"))
     params.append(click.Option(["--out", "-o"], required=True, type=click.Path(path_type=Path),
                                help="output folder"))
 
     @reports_errors
-    def callback(out: Path, **values: Any) -> None:
-        from .jobs import save_patterns
+    def callback(out: Path, gamma_file: Path | None, **values: Any) -> None:
+        from .jobs import read_gamma, save_patterns
 
         values = {key: coerce_field(fields[key], value) for key, value in values.items()}
+        if gamma_file is not None:
+            values["gamma"] = read_gamma(gamma_file)
         spec = spec_class(**values)
         save_patterns(spec, out)
         click.echo(f"wrote {spec.frame_count} {name} patterns and spec.json to {out}")
@@ -91,6 +96,41 @@ def _show(value: Any) -> str:
 
 for _codec in REGISTRY.values():
     patterns.add_command(_spec_command(_codec.name, _codec.spec_class, _codec.summary))
+
+
+@patterns.command("gamma")
+@click.option("--width", type=int, default=1080, show_default=True,
+              help="projector width in pixels")
+@click.option("--height", type=int, default=1080, show_default=True,
+              help="projector height in pixels")
+@click.option("--levels", type=int, default=17, show_default=True,
+              help="grey levels from black to white")
+@click.option("--bits", type=click.Choice(["8", "16"]), default="8", show_default=True)
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder")
+@reports_errors
+def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -> None:
+    """A ramp of uniform grey frames (NN.png and ramp.json) for 'bistair gamma'."""
+    from .jobs import save_ramp
+
+    save_ramp(width, height, levels, int(bits), out)
+    click.echo(f"wrote {levels} grey frames and ramp.json to {out}")
+
+
+@cli.command()
+@click.argument("captures", nargs=-1, required=True)
+@click.option("--ramp", type=click.Path(path_type=Path), default=None,
+              help="ramp.json of the grey frames [default: ramp.json in the captures' folder]")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="gamma file to write (JSON)")
+@reports_errors
+def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
+    """Measure the projector's gamma from captures of 'bistair patterns gamma'."""
+    from .jobs import measure_gamma
+
+    fit = measure_gamma(list(captures), out, ramp)
+    click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
+               f"{len(fit.levels)} levels, {fit.pixels} pixels); wrote {out}")
 
 
 @cli.command()

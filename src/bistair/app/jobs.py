@@ -26,7 +26,8 @@ from typing import Any
 import numpy as np
 
 from ..codecs import decode, encode
-from ..core.captures import to_bit_depth
+from ..core.captures import full_scale_of, to_bit_depth
+from ..core.response import Response, estimate_response, ramp_levels
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.board import Board
@@ -37,14 +38,17 @@ from ..geometry.opencv import read_opencv_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.files import (
     Captures,
+    capture_files,
     check_output,
     load_spec,
     natural_key,
+    output_file,
     output_folder,
     read_captures,
     read_with_spec,
     write_image,
 )
+from ..io.jsonfile import read_json, write_json
 from ..io.previews import colorize
 from ..io.writers import write_depth, write_ply, write_result
 from ..spec import BaseSpec
@@ -59,6 +63,54 @@ def save_patterns(spec: BaseSpec, out: str | Path) -> Path:
             write_image(tmp / f"{i:0{width}d}.png", img)
         (tmp / "spec.json").write_text(spec.to_json())
     return Path(out)
+
+
+def save_ramp(width: int, height: int, levels: int, bits: int, out: str | Path) -> Path:
+    """Write a gamma ramp: ``levels`` uniform frames from black to white (``NN.png``) and
+    ``ramp.json`` (their pattern values), for :func:`measure_gamma`."""
+    if width < 8 or height < 8:
+        raise BistairError(f"projector size {width}x{height} is too small (8x8 at least)")
+    values = ramp_levels(levels)
+    digits = max(2, len(str(levels - 1)))
+    with output_folder(out) as tmp:
+        for i, v in enumerate(values):
+            write_image(tmp / f"{i:0{digits}d}.png",
+                        to_bit_depth(np.full((height, width), v), bits))
+        write_json(tmp / "ramp.json", {"format": "bistair-gamma-ramp", "version": 1,
+                                       "width": width, "height": height, "bits": bits,
+                                       "levels": values.tolist()})
+    return Path(out)
+
+
+def measure_gamma(captures: Captures, out: str | Path,
+                  ramp: str | Path | None = None) -> Response:
+    """Fit the projector's gamma to captures of a ramp (:func:`save_ramp`) and write
+    ``gamma.json`` atomically; ``ramp`` defaults to ``ramp.json`` in the captures' folder."""
+    files = capture_files(captures)
+    if ramp is None:
+        first = Path(captures if isinstance(captures, str | Path) else captures[0])
+        ramp = (first if first.is_dir() else files[0].parent) / "ramp.json"
+    data = read_json(ramp, "gamma ramp")
+    levels = data.get("levels") if isinstance(data, dict) else None
+    if not isinstance(levels, list) or not all(isinstance(v, int | float) for v in levels):
+        raise BistairError(f"gamma ramp {ramp} has no list of 'levels'")
+    stack = read_captures(files)
+    if len(stack) != len(levels):
+        raise BistairError(f"the gamma ramp has {len(levels)} levels, the captures have "
+                           f"{len(stack)} frames")
+    fit = estimate_response(stack, np.asarray(levels, float), full_scale_of(stack))
+    with output_file(out) as tmp:
+        write_json(tmp, fit.to_dict())
+    return fit
+
+
+def read_gamma(path: str | Path) -> float:
+    """The fitted gamma of a ``gamma.json`` written by :func:`measure_gamma`."""
+    data = read_json(path, "gamma file")
+    value = data.get("gamma") if isinstance(data, dict) else None
+    if not isinstance(value, int | float) or not 0.2 <= value <= 5.0:
+        raise BistairError(f"gamma file {path} has no gamma in [0.2, 5]")
+    return float(value)
 
 
 def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Path | None = None,
