@@ -31,4 +31,4 @@ def test_same_orders_and_phases_as_before(name, images, spec, options):
     assert np.minimum(diff, TWO_PI - diff).max() < 1e-5
     # the absolute phase is the wrapped one plus its orders (to float32 rounding)
     whole = res.wrapped[ok].astype(np.float64) + TWO_PI * res.order[ok]
-    assert np.abs(res.phase[ok] - whole).max() < 1e-7 * np.abs(whole).max() + 1e-6
+    assert np.abs(res.phase[ok] - whole).max() < 5e-7 * np.abs(whole).max() + 1e-6
