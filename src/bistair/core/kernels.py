@@ -42,10 +42,11 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
                 import numba  # heavy: imported when the first kernel runs
 
                 module = globals()
-                module["prange"] = numba.prange
-                for name, value in list(module.items()):
-                    if getattr(value, "_inline", False):
-                        module[name] = numba.njit(cache=True, inline="always")(value)
+                if module["prange"] is range:  # the first kernel: helpers compiled once
+                    module["prange"] = numba.prange
+                    for name, value in list(module.items()):
+                        if getattr(value, "_inline", False):
+                            module[name] = numba.njit(cache=True, inline="always")(value)
                 compiled = numba.njit(cache=True, parallel=parallel, fastmath=False,
                                       error_model="numpy")(fn)
                 _COMPILED[fn.__name__] = compiled
@@ -173,3 +174,141 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
             vert[y, x] = _jump(ax[y, x], ay[y, x], an[y, x], ax[y + 1, x], ay[y + 1, x],
                                an[y + 1, x], noise[y, x], noise[y + 1, x], rel, fhalf)
     return vert, horiz
+
+
+@kernel(parallel=True)
+def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
+                 noise: np.ndarray, jump_v: np.ndarray, jump_h: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The links of :func:`bistair.core.regions.fringe_regions`: ``(vertical links kept
+    (H-1, W), horizontal links kept (H, W-1), pixels kept (H, W))``.
+
+    A link between two valid pixels is cut at a wrap (its high-phase end is dropped), at a
+    step above ``cut`` or a cut given in ``jump_v``/``jump_h`` (both ends dropped), and,
+    along the rows, in a run of links against the phase's direction ``sign`` whose fall
+    exceeds ``max(0.15, 4 sigma)`` (``sigma``: ``sqrt(2)`` times the larger per-pixel phase
+    noise of a link, ``noise``; both ends dropped).
+    """
+    h, w = phi.shape
+    cut32 = np.float32(cut)
+    sqrt2 = math.sqrt(2.0)
+    vert = np.zeros((h - 1, w), np.bool_)
+    drop_up = np.zeros((h - 1, w), np.bool_)
+    drop_down = np.zeros((h - 1, w), np.bool_)
+    for y in prange(h - 1):
+        for x in range(w):
+            if not (valid[y, x] and valid[y + 1, x]):
+                continue
+            raw = phi[y + 1, x] - phi[y, x]
+            if abs(raw) > PI32:
+                if raw <= 0:
+                    drop_up[y, x] = True
+                else:
+                    drop_down[y, x] = True
+            elif abs(raw) > cut32 or jump_v[y, x]:
+                drop_up[y, x] = True
+                drop_down[y, x] = True
+            else:
+                vert[y, x] = True
+    horiz = np.zeros((h, w - 1), np.bool_)
+    keep = np.zeros((h, w), np.bool_)
+    for y in prange(h):
+        raw = np.zeros(w - 1, np.float32)
+        state = np.zeros(w - 1, np.int8)  # 0 none, 1 ok, 2 wrap high-a, 3 wrap high-b, 4 cut
+        for x in range(w - 1):
+            if not (valid[y, x] and valid[y, x + 1]):
+                continue
+            r = (phi[y, x + 1] - phi[y, x]) if sign > 0 else (phi[y, x] - phi[y, x + 1])
+            raw[x] = r
+            if abs(r) > PI32:
+                state[x] = 2 if r <= 0 else 3
+            elif abs(r) > cut32:
+                state[x] = 4
+            else:
+                state[x] = 1
+        x = 0
+        while x < w - 1:  # runs of ok links against the phase's direction
+            if not (state[x] == 1 and raw[x] < 0):
+                x += 1
+                continue
+            start = x
+            fall = 0.0
+            spread = 0.0
+            while x < w - 1 and state[x] == 1 and raw[x] < 0:
+                fall += -np.float64(raw[x])
+                spread = max(spread, sqrt2 * np.float64(max(noise[y, x], noise[y, x + 1])))
+                x += 1
+            if fall > max(0.15, 4.0 * spread):
+                for k in range(start, x):
+                    state[k] = 4
+        drop_lo = np.zeros(w, np.bool_)  # dropped by a link on the pixel's low-x side...
+        for x in range(w - 1):
+            s = state[x]
+            if s == 1 and jump_h[y, x]:
+                s = 4
+            if s == 1:
+                horiz[y, x] = True
+            elif s == 4:
+                drop_lo[x] = True
+                drop_lo[x + 1] = True
+            elif s == 2:  # raw <= 0: the first pixel along the walk is the high end
+                if sign > 0:
+                    drop_lo[x] = True
+                else:
+                    drop_lo[x + 1] = True
+            elif s == 3:
+                if sign > 0:
+                    drop_lo[x + 1] = True
+                else:
+                    drop_lo[x] = True
+        for x in range(w):
+            k = valid[y, x] and not drop_lo[x]
+            if y < h - 1 and drop_up[y, x]:
+                k = False
+            if y > 0 and drop_down[y - 1, x]:
+                k = False
+            keep[y, x] = k
+    return vert, horiz, keep
+
+
+@kernel()
+def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.ndarray,
+             horiz: np.ndarray, passes: int) -> None:
+    """Give valid pixels that were dropped the label of a neighbour they are linked to
+    (below, above, right, left: the first labelled one), ``passes`` times, in place; each
+    pass reads the labels the previous one left."""
+    h, w = labels.shape
+    ys = []
+    xs = []
+    for y in range(h):
+        for x in range(w):
+            if valid[y, x] and not keep[y, x]:
+                ys.append(y)
+                xs.append(x)
+    n = len(ys)
+    ty = np.array(ys, np.int64)
+    tx = np.array(xs, np.int64)
+    got = np.zeros(n, np.int32)
+    for _ in range(passes):
+        if n == 0:
+            break
+        for i in range(n):
+            y, x = ty[i], tx[i]
+            g = 0
+            if y + 1 < h and vert[y, x]:
+                g = labels[y + 1, x]
+            if g == 0 and y > 0 and vert[y - 1, x]:
+                g = labels[y - 1, x]
+            if g == 0 and x + 1 < w and horiz[y, x]:
+                g = labels[y, x + 1]
+            if g == 0 and x > 0 and horiz[y, x - 1]:
+                g = labels[y, x - 1]
+            got[i] = g
+        m = 0
+        for i in range(n):
+            labels[ty[i], tx[i]] = got[i]
+            if got[i] == 0:
+                ty[m] = ty[i]
+                tx[m] = tx[i]
+                m += 1
+        n = m

@@ -22,9 +22,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
-from scipy import ndimage
 
+from .kernels import fringe_links, period_jump_links, reattach
 from .phase import TWO_PI, order_from_reference
 
 
@@ -173,52 +174,21 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     valid = np.asarray(valid, dtype=bool)
     if cut is None:
         cut = default_cut(phi, valid)
-    if phase_noise is None:
-        sigma = np.full((phi.shape[0], phi.shape[1] - 1), 0.02 * np.sqrt(2.0))
-    else:  # noise of the difference of two neighbours
-        sigma = np.sqrt(2.0) * np.maximum(phase_noise[:, :-1], phase_noise[:, 1:])
+    h, w = phi.shape
+    noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
+             else np.ascontiguousarray(phase_noise, dtype=np.float32))
     sign = fringe_direction(phi, valid)
-    jump_v, jump_h = period_jumps(phi, valid, 0.02 if phase_noise is None else phase_noise)
+    jump_v, jump_h = period_jump_links(phi, valid, noise, 3, 0.3)
     if boundaries is not None:
         jump_v, jump_h = jump_v | boundaries[0], jump_h | boundaries[1]
-    vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
-    drop_up |= jump_v & vert
-    drop_down |= jump_v & vert
-    vert &= ~jump_v
-    if sign > 0:
-        horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
-                                                  valid[:, 1:], cut, sigma)
-    else:  # walk the rows the other way
-        horiz, drop_right, drop_left = _link_cuts(phi[:, 1:], phi[:, :-1], valid[:, 1:],
-                                                  valid[:, :-1], cut, sigma[:, ::-1])
-        horiz, drop_right, drop_left = horiz[:, ::-1], drop_right[:, ::-1], drop_left[:, ::-1]
-    drop_left |= jump_h & horiz
-    drop_right |= jump_h & horiz
-    horiz &= ~jump_h
-    keep = valid.copy()
-    keep[:-1] &= ~drop_up
-    keep[1:] &= ~drop_down
-    keep[:, :-1] &= ~drop_left
-    keep[:, 1:] &= ~drop_right
-    labels, n = ndimage.label(keep)
-    labels = labels.astype(np.int32)
+    vert, horiz, keep = fringe_links(phi, valid, float(np.float32(cut)), sign, noise,
+                                     jump_v, jump_h)
+    n, labels = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
+                                        ltype=cv2.CV_32S)
+    n -= 1
     # Reattach the removed pixels through links that are not cut (a few passes, on the
     # removed pixels only: they are thin lines along the wraps).
-    h, w = labels.shape
-    ty, tx = np.nonzero(valid & ~keep)
-    for _ in range(3):
-        if ty.size == 0:
-            break
-        got = np.zeros(ty.size, np.int32)
-        for dy, dx, link in ((1, 0, vert), (-1, 0, vert), (0, 1, horiz), (0, -1, horiz)):
-            ny, nx = ty + dy, tx + dx
-            inside = (ny >= 0) & (ny < h) & (nx >= 0) & (nx < w)
-            ly, lx = np.minimum(ty, ny), np.minimum(tx, nx)  # the link's own index
-            ok = inside & (got == 0)
-            ok[ok] = link[ly[ok], lx[ok]]
-            got[ok] = labels[ny[ok], nx[ok]]
-        labels[ty, tx] = got
-        ty, tx = ty[got == 0], tx[got == 0]
+    reattach(labels, valid, keep, vert, horiz, 3)
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     small = sizes < min_size
     small[0] = False
