@@ -312,3 +312,71 @@ def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.n
                 tx[m] = tx[i]
                 m += 1
         n = m
+
+
+@kernel()
+def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sums of ``values`` (V, H, W) per (label, row) over the labelled pixels (label > 0):
+    ``(keys, counts, sums (V, K))``, ``keys = label * H + row`` ascending. Float64 sums in
+    raster order, as ``np.bincount`` adds them."""
+    nv, h, w = values.shape
+    n_bins = (n_labels + 1) * h
+    count = np.zeros(n_bins, np.int64)
+    acc = np.zeros((nv, n_bins), np.float64)
+    for y in range(h):
+        for x in range(w):
+            lab = labels[y, x]
+            if lab > 0:
+                k = lab * h + y
+                count[k] += 1
+                for v in range(nv):
+                    acc[v, k] += np.float64(values[v, y, x])
+    used = 0
+    for k in range(n_bins):
+        if count[k] > 0:
+            used += 1
+    keys = np.empty(used, np.int64)
+    counts = np.empty(used, np.int64)
+    sums = np.empty((nv, used), np.float64)
+    i = 0
+    for k in range(n_bins):
+        if count[k] > 0:
+            keys[i] = k
+            counts[i] = count[k]
+            for v in range(nv):
+                sums[v, i] = acc[v, k]
+            i += 1
+    return keys, counts, sums
+
+
+@kernel()
+def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Neighbour pairs of different regions across a phase wrap, walking down the columns
+    and along the rows (a wrap along a row against the phase's direction ``sign`` is left
+    out): ``(src, dst, step)``, step +1 where the phase falls from ``src`` to ``dst``."""
+    h, w = phi.shape
+    src = []
+    dst = []
+    step = []
+    for y in range(h):
+        for x in range(w):
+            la = labels[y, x]
+            if la <= 0:
+                continue
+            if y + 1 < h:
+                lb = labels[y + 1, x]
+                if lb > 0 and lb != la and abs(phi[y + 1, x] - phi[y, x]) > PI32:
+                    src.append(la)
+                    dst.append(lb)
+                    step.append(1 if phi[y, x] > phi[y + 1, x] else -1)
+            if x + 1 < w:
+                lb = labels[y, x + 1]
+                if lb > 0 and lb != la and abs(phi[y, x + 1] - phi[y, x]) > PI32:
+                    st = 1 if phi[y, x] > phi[y, x + 1] else -1
+                    if st == sign:
+                        src.append(la)
+                        dst.append(lb)
+                        step.append(st)
+    return (np.array(src, np.int64), np.array(dst, np.int64), np.array(step, np.int64))

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .kernels import fringe_links, period_jump_links, reattach
+from .kernels import fringe_links, period_jump_links, reattach, wrap_links
 from .phase import TWO_PI, order_from_reference
 
 
@@ -235,17 +235,7 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     (``src`` before ``dst``). ``direction`` is :func:`fringe_direction`, computed if not given.
     """
     sign = fringe_direction(phi, labels > 0) if direction is None else direction
-    src, dst, step = [], [], []
-    for a, b, la, lb, along in ((phi[:-1], phi[1:], labels[:-1], labels[1:], False),
-                                (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:], True)):
-        sel = (la != lb) & (la > 0) & (lb > 0)
-        sel[sel] = np.abs(b[sel] - a[sel]) > np.pi
-        st = np.where(a[sel] > b[sel], 1, -1)
-        keep = st == sign if along else np.ones(st.size, bool)
-        src.append(la[sel][keep])
-        dst.append(lb[sel][keep])
-        step.append(st[keep])
-    s, d, st = (np.concatenate(v).astype(np.int64) for v in (src, dst, step))
+    s, d, st = wrap_links(phi, labels, sign)
     if s.size == 0:
         empty = np.zeros(0, np.int64)
         return RegionLinks(empty, empty, empty, empty)

@@ -63,6 +63,7 @@ from .bands import (
     row_profiles,
     row_runs,
     split_regions,
+    stair_values,
     union_levels,
 )
 from .paper import paper_orders
@@ -207,14 +208,16 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
     weight = core_weight(fs.phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
 
+    values = stair_values(theta, weight, ratio)
+
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        prof = row_profiles(labels, theta, weight, ratio)
+        prof = row_profiles(labels, values)
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = band_splits(runs, heights, spec.local_rows / spec.group_rows)
         if splits:  # surfaces stacked in one fringe region: decode them apart
             labels, n = split_regions(labels, n, splits)
-            prof = row_profiles(labels, theta, weight, ratio)
+            prof = row_profiles(labels, values)
             runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
