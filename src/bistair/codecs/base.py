@@ -173,9 +173,7 @@ class Codec:
                            select=[frames.index(name) for name in spec.method_frames()],
                            **roles)
         if spec.orientation == "rows":
-            return prepared, Prepared(
-                prepared.frames.transpose(0, 2, 1), prepared.clipped.T, prepared.full_scale,
-                *(None if a is None else a.T for a in (prepared.white, prepared.black)))
+            return prepared, prepared.transposed()
         return prepared, prepared
 
     def phase_map(self, images: np.ndarray, spec: BaseSpec,

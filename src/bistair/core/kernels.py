@@ -380,3 +380,60 @@ def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
                         dst.append(lb)
                         step.append(st)
     return (np.array(src, np.int64), np.array(dst, np.int64), np.array(step, np.int64))
+
+
+@kernel(parallel=True)
+def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.ndarray,
+               cos_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(num, den, avg)`` of frames ``start .. start+steps-1`` of a raw capture stack (any
+    dtype; each value times ``scale`` is its fraction of full scale): ``num = -sum
+    sin_w[n] I_n``, ``den = sum cos_w[n] I_n`` and the mean, in one pass (float32, summed in
+    frame order as :func:`bistair.core.phase.wrapped_phase` sums them)."""
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    num = np.empty((h, w), np.float32)
+    den = np.empty((h, w), np.float32)
+    avg = np.empty((h, w), np.float32)
+    n32 = np.float32(steps)
+    for y in prange(h):
+        for x in range(w):
+            s = np.float32(0.0)
+            c = np.float32(0.0)
+            total = np.float32(0.0)
+            for n in range(steps):
+                f = np.float32(raw[start + n, y, x]) * s32
+                s += sin_w[n] * f
+                c += cos_w[n] * f
+                total += f
+            num[y, x] = -s
+            den[y, x] = c
+            avg[y, x] = total / n32
+    return num, den, avg
+
+
+@kernel(parallel=True)
+def stair_phase_pair(raw: np.ndarray, i_cos: int, i_sin: int, scale: float, avg: np.ndarray,
+                     valid: np.ndarray, levels: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stair phase in ``[-pi, pi)`` and its modulation of a coded pair (frames ``i_cos``,
+    ``i_sin`` against the fringes' average, Eq. 19), and its stair level of ``levels``
+    where ``valid`` (-1 elsewhere), in one pass (float32)."""
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    lv = np.float32(levels / (2.0 * math.pi))
+    theta = np.empty((h, w), np.float32)
+    smod = np.empty((h, w), np.float32)
+    ks = np.empty((h, w), np.int32)
+    for y in prange(h):
+        for x in range(w):
+            c = np.float32(raw[i_cos, y, x]) * s32 - avg[y, x]
+            s = np.float32(raw[i_sin, y, x]) * s32 - avg[y, x]
+            t = np.float32(math.atan2(s, c))
+            theta[y, x] = t
+            smod[y, x] = np.float32(math.hypot(s, c))
+            if valid[y, x]:
+                q = np.int32(math.floor((t + PI32) * lv)) % np.int32(levels)
+                ks[y, x] = q
+            else:
+                ks[y, x] = -1
+    return theta, smod, ks
