@@ -437,3 +437,36 @@ def stair_phase_pair(raw: np.ndarray, i_cos: int, i_sin: int, scale: float, avg:
             else:
                 ks[y, x] = -1
     return theta, smod, ks
+
+
+@kernel(parallel=True)
+def stair_turns(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
+                step: float) -> np.ndarray:
+    """Horizontal links (H, W-1) where the stair phase turns by more than
+    ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of the link, away
+    from the phase jumps (see :func:`bistair.codecs.bidirectional.stair_edges`)."""
+    h, w = phi.shape
+    edge = np.zeros((h, w - 1), np.bool_)
+    lo = np.float32(0.15 * 2.0 * math.pi)
+    hi = np.float32(0.85 * 2.0 * math.pi)
+    base = 0.75 * step
+    for y in prange(h):
+        for x in range(1, w - 2):
+            if not (valid[y, x - 1] and valid[y, x] and valid[y, x + 1] and valid[y, x + 2]):
+                continue
+            mid = phi[y, x]
+            if not (mid > lo and mid < hi):
+                continue
+            lr = np.float32(math.cos(theta[y, x - 1])) + np.float32(math.cos(theta[y, x]))
+            li = np.float32(math.sin(theta[y, x - 1])) + np.float32(math.sin(theta[y, x]))
+            rr = np.float32(math.cos(theta[y, x + 1])) + np.float32(math.cos(theta[y, x + 2]))
+            ri = np.float32(math.sin(theta[y, x + 1])) + np.float32(math.sin(theta[y, x + 2]))
+            re = rr * lr + ri * li
+            im = ri * lr - rr * li
+            turn = abs(np.float32(math.atan2(im, re)))
+            a = max(noise[y, x - 1], noise[y, x + 2])
+            b = max(noise[y, x], noise[y, x + 1])
+            spread = np.float32(math.sqrt(a * a + b * b))
+            if turn > max(base, 4.0 * spread):
+                edge[y, x] = True
+    return edge

@@ -46,7 +46,7 @@ from scipy import ndimage
 
 from ...core.captures import Prepared
 from ...core.checks import stair_misfit
-from ...core.kernels import stair_phase_pair
+from ...core.kernels import stair_phase_pair, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
@@ -178,24 +178,20 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     down across the partition bands between them.
     """
     h, w = phi.shape
-    step = TWO_PI / stairs
-    z = np.exp(1j * theta.astype(np.float32)) * valid
-    left = z[:, :-3] + z[:, 1:-2]
-    right = z[:, 2:-1] + z[:, 3:]
-    turn = np.abs(np.angle(right * np.conj(left)))
-    spread = np.sqrt(np.maximum(noise[:, :-3], noise[:, 3:]) ** 2
-                     + np.maximum(noise[:, 1:-2], noise[:, 2:-1]) ** 2)
-    mid = phi[:, 1:-2]
-    inside = (mid > 0.15 * TWO_PI) & (mid < 0.85 * TWO_PI)
-    ok = valid[:, :-3] & valid[:, 1:-2] & valid[:, 2:-1] & valid[:, 3:] & inside
-    edge = np.zeros((h, w - 1), bool)
-    edge[:, 1:-1] = ok & (turn > np.maximum(0.75 * step, 4.0 * spread))
-    if not edge.any():
+    edge = stair_turns(phi, theta, valid, np.ascontiguousarray(noise, dtype=np.float32),
+                       TWO_PI / stairs)
+    ys, xs = np.nonzero(edge)
+    if ys.size == 0:
         return np.zeros((h - 1, w), bool), edge
-    wide = ndimage.binary_dilation(edge, np.ones((1, 3), bool))
-    edge &= ndimage.binary_opening(wide, np.ones((4, 1), bool))  # four rows on end
-    if reach > 0 and edge.any():
-        edge = ndimage.binary_dilation(edge, np.ones((2 * reach + 1, 1), bool))
+    # morphology on the edges' bounding box (with margins the structures cannot reach past)
+    y0, y1 = max(ys.min() - reach - 8, 0), min(ys.max() + reach + 9, h)
+    x0, x1 = max(xs.min() - 4, 0), min(xs.max() + 5, w - 1)
+    box = edge[y0:y1, x0:x1]
+    wide = ndimage.binary_dilation(box, np.ones((1, 3), bool))
+    box &= ndimage.binary_opening(wide, np.ones((4, 1), bool))  # four rows on end
+    if reach > 0 and box.any():
+        box = ndimage.binary_dilation(box, np.ones((2 * reach + 1, 1), bool))
+    edge[y0:y1, x0:x1] = box
     return np.zeros((h - 1, w), bool), edge
 
 
