@@ -99,7 +99,11 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
     one = np.float32(1.0)
     spread = np.float32(2.0) * max(noise_p / np.float32(math.sqrt(max(pn, one))),
                                    noise_q / np.float32(math.sqrt(max(qn, one))))
-    step = np.float32(math.hypot(px - qx, py - qy))
+    dx, dy = px - qx, py - qy
+    limit = np.float32(4.0) * spread
+    if dx * dx + dy * dy < limit * limit * np.float32(0.9999):
+        return False  # clearly below the noise: no square root needed
+    step = np.float32(math.hypot(dx, dy))
     if not step > np.float32(4.0) * spread:
         return False
     size = max(np.float32(math.hypot(px, py)), np.float32(math.hypot(qx, qy)))
@@ -412,44 +416,18 @@ def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.
 
 
 @kernel(parallel=True)
-def stair_phase_pair(raw: np.ndarray, i_cos: int, i_sin: int, scale: float, avg: np.ndarray,
-                     valid: np.ndarray, levels: int
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stair phase in ``[-pi, pi)`` and its modulation of a coded pair (frames ``i_cos``,
-    ``i_sin`` against the fringes' average, Eq. 19), and its stair level of ``levels``
-    where ``valid`` (-1 elsewhere), in one pass (float32)."""
-    _, h, w = raw.shape
-    s32 = np.float32(scale)
-    lv = np.float32(levels / (2.0 * math.pi))
-    theta = np.empty((h, w), np.float32)
-    smod = np.empty((h, w), np.float32)
-    ks = np.empty((h, w), np.int32)
-    for y in prange(h):
-        for x in range(w):
-            c = np.float32(raw[i_cos, y, x]) * s32 - avg[y, x]
-            s = np.float32(raw[i_sin, y, x]) * s32 - avg[y, x]
-            t = np.float32(math.atan2(s, c))
-            theta[y, x] = t
-            smod[y, x] = np.float32(math.hypot(s, c))
-            if valid[y, x]:
-                q = np.int32(math.floor((t + PI32) * lv)) % np.int32(levels)
-                ks[y, x] = q
-            else:
-                ks[y, x] = -1
-    return theta, smod, ks
-
-
-@kernel(parallel=True)
-def stair_turns(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
-                step: float) -> np.ndarray:
-    """Horizontal links (H, W-1) where the stair phase turns by more than
-    ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of the link, away
-    from the phase jumps (see :func:`bistair.codecs.bidirectional.stair_edges`)."""
+def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np.ndarray,
+                noise: np.ndarray, step: float) -> np.ndarray:
+    """Horizontal links (H, W-1) where the stair phase (given by its cosine and sine) turns
+    by more than ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of
+    the link, away from the phase jumps (see
+    :func:`bistair.codecs.bidirectional.stair_edges`)."""
     h, w = phi.shape
     edge = np.zeros((h, w - 1), np.bool_)
     lo = np.float32(0.15 * 2.0 * math.pi)
     hi = np.float32(0.85 * 2.0 * math.pi)
     base = 0.75 * step
+    cb, sb = math.cos(base), math.sin(base)
     for y in prange(h):
         for x in range(1, w - 2):
             if not (valid[y, x - 1] and valid[y, x] and valid[y, x + 1] and valid[y, x + 2]):
@@ -457,12 +435,15 @@ def stair_turns(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
             mid = phi[y, x]
             if not (mid > lo and mid < hi):
                 continue
-            lr = np.float32(math.cos(theta[y, x - 1])) + np.float32(math.cos(theta[y, x]))
-            li = np.float32(math.sin(theta[y, x - 1])) + np.float32(math.sin(theta[y, x]))
-            rr = np.float32(math.cos(theta[y, x + 1])) + np.float32(math.cos(theta[y, x + 2]))
-            ri = np.float32(math.sin(theta[y, x + 1])) + np.float32(math.sin(theta[y, x + 2]))
+            lr = cos_t[y, x - 1] + cos_t[y, x]
+            li = sin_t[y, x - 1] + sin_t[y, x]
+            rr = cos_t[y, x + 1] + cos_t[y, x + 2]
+            ri = sin_t[y, x + 1] + sin_t[y, x + 2]
             re = rr * lr + ri * li
             im = ri * lr - rr * li
+            # well inside the base angle: no edge, and no arctangent needed
+            if cb * abs(im) - sb * re < -1e-6 * (abs(im) + abs(re)):
+                continue
             turn = abs(np.float32(math.atan2(im, re)))
             a = max(noise[y, x - 1], noise[y, x + 2])
             b = max(noise[y, x], noise[y, x + 1])

@@ -46,12 +46,12 @@ from scipy import ndimage
 
 from ...core.captures import Prepared
 from ...core.checks import stair_misfit
-from ...core.kernels import stair_phase_pair, stair_turns
+from ...core.kernels import stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import phase_from_regions
-from ...core.stair import quantize, stair_level_phase, stair_pair
+from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
@@ -139,9 +139,9 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
     """Stage 2: the stair phase of the coded pair (Eq. 19), its modulation and ``k_s`` (Eq. 20)
     on the valid pixels."""
-    theta, stair_mod, ks = stair_phase_pair(prepared.raw, spec.steps, spec.steps + 1,
-                                            float(prepared.scale), fs.avg, fs.valid,
-                                            spec.stairs)
+    frames = prepared.frames
+    theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
+    ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
         raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
                            "between the levels of the code: are stair-cos and stair-sin "
@@ -178,8 +178,8 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     down across the partition bands between them.
     """
     h, w = phi.shape
-    edge = stair_turns(phi, theta, valid, np.ascontiguousarray(noise, dtype=np.float32),
-                       TWO_PI / stairs)
+    edge = stair_turns(phi, np.cos(theta), np.sin(theta), valid,
+                       np.ascontiguousarray(noise, dtype=np.float32), TWO_PI / stairs)
     ys, xs = np.nonzero(edge)
     if ys.size == 0:
         return np.zeros((h - 1, w), bool), edge
