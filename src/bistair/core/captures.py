@@ -29,7 +29,7 @@ class ScaledStack:
     (``raw[key] * scale``), so only the frames a step asks for are converted.
 
     >>> s = ScaledStack(np.full((2, 3, 4), 51, np.uint8), 1 / 255)
-    >>> s.shape, s[1].dtype, float(s[0, 0, 0])
+    >>> s.shape, s[1].dtype, round(float(s[0, 0, 0]), 6)
     ((2, 3, 4), dtype('float32'), 0.2)
     """
 
