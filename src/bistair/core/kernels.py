@@ -451,3 +451,41 @@ def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np
             if turn > max(base, 4.0 * spread):
                 edge[y, x] = True
     return edge
+
+
+@kernel(parallel=True)
+def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
+    """:func:`bistair.core.stair.quantize` of a float32 phase map, -1 where not ``valid``."""
+    h, w = theta.shape
+    scale = np.float32(levels / (2.0 * math.pi))
+    out = np.empty((h, w), np.int32)
+    for y in prange(h):
+        for x in range(w):
+            if valid[y, x]:
+                out[y, x] = np.int32(math.floor((theta[y, x] + PI32) * scale)) % levels
+            else:
+                out[y, x] = -1
+    return out
+
+
+@kernel(parallel=True)
+def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
+                  min_strong: int, min_size: int) -> np.ndarray:
+    """``strong | (weak & region kept)``, a region kept when it holds ``min_strong`` strong
+    pixels or ``min_size`` pixels (see :func:`bistair.core.measure.coherent_pixels`)."""
+    h, w = labels.shape
+    size = np.zeros(n + 1, np.int64)
+    bright = np.zeros(n + 1, np.int64)
+    for y in range(h):
+        for x in range(w):
+            lab = labels[y, x]
+            size[lab] += 1
+            if strong[y, x]:
+                bright[lab] += 1
+    keep = (bright >= min_strong) | (size >= min_size)
+    keep[0] = False
+    out = np.empty((h, w), np.bool_)
+    for y in prange(h):
+        for x in range(w):
+            out[y, x] = strong[y, x] or (weak[y, x] and keep[labels[y, x]])
+    return out

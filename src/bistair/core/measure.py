@@ -30,7 +30,7 @@ from .captures import (
     saturation,
     validity,
 )
-from .kernels import nstep_sums
+from .kernels import keep_coherent, nstep_sums
 from .phase import phase_of_sums, residuals, shifts_of
 from .regions import fringe_regions
 
@@ -162,8 +162,4 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     whose phase runs on smoothly with a region's is part of a lit surface.
     """
     labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
-    size = np.bincount(labels.ravel(), minlength=n + 1)
-    bright = np.bincount(labels.ravel(), weights=strong.ravel(), minlength=n + 1)
-    keep = (bright >= min_strong) | (size >= min_size)
-    keep[0] = False
-    return strong | (weak & keep[labels])
+    return keep_coherent(labels, weak, strong, n, min_strong, min_size)

@@ -84,10 +84,11 @@ def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: fl
     phi = np.arctan2(num, den)
     if phase_offset:
         phi = (phi - np.float32(phase_offset)) % np.float32(TWO_PI)
-    phi = np.where(phi < 0, phi + np.float32(TWO_PI), phi)
+    np.add(phi, np.float32(TWO_PI), out=phi, where=phi < 0)
     phi[phi >= np.float32(TWO_PI)] = 0.0  # float32 rounding of tiny negatives
-    mod = np.hypot(num, den) * np.float32(2.0 / steps)
-    return phi.astype(np.float32), mod.astype(np.float32)
+    mod = np.hypot(num, den)
+    mod *= np.float32(2.0 / steps)
+    return phi.astype(np.float32, copy=False), mod.astype(np.float32, copy=False)
 
 
 def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,

@@ -46,7 +46,7 @@ from scipy import ndimage
 
 from ...core.captures import Prepared
 from ...core.checks import stair_misfit
-from ...core.kernels import stair_turns
+from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
@@ -141,7 +141,7 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     on the valid pixels."""
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
-    ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
+    ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
         raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
                            "between the levels of the code: are stair-cos and stair-sin "
@@ -224,7 +224,7 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
                     group_height=default)
         return labels, n, region_evidence(runs, n, heights, layout)
 
-    q_part = quantize(theta, spec.partitions)
+    q_part = quantize32(theta, spec.partitions, np.ones(theta.shape, bool))
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """A pixel reads its order's local or partition level (its row decides which)."""
