@@ -51,7 +51,7 @@ from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import phase_from_regions
-from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
+from ...core.stair import stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
