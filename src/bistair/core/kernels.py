@@ -14,7 +14,7 @@ Examples
 >>> vert, horiz = period_jump_links(phi, np.ones(phi.shape, bool),
 ...                                 np.full(phi.shape, 0.01, np.float32), 3, 0.3)
 >>> np.flatnonzero(horiz[0]).tolist(), bool(vert.any())
-([18, 19, 20], False)
+([16, 17, 18, 19, 21, 22], False)
 """
 
 from __future__ import annotations
