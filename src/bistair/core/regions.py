@@ -244,15 +244,15 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     return RegionLinks(key // 2 // n, key // 2 % n, np.where(key % 2 == 1, 1, -1), count)
 
 
-def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndarray,
-                         max_distance: float = 3.0) -> np.ndarray:
-    """Absolute phase for ``target`` pixels from the nearest pixel that has one.
-
-    The fringe order is ``round((Phi_near - phi) / 2pi)``; target pixels farther than
-    ``max_distance`` from any absolute phase stay NaN.
+def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
+                max_distance: float = 3.0) -> np.ndarray:
+    """Fringe orders for ``target`` pixels without one (``order < 0``) from the nearest
+    pixel that has one: the order that brings the pixel's phase nearest that pixel's
+    absolute phase, ``round((phi_near + 2 pi k_near - phi) / 2pi)``. Target pixels farther
+    than ``max_distance`` from any order keep -1. Returns a new int32 array.
     """
-    out = abs_phase.copy()
-    ty, tx = np.nonzero(target & ~np.isfinite(abs_phase))
+    out = np.array(order, dtype=np.int32)
+    ty, tx = np.nonzero(target & (out < 0))
     if ty.size == 0:
         return out
     r = int(np.floor(max_distance))
@@ -261,15 +261,15 @@ def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndar
     near = np.argsort(dist, kind="stable")
     near = near[(dist[near] > 0) & (dist[near] <= max_distance)]
     dy, dx = dy.ravel()[near], dx.ravel()[near]
-    h, w = abs_phase.shape
+    h, w = out.shape
     yy = np.clip(ty[:, None] + dy[None, :], 0, h - 1)
     xx = np.clip(tx[:, None] + dx[None, :], 0, w - 1)
-    cand = abs_phase[yy, xx]  # (targets, offsets), nearest offsets first
-    found = np.isfinite(cand)
+    cand = order[yy, xx]  # (targets, offsets), nearest offsets first
+    found = cand >= 0
     first = found.argmax(axis=1)
     has = found.any(axis=1)
-    ref = cand[np.arange(ty.size), first][has]
+    pick_y, pick_x = yy[np.arange(ty.size), first][has], xx[np.arange(ty.size), first][has]
+    ref = phi[pick_y, pick_x] + TWO_PI * order[pick_y, pick_x]  # absolute phase, float64
     sel_y, sel_x = ty[has], tx[has]
-    k = order_from_reference(phi[sel_y, sel_x], ref)
-    out[sel_y, sel_x] = phi[sel_y, sel_x] + TWO_PI * k
+    out[sel_y, sel_x] = order_from_reference(phi[sel_y, sel_x], ref)
     return out

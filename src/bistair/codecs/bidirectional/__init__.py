@@ -50,7 +50,7 @@ from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
-from ...core.resolve import phase_from_regions
+from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
@@ -158,10 +158,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
     if strategy == "paper":
         order = paper_orders(ks, theta, fs, spec)
-        abs_phase = np.where(order >= 0, fs.phi + TWO_PI * order, np.nan)
+        order = order.astype(np.int32)
     else:
-        abs_phase = _region_phase(fs, theta, code.maps["stair_modulation"], ks, spec, info)
-    return Orders(abs_phase, info)
+        order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
+    return Orders(order, info)
 
 
 def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
@@ -195,7 +195,7 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     return np.zeros((h - 1, w), bool), edge
 
 
-def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
+def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
                   spec: BidirectionalSpec, info: dict) -> np.ndarray:
     # stair phase noise: the pair's two frames against the fringes' average
     noise = fs.noise * np.sqrt(2.0) / np.maximum(stair_mod, 1e-6)
@@ -230,7 +230,7 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
         """A pixel reads its order's local or partition level (its row decides which)."""
         return (ks == k % spec.stairs) | (q_part == k // spec.stairs)
 
-    return phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
+    return orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
 
 
 def stairs_for(fringes: int) -> tuple[int, int]:
