@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import signal
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -365,7 +366,13 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
     click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
+def _terminated(signum: int, frame: Any) -> None:
+    """SIGTERM ends the command like Ctrl-C: temporary outputs are removed on the way out."""
+    raise SystemExit(128 + signum)
+
+
 def main() -> None:
+    signal.signal(signal.SIGTERM, _terminated)
     try:
         cli(standalone_mode=False)
     except click.exceptions.Abort:

@@ -82,10 +82,37 @@ class Prepared:
 
 
 def full_scale_of(stack: np.ndarray) -> float:
-    """Full-scale value of a stack: its dtype's range, or the smallest common range above it."""
+    """Full-scale value of a stack: its dtype's range, or the smallest common range above it.
+
+    A 10-, 12- or 14-bit camera's data stored MSB-aligned in 16-bit containers (values that
+    are all multiples of ``2**z``, the top above 16383) saturates at ``65536 - 2**z``, not at
+    65535: its full scale is detected from the bits that are never set.
+
+    Parameters
+    ----------
+    stack : numeric array of any shape.
+
+    Returns
+    -------
+    float
+        255 for ``uint8``; for other integers and for floats above 1 the smallest of
+        255, 1023, 4095, 16383 and 65535 at or above the maximum (or the MSB-aligned full
+        scale above), the maximum itself beyond that; 1 for floats within [0, 1].
+
+    Examples
+    --------
+    >>> full_scale_of(np.array([0, 4095], np.uint16)), full_scale_of(np.array([0.2, 0.9]))
+    (4095.0, 1.0)
+    >>> full_scale_of(np.array([0, 16, 65520], np.uint16))  # 12 bits, MSB-aligned
+    65520.0
+    """
     if stack.dtype == np.uint8:
         return 255.0
     top = float(np.nanmax(stack)) if stack.size else 0.0
+    if stack.dtype == np.uint16 and top > 16383:
+        used_bits = int(np.bitwise_or.reduce(stack, axis=None))
+        zeros = (used_bits & -used_bits).bit_length() - 1
+        return 65536.0 - 2**zeros if 2 <= zeros <= 8 else 65535.0
     if np.issubdtype(stack.dtype, np.integer) or top > 1.0:
         for scale in (255.0, 1023.0, 4095.0, 16383.0, 65535.0):
             if top <= scale:
