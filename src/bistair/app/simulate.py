@@ -23,7 +23,7 @@ Examples
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -43,12 +43,12 @@ from ..sim.boards import write_board_captures
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
              camera_size: tuple[int, int] | None = None, compensated: bool = True,
-             **imaging: Any) -> Path:
+             progress: Callable[[str], None] | None = None, **imaging: Any) -> Path:
     """Render ``scene`` for each of ``methods`` and write the capture folders into ``out``.
 
     ``imaging`` goes to :class:`bistair.sim.Imaging` (``gamma``, ``read_noise``,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
-    the projector's gamma.
+    the projector's gamma. ``progress`` is called with each stage's name as it starts.
 
     Raises
     ------
@@ -78,9 +78,12 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
     specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
                          methods=methods)
+    say = progress or (lambda stage: None)
+    say(f"tracing {scene} ({rig.camera.size[0]}x{rig.camera.size[1]})")
     traced = trace(rig, geometry, im)
     with output_folder(out) as tmp:
         for method, (spec, _) in specs.items():
+            say(f"rendering and writing {method}")
             folder = tmp / method
             folder.mkdir()
             images = expose(traced, encode(spec), im)
