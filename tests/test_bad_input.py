@@ -53,6 +53,8 @@ ROWS = [
     # demo
     (["demo", "--camera", "0x0", "--out", "{out}"], "camera size 0x0 must be 8 to 8192 whole"),
     (["demo", "--seed", "-1", "--out", "{out}"], "seed must be a whole number of at least 0"),
+    (DECODE + ["--threads", "0"], "Invalid value for '--threads': 0 is not in the range x>=1"),
+    (DECODE + ["--threads", "many"], "Invalid value for '--threads': 'many' is not a valid"),
     # decode --min-modulation: a fraction of full scale, strictly between 0 and 1
     (DECODE + ["--min-modulation", "-1"], "the minimum modulation must lie between 0 and 1 "
                                           "(a fraction of full scale), got -1.0"),

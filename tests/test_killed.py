@@ -36,9 +36,11 @@ def _wait_for_temp(parent: Path, proc: subprocess.Popen) -> Path:
 def test_signal_while_writing_leaves_nothing(tmp_path: Path, sig: signal.Signals) -> None:
     out = tmp_path / "scans"
     proc = _start(out)
-    _wait_for_temp(tmp_path, proc)
+    temp = _wait_for_temp(tmp_path, proc)
     proc.send_signal(sig)
     _, err = proc.communicate(timeout=60)
+    if proc.returncode == 0 and out.exists() and not temp.exists():
+        pytest.skip("the command finished writing before the signal reached it (busy machine)")
     assert proc.returncode != 0
     assert list(tmp_path.iterdir()) == [], "temporary output left behind"
     assert "Traceback" not in err

@@ -19,11 +19,34 @@ Examples
 
 from __future__ import annotations
 
-from .codecs import decode, encode, get_codec, make_spec, methods, spec_from_dict
-from .core.result import DecodeResult
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .errors import BistairError
-from .io.files import load_spec
+
+if TYPE_CHECKING:
+    from .codecs import decode, encode, get_codec, make_spec, methods, spec_from_dict
+    from .core.result import DecodeResult
+    from .io.files import load_spec
 
 __all__ = ["BistairError", "DecodeResult", "decode", "encode", "get_codec", "load_spec",
            "make_spec", "methods", "spec_from_dict"]
 __version__ = "0.1.0"
+
+# the public names, imported on first use (PEP 562) so that ``import bistair`` and
+# ``bistair --version`` do not pay for SciPy and the codecs before they are needed
+_LAZY = {"decode": ".codecs", "encode": ".codecs", "get_codec": ".codecs",
+         "make_spec": ".codecs", "methods": ".codecs", "spec_from_dict": ".codecs",
+         "DecodeResult": ".core.result", "load_spec": ".io.files"}
+
+
+def __getattr__(name: str) -> Any:
+    if name not in _LAZY:
+        raise AttributeError(f"module 'bistair' has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name], __name__), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})

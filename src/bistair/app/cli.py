@@ -18,7 +18,6 @@ from typing import Any
 import click
 import numpy as np
 
-from ..codecs import REGISTRY
 from ..errors import BistairError
 from ..spec import BaseSpec, coerce_field, field_kind
 
@@ -48,13 +47,49 @@ def _quiet(func: Callable) -> Callable:
                         help="print only errors and warnings (no progress, no summary)")(func)
 
 
+def _threads(func: Callable) -> Callable:
+    """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
+
+    def limit(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
+        if value is not None:
+            import cv2
+
+            from ..core.kernels import set_threads
+
+            set_threads(value)
+            cv2.setNumThreads(value)
+        return value
+
+    return click.option("--threads", type=click.IntRange(min=1), default=None,
+                        expose_value=False, callback=limit,
+                        help="use at most N threads [default: every core]")(func)
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="bistair", prog_name="bistair")
 def cli() -> None:
     """Absolute phase measurement for fringe projection profilometry."""
 
 
-@cli.group()
+class _MethodCommands(click.Group):
+    """A group whose method commands are made from the registry when asked for, so that
+    ``bistair --version`` and ``--help`` do not import the codecs."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        from ..codecs import REGISTRY
+
+        return [*REGISTRY, *super().list_commands(ctx)]
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        from ..codecs import REGISTRY
+
+        codec = REGISTRY.get(cmd_name)
+        if codec is None:
+            return super().get_command(ctx, cmd_name)
+        return _spec_command(codec.name, codec.spec_class, codec.summary)
+
+
+@cli.group(cls=_MethodCommands)
 def patterns() -> None:
     """Write a method's patterns (NN.png) and their spec.json into a folder."""
 
@@ -99,10 +134,6 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
 def _show(value: Any) -> str:
     """A default as the command line shows it: 30 rather than 30.0."""
     return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
-
-
-for _codec in REGISTRY.values():
-    patterns.add_command(_spec_command(_codec.name, _codec.spec_class, _codec.summary))
 
 
 @patterns.command("gamma")
@@ -151,6 +182,7 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@_threads
 @_quiet
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
@@ -238,6 +270,7 @@ def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int,
              noise: float, blur: float, gamma: float, compensated: bool, ambient: float,
              bits: str, seed: int, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth."""
+    from ..codecs import REGISTRY
     from .progress import Progress
     from .simulate import simulate as run
 
@@ -342,6 +375,7 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="specs of both axes: drop pixels whose projector column and "
               "row lie farther than this (projector pixels) from the camera ray's projection")
+@_threads
 @_quiet
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,

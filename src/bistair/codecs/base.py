@@ -46,6 +46,8 @@ from ..core.checks import (
     edge_alignment,
     jump_problem,
     outside_problem,
+    swapped_frames,
+    wrap_steps,
 )
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
@@ -69,6 +71,8 @@ class CodeMap:
     cycle : the code repeats every ``cycle`` values (a stair), or ``None``.
     check : a codec's own check of the phase convention, where its code says nothing of
         it (multi-frequency: the code comes from the phases themselves).
+    beyond : valid pixels whose code names a fringe beyond the projector's last (counted
+        with the coordinates outside the projector).
     """
 
     code: np.ndarray
@@ -76,6 +80,7 @@ class CodeMap:
     edge_phase: float = 0.0
     cycle: int | None = None  # the code repeats every ``cycle`` values (a stair)
     check: EdgeCheck | None = None  # a codec's own check of the phase convention
+    beyond: int = 0  # pixels whose code names a fringe beyond the projector's last
 
     @property
     def edges(self) -> np.ndarray:
@@ -86,7 +91,7 @@ class CodeMap:
         """The same maps with image axes swapped (for the rows orientation)."""
         return CodeMap(np.ascontiguousarray(self.code.T),
                        {k: np.ascontiguousarray(v.T) for k, v in self.maps.items()},
-                       self.edge_phase, self.cycle, self.check)
+                       self.edge_phase, self.cycle, self.check, self.beyond)
 
 
 @dataclass
@@ -120,7 +125,8 @@ class Codec:
     simulator); ``variants`` names decoder options worth comparing too (label -> options).
     ``aligned``: the decoder needs the coded axis to run along the image's rows of the
     column layout (bands of a code down the image), so captures whose phase changes more
-    across that axis are refused; for the others it is a warning.
+    across that axis are refused; for the others it is a warning (a camera turned against
+    the projector, as on a rig rolled by 90 degrees, decodes right with a per-pixel code).
     """
 
     name: str
@@ -211,18 +217,26 @@ class Codec:
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
+        _refuse(shift_order_problem(cols, fs.valid, spec))
         turned = axis_problem(fs.phi, fs.valid, spec.orientation)
-        if self.aligned:
+        if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
             _refuse(turned)
         code = self.code_columns(cols, spec, fs, min_modulation)
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
+        if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
+            bad, big, links = wrap_steps(fs.phi, orders.order, fs.valid)
+            orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
+            _refuse(jump_problem(bad, links, limit=0.05, big=big, big_limit=0.02))
         _refuse(jump_problem(orders.info.get("jump_violations", 0),
                              orders.info.get("jump_links", 0)))
         result = result_from_orders(self.name, fs, orders.order, spec.period,
                                    code=code.code, info=orders.info, length=spec.coded_length)
+        if code.beyond:
+            result.info["outside_projector"] = (result.info.get("outside_projector", 0)
+                                                + code.beyond)
         _refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
                                 spec.coded_length))
         result.info["valid_pixels"] = int(result.mask.sum())
@@ -231,6 +245,32 @@ class Codec:
             result = result.transposed()
         result.texture = prepared.white
         return result
+
+
+def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
+                        samples: int = 20000) -> str | None:
+    """A one-line reason to refuse when two frames of an N-step set look swapped
+    (:func:`~bistair.core.checks.swapped_frames`, on a subsample of the valid pixels)."""
+    names = spec.method_frames()
+    sets: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        if "shift-" in name:
+            sets.setdefault(name.rsplit("shift-", 1)[0], []).append(i)
+    idx = np.flatnonzero(valid)
+    idx = idx[:: max(1, idx.size // samples)]
+    if idx.size < 500:
+        return None
+    r, c = np.unravel_index(idx, valid.shape)
+    for members in sets.values():
+        if len(members) < 4:
+            continue
+        values = np.stack([np.asarray(cols.frames.raw[m][r, c], np.float64) for m in members])
+        pair = swapped_frames(values, spec.shift_sign)
+        if pair is not None:
+            a, b = (names[members[i]] for i in pair)
+            return (f"frames {a} and {b} look swapped: the phase shifts fit a sinusoid three "
+                    "times better exchanged (check the frame order)")
+    return None
 
 
 def _refuse(problem: str | None) -> None:

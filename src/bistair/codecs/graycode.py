@@ -197,7 +197,9 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         maps["second_phase"] = second.phi
     ok = valid & (k >= 0) & (k < spec.fringes)
     maps["edges"] = np.where(valid, edges, -1).astype(np.int32)
-    return CodeMap(np.where(ok, k, -1).astype(np.int32), maps, edge_phase=edge_phase)
+    beyond = int(np.count_nonzero(valid & (k >= spec.fringes)))
+    return CodeMap(np.where(ok, k, -1).astype(np.int32), maps, edge_phase=edge_phase,
+                   beyond=beyond)
 
 
 def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,

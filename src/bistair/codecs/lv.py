@@ -131,7 +131,7 @@ def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:
 
 
 def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.ndarray,
-                    spec: LvSpec) -> np.ndarray:
+                    spec: LvSpec, info: dict | None = None) -> np.ndarray:
     """Votes of every chain of ``window`` adjacent regions for its members' orders.
 
     Each region starts a window (itself and the next ``window - 1`` regions up); the window's
@@ -139,7 +139,9 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     whose neighbour (starting one region before or after) was found elsewhere than one place
     before or after it is contradicted and does not vote; one with neighbours must be
     confirmed by one of them. A region's evidence is the share of its windows voting for
-    each order, weighted by the least sure code in the window.
+    each order, weighted by the least sure code in the window. ``info`` receives how many
+    complete windows were read (``code_windows``) and how many of them the sequence does
+    not hold (``unknown_windows``).
     """
     n_reg = region_code.size - 1
     table = np.full(spec.levels ** spec.window, -1, np.int64)
@@ -156,6 +158,8 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     ok = (chain >= 0).all(axis=1) & (region_code[safe] >= 0).all(axis=1) & distinct
     ok[0] = False
     start = np.where(ok, table[_window_key(region_code[safe], spec.levels)], -1)
+    if info is not None:
+        info.update(code_windows=int(ok.sum()), unknown_windows=int((ok & (start < 0)).sum()))
     ok &= start >= 0
     pred = np.full(n_reg + 1, -1, np.int64)
     has_succ = succ >= 0
@@ -205,13 +209,19 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
         region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
         region_code[0] = -1
         succ = _successors(region_links(fs.phi, labels), n)
-        return labels, n, window_evidence(region_code, shares.max(axis=1), succ, spec)
+        return labels, n, window_evidence(region_code, shares.max(axis=1), succ, spec, info)
 
     sequence = np.asarray(spec.sequence)
-    info = {"noise": fs.noise, "fringes": spec.fringes}
+    info: dict = {"noise": fs.noise, "fringes": spec.fringes}
     order = orders_from_regions(
         fs.phi, fs.valid, labels, evidence_of, info=info,
         agrees=lambda k: (codes == sequence[np.clip(k, 0, None)]) | (codes < 0))
+    windows, unknown = info.get("code_windows", 0), info.get("unknown_windows", 0)
+    if windows >= 20 and unknown > 0.15 * windows:
+        raise BistairError(
+            f"the captures do not fit the spec: {100 * unknown / windows:.0f}% of the "
+            f"{windows} code windows read are not in the spec's code sequence: does the spec "
+            "fit (period, projector size, levels, window)?")
     return Orders(order, info)
 
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .phase import TWO_PI, wrap
+from .phase import TWO_PI, shifts_of, wrap
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 
@@ -126,10 +126,11 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     return ("refuse" if abs(check.crossing) > np.pi / 3 else "warn", message)
 
 
-def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str) -> str | None:
+def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str,
+                 factor: float = 1.0) -> str | None:
     """A one-line reason to refuse when the wrapped phase (column layout: the coded axis
-    along the rows) changes more down the columns than along the rows, i.e. the fringes run
-    along the image's coded axis instead of across it.
+    along the rows) changes more than ``factor`` times as fast down the columns as along
+    the rows, i.e. the fringes run along the image's coded axis instead of across it.
 
     >>> x = np.arange(128.0)
     >>> phi = np.tile((2 * np.pi * x / 16) % (2 * np.pi), (64, 1)).astype(np.float32)
@@ -144,7 +145,7 @@ def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str) -> str | 
     if min(along.size, across.size) < 500:
         return None
     a, c = float(np.median(along)), float(np.median(across))
-    if c <= a:
+    if c <= factor * a:
         return None
     axis, other = ("x", "rows") if orientation == "columns" else ("y", "columns")
     down = "down" if orientation == "columns" else "across"
@@ -168,18 +169,102 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
             f"outside the {length}-px projector: is the period (or the projector size) right?")
 
 
-def jump_problem(violations: int, links: int) -> str | None:
-    """A one-line reason to refuse when the fringe orders do not step by one across many
-    phase jumps (the code does not fit the spec's levels).
+def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
+               every: int = 2, reach: int = 3) -> tuple[int, int, int]:
+    """How the fringe orders step across the clean wraps of the wrapped phase along the
+    rows (every ``every``-th row).
+
+    A clean wrap is a place where the wrapped phase wraps around and runs on smoothly
+    (within 0.6 rad per pixel once unwrapped) for ``reach`` pixels on either side, without
+    another wrap and with every pixel valid. Across it the order must step by exactly one
+    (up when the phase falls from near 2*pi to near 0), measured between the ends of that
+    window, so that a per-pixel code that switches a pixel or two early or late beside its
+    edges (blur) does not count. Object edges are rarely smooth across, so almost every
+    violation is a misread code; a violation by two or more orders (``big``) is a code read
+    wrong in a whole block of fringes.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in [0, 2*pi).
+    order : (H, W) int array
+        Fringe orders, -1 where invalid.
+    valid : (H, W) bool array
+        Pixels to judge.
+    every : int
+        Judge every ``every``-th row.
+    reach : int
+        Pixels on either side of a wrap that must run on smoothly.
+
+    Returns
+    -------
+    (violations, big violations, places) : tuple of int
+        ``places`` counts the clean wraps.
+
+    Examples
+    --------
+    >>> x = np.arange(300.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (8, 1)).astype(np.float32)
+    >>> order = np.tile((x // 30).astype(np.int32), (8, 1))
+    >>> ok = np.ones(phi.shape, bool)
+    >>> wrap_steps(phi, order, ok)
+    (0, 0, 36)
+    >>> wrap_steps(phi, order % 4, ok)  # a code that repeats every 4 fringes
+    (8, 8, 36)
+    >>> late = order.copy()
+    >>> late[:, 30] -= 1  # the code switches one pixel late at one edge
+    >>> wrap_steps(phi, late, ok)
+    (0, 0, 36)
+    """
+    p, k = phi[::every].astype(np.float32), order[::every]
+    ok = valid[::every] & (k >= 0)
+    width = p.shape[1]
+    if width < 2 * reach + 2:
+        return 0, 0, 0
+    d = p[:, 1:] - p[:, :-1]
+    wraps = np.abs(d) > np.pi
+    clean = ok[:, 1:] & ok[:, :-1] & (np.abs(d - TWO_PI * np.round(d / TWO_PI)) < 0.6)
+    zero = np.zeros((p.shape[0], 1), np.int32)
+    bad_sum = np.concatenate([zero, np.cumsum(~clean, axis=1, dtype=np.int32)], axis=1)
+    wrap_sum = np.concatenate([zero, np.cumsum(wraps & clean, axis=1, dtype=np.int32)], axis=1)
+    span = 2 * reach + 1  # the pairs j-reach .. j+reach around the wrap at pair j
+    bad_in = bad_sum[:, span:] - bad_sum[:, :-span]
+    wraps_in = wrap_sum[:, span:] - wrap_sum[:, :-span]
+    centre = slice(reach, width - 1 - reach)
+    judged = wraps[:, centre] & (bad_in == 0) & (wraps_in == 1)
+    want = np.where(d[:, centre] > 0, -1, 1)  # read only at wraps
+    step = k[:, span:].astype(np.int64) - k[:, :-span]
+    off = np.abs(step - want)[judged]
+    return int(np.count_nonzero(off)), int(np.count_nonzero(off >= 2)), int(judged.sum())
+
+
+def jump_problem(violations: int, links: int, limit: float = 0.1,
+                 big: int = 0, big_limit: float = 1.0) -> str | None:
+    """A one-line reason to refuse when the fringe orders do not step by one across more
+    than ``limit`` of the phase jumps (the code does not fit the spec's levels), or are off
+    by two or more orders at more than ``big_limit`` of them.
 
     >>> jump_problem(600, 2000)[:36]
     'the fringe orders do not step by one'
+    >>> jump_problem(150, 2000) is None, jump_problem(150, 2000, limit=0.05) is None
+    (True, False)
+    >>> jump_problem(50, 2000, 0.05, big=50, big_limit=0.02)[:40]
+    'the fringe orders jump by whole blocks a'
     """
-    if links < 200 or violations <= 0.1 * links:
+    if links < 200:
+        return None
+    if big > big_limit * links:
+        return (f"the fringe orders jump by whole blocks at {100 * big / links:.1f}% of the "
+                "phase jumps where the phase runs on smoothly, so the code is misread in "
+                "whole blocks: are code frames swapped, does the spec fit the captures "
+                "(frame order, period, projector size), or is there too much noise or blur "
+                "for this code?")
+    if violations <= limit * links:
         return None
     return (f"the fringe orders do not step by one across {100 * violations / links:.0f}% of "
             "the phase jumps, so the code is not read reliably: does the spec fit the "
-            "captures (method, levels, stairs, partitions, period, frame order)?")
+            "captures (method, levels, stairs, partitions, period, frame order), or is there "
+            "too much noise or blur for this code?")
 
 
 def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> float:
@@ -197,3 +282,54 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     d = np.abs(wrap(t[:, None] - levels[None, :]))
     nearest = d.argmin(axis=1)
     return float(np.median(d[np.arange(t.size), nearest] / (0.5 * gap[nearest])))
+
+
+def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:
+    """Median RMS residual of the N-step sinusoid fit over its modulation, for
+    ``samples`` of shape (N, pixels) (0 for N = 3, which has no redundancy).
+
+    >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
+    >>> phi = np.linspace(0, 6, 50)[None]
+    >>> round(fit_residual(0.5 + 0.3 * np.cos(phi + d)), 6)
+    0.0
+    """
+    steps = samples.shape[0]
+    if steps <= 3 or samples.shape[1] == 0:
+        return 0.0
+    d = shifts_of(steps, shift_sign)[:, None]
+    c = 2.0 / steps * (samples * np.cos(d)).sum(axis=0)
+    s = 2.0 / steps * (samples * np.sin(d)).sum(axis=0)
+    fit = samples.mean(axis=0) + c * np.cos(d) + s * np.sin(d)
+    rms = np.sqrt(((samples - fit) ** 2).sum(axis=0) / (steps - 3))
+    return float(np.median(rms / np.maximum(np.hypot(c, s), 1e-6)))
+
+
+def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] | None:
+    """The two frames of an N-step set (``samples``: (N, pixels), N >= 4) that look swapped:
+    the set fits a sinusoid badly (residual over 0.3 of the modulation) and, with those two
+    exchanged, at least three times better (of equally good exchanges, the nearest pair).
+    ``None`` when the set fits or no exchange helps (an uncompensated gamma leaves a
+    residual that no exchange removes).
+
+    >>> d = 2 * np.pi * np.arange(5)[:, None] / 5
+    >>> frames = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
+    >>> swapped_frames(frames) is None, swapped_frames(frames[[0, 2, 1, 3, 4]])
+    (True, (1, 2))
+    """
+    steps = samples.shape[0]
+    base = fit_residual(samples, shift_sign)
+    if steps <= 3 or base <= 0.3:
+        return None
+    tried = {}
+    for i in range(steps):
+        for j in range(i + 1, steps):
+            order = np.arange(steps)
+            order[[i, j]] = order[[j, i]]
+            tried[(i, j)] = fit_residual(samples[order], shift_sign)
+    best = min(tried.values())
+    if best >= base / 3:
+        return None
+    # an exchange can also turn the set into the reversed sequence, which fits as well:
+    # of the exchanges that fit about as well, the closest pair is the likely mistake
+    close = [pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6]
+    return min(close, key=lambda pair: (pair[1] - pair[0], pair))

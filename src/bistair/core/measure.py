@@ -20,7 +20,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from .captures import (
     Prepared,
@@ -92,7 +91,7 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
     ok = ok0 & ok1
     sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
     dof = steps - 3
-    return float(np.sqrt(np.median(sample) / (2.0 * stats.chi2.ppf(0.5, dof))))
+    return float(np.sqrt(np.median(sample) / (2.0 * _chi2_median(dof))))
 
 
 def _along_fringe_noise(frames: np.ndarray) -> float:
@@ -163,3 +162,11 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     """
     labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
     return keep_coherent(labels, weak, strong, n, min_strong, min_size)
+
+
+def _chi2_median(dof: int) -> float:
+    """The median of a chi-squared distribution of ``dof`` degrees of freedom (scipy.stats'
+    ``chi2.ppf(0.5, dof)`` without importing scipy.stats, half a second at start-up)."""
+    from scipy import special  # imported when first needed: keeps the CLI's start-up short
+
+    return float(2.0 * special.gammaincinv(dof / 2.0, 0.5))

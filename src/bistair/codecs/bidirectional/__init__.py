@@ -45,10 +45,10 @@ import numpy as np
 from scipy import ndimage
 
 from ...core.captures import Prepared
-from ...core.checks import stair_misfit
+from ...core.checks import stair_misfit, wrap_steps
 from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
-from ...core.phase import TWO_PI
+from ...core.phase import TWO_PI, wrap
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair, stair_phase
@@ -59,6 +59,8 @@ from .bands import (
     BandLayout,
     band_splits,
     group_heights,
+    nearest_level,
+    observed_levels,
     profile_centroids,
     region_evidence,
     row_profiles,
@@ -157,11 +159,56 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     theta, ks = code.maps["stair_phase"], code.code
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
     if strategy == "paper":
-        order = paper_orders(ks, theta, fs, spec)
-        order = order.astype(np.int32)
+        order = paper_orders(ks, theta, fs, spec).astype(np.int32)
+        # the published decoder as published: its orders are judged by the same limit as
+        # the region decoder's (10% of the phase jumps), and reported, not corrected
+        bad, big, links = wrap_steps(fs.phi, order, fs.valid)
+        info.update(jump_violations=bad, jump_links=links, block_jumps=big)
+        if links and bad > 0.005 * links:
+            info["warnings"] = [f"the paper decoder's orders do not step by one across "
+                                f"{100 * bad / links:.1f}% of the phase jumps"]
     else:
         order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
+    misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
+    info["stair_misfit"] = round(misfit, 4)
+    if misfit > 0.1:
+        raise BistairError(
+            f"the captures do not fit the spec: at {100 * misfit:.0f}% of the decoded pixels "
+            "the stair phase is nearer a level other than the local or partition level of the "
+            "decoded order: are partitions, stairs and period right?")
     return Orders(order, info)
+
+
+def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np.ndarray,
+              spec: BidirectionalSpec, samples: int = 20000) -> float:
+    """Share of decoded pixels whose stair phase contradicts their fringe order.
+
+    A pixel of order ``k`` shows the local level ``k % S`` or the partition level ``k // S``
+    (its projector row decides which). Among pixels whose stair phase is sharp (noise under
+    0.1 rad) and away from the fringe edges, those nearer another level of either stair
+    (by twice their noise and at least 0.05 rad; levels where this capture shows them, as
+    an uncompensated gamma moves them) contradict their order. A right decode has almost
+    none; a spec with other partitions or stairs than the captures' has many.
+    """
+    idx = np.flatnonzero(fs.valid & (order >= 0))
+    idx = idx[:: max(1, idx.size // samples)]
+    th, k = theta.ravel()[idx].astype(np.float64), order.ravel()[idx].astype(np.int64)
+    sigma = fs.noise * math.sqrt(2.0) / np.maximum(stair_mod.ravel()[idx], 1e-6)
+    phi = fs.phi.ravel()[idx]
+    sharp = (sigma < 0.1) & (phi > 0.5) & (phi < TWO_PI - 0.5)
+    th, k, sigma = th[sharp], k[sharp], sigma[sharp]
+    if th.size < 500:
+        return 0.0
+    levels = union_levels(spec.partitions, spec.stairs)
+    seen = observed_levels(th, np.ones(th.size), levels)
+    near = np.abs(wrap(th[:, None] - seen[None, :])).min(axis=1)
+    local = nearest_level(stair_level_phase(np.arange(spec.stairs), spec.stairs), levels)
+    part = nearest_level(stair_level_phase(np.arange(spec.partitions), spec.partitions), levels)
+    inside = k // spec.stairs < spec.partitions
+    kk = np.where(inside, k, 0)
+    own = np.minimum(np.abs(wrap(th - seen[local[kk % spec.stairs]])),
+                     np.abs(wrap(th - seen[part[kk // spec.stairs]])))
+    return float(np.mean(~inside | (own > near + np.maximum(0.05, 2.0 * sigma))))
 
 
 def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,

@@ -160,6 +160,10 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     kept = level >= 0.7 * _region_percentile(region, level, 0.8)
     dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
     idx = np.flatnonzero(kept)
+    if idx.size == 0:  # no band row left (tiny or pure-noise captures)
+        empty = np.zeros(0)
+        return Runs(*(empty.astype(np.int64),) * 3, empty, empty, empty,
+                    empty.astype(np.int64), empty.astype(bool), empty.astype(bool), empty)
     region_k, row_k = region[idx], row[idx]
     uid = read[idx]
     same = np.zeros(idx.size, bool)

@@ -1,0 +1,131 @@
+"""A spec that does not fit the captures is refused, never decoded into wrong numbers
+(issue 14, defect 1), for every codec.
+
+Each codec's captures of one scene are decoded with specs that differ from the one that
+made them: the other orientation, a wider projector, another period, other levels, another
+method's spec with the same frame count, code frames or shift frames swapped. Each decode
+must either be refused with a one-line :class:`BistairError` or be right (at most 1% of the
+valid pixels more than 5 projector pixels off the truth of the spec's coded axis).
+
+Not caught, by design: a period so close to the true one that the code reads the same
+(a stair sequence that is a prefix of a longer one, a Gray code of the same length). The
+captures alone cannot tell these apart; the README says so.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+import bistair
+from bistair.codecs import REGISTRY
+from bistair.errors import BistairError
+from bistair.sim import Imaging, expose, preset, trace
+
+COMMON = ["rows", "wider projector", "another method", "swapped code frames",
+          "swapped shift frames"]
+OWN = {
+    "bidirectional": ["period x1.5", "period 2000", "stairs - 1", "partitions + 1"],
+    "graycode": ["period x1.5", "not complementary"],
+    "lv": ["period x1.5", "levels + 1", "window + 1"],
+    "multifreq": ["periods reversed", "middle period off"],
+    "phase-coding": ["period x1.5", "period 2000"],
+}
+CASES = [(method, case) for method in sorted(REGISTRY) for case in COMMON + OWN.get(method, [])]
+
+
+@pytest.fixture(scope="module")
+def scene() -> Any:
+    rig, geometry = preset("objects-on-plane", camera_size=(480, 384))
+    imaging = Imaging(read_noise=0.01, camera_blur=1.0, seed=1)
+    return rig, imaging, trace(rig, geometry, imaging)
+
+
+def _spec(method: str, rig: Any, imaging: Any) -> Any:
+    """The codec's pattern set for the rig, pre-compensating the projector's gamma."""
+    width, height = rig.projector.size
+    params = REGISTRY[method].comparable(width, height, 30, 4)
+    return bistair.make_spec(method, width=width, height=height, gamma=imaging.gamma, **params)
+
+
+def _changes(spec: Any, case: str) -> dict[str, Any]:
+    p = getattr(spec, "periods", None)
+    return {
+        "rows": {"orientation": "rows"},
+        "wider projector": {"width": spec.width * 16 // 9},
+        "period x1.5": {"period": getattr(spec, "period", 0) * 1.5},
+        "period 2000": {"period": 2000.0},
+        "periods reversed": {"periods": tuple(reversed(p or ()))},
+        "middle period off": {"periods": (p[0], p[1] * 1.2, *p[2:])} if p else {},
+        "stairs - 1": {"stairs": getattr(spec, "stairs", 0) - 1,
+                       "partitions": getattr(spec, "partitions", 0) + 1},
+        "partitions + 1": {"partitions": getattr(spec, "partitions", 0) + 1},
+        "levels + 1": {"levels": getattr(spec, "levels", 0) + 1},
+        "window + 1": {"window": getattr(spec, "window", 0) + 1},
+        "not complementary": {"complementary": 0},
+    }[case]
+
+
+def _truth(spec: Any, truth: Any) -> np.ndarray:
+    return truth.coord_x if spec.orientation == "columns" else truth.coord_y
+
+
+def _refused_or_right(images: np.ndarray, spec: Any, truth: Any) -> str:
+    try:
+        result = bistair.decode(images, spec)
+    except BistairError as exc:
+        message = str(exc)
+        assert message and "\n" not in message
+        return "refused"
+    both = result.mask & truth.mask
+    assert both.sum() > 1000, "a decode that answers for almost no pixel"
+    wrong = np.abs(result.coord[both] - _truth(spec, truth)[both]) > 5.0
+    # phase coding's 36 stair levels misread one region of this scene by one order even
+    # with the right spec (1.3% of the valid pixels, measured): its own limit, not a mismatch
+    limit = 0.02 if spec.method == "phase-coding" else 0.01
+    assert wrong.mean() <= limit, f"{100 * wrong.mean():.1f}% of the valid pixels wrong"
+    return "right"
+
+
+@pytest.mark.parametrize(("method", "case"), CASES, ids=[f"{m}-{c}" for m, c in CASES])
+def test_a_spec_that_does_not_fit_is_refused(scene: Any, method: str, case: str) -> None:
+    rig, imaging, traced = scene
+    spec = _spec(method, rig, imaging)
+    images = expose(traced, bistair.encode(spec), imaging)
+    code = [i for i, name in enumerate(spec.frames) if "shift" not in name]
+    if case == "another method":
+        others = [_spec(m, rig, imaging) for m in sorted(REGISTRY) if m != method]
+        wrong_specs = [s for s in others if s.frame_count == spec.frame_count]
+        if not wrong_specs:
+            pytest.skip(f"no other method has {spec.frame_count} frames")
+        for other in wrong_specs:
+            _refused_or_right(images, other, traced.truth)
+        return
+    if case == "swapped code frames":
+        frames = code if len(code) >= 2 else list(range(spec.steps, spec.steps * 2))
+        for i in range(0, len(frames) - 1, 2):
+            swapped = images.copy()
+            swapped[[frames[i], frames[i + 1]]] = swapped[[frames[i + 1], frames[i]]]
+            _refused_or_right(swapped, spec, traced.truth)
+        return
+    if case == "swapped shift frames":
+        swapped = images.copy()
+        swapped[[0, 1]] = swapped[[1, 0]]
+        _refused_or_right(swapped, spec, traced.truth)
+        return
+    try:
+        wrong = spec.replace(**_changes(spec, case))
+    except BistairError:
+        pytest.skip(f"{case}: the spec itself is refused")
+    _refused_or_right(images, wrong, traced.truth)
+
+
+@pytest.mark.parametrize("method", sorted(REGISTRY))
+def test_the_right_spec_decodes_the_same_scene(scene: Any, method: str) -> None:
+    """The baseline of the table above: with its own spec each codec decodes this scene."""
+    rig, imaging, traced = scene
+    spec = _spec(method, rig, imaging)
+    images = expose(traced, bistair.encode(spec), imaging)
+    assert _refused_or_right(images, spec, traced.truth) == "right"
