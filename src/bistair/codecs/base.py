@@ -111,7 +111,37 @@ OrderFn = Callable[..., Orders]
 def measure_shifts(prepared: Prepared, spec: PeriodSpec,
                    min_modulation: float | None = None) -> FringeSet:
     """Stage 1 of the single-period methods: their N-step set, the first ``steps`` frames,
-    in the spec's phase convention."""
+    in the spec's phase convention.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : PeriodSpec
+        The spec: ``steps``, ``shift_sign`` and ``phase_offset`` are used.
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a valid pixel needs; by default a threshold
+        from the measured camera noise.
+
+    Returns
+    -------
+    FringeSet
+        (H, W) float32 wrapped phase in [0, 2*pi) (radians), average and modulation
+        (fractions of full scale), the validity mask and the camera noise.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> fs.phi.shape, int(fs.valid.sum())
+    ((32, 240), 7680)
+    >>> (fs.phi[0, 7:30:7] * 30 / (2 * np.pi)).round(2).tolist()  # projector pixels
+    [7.0, 14.0, 21.0, 28.0]
+    """
     return measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
                    phase_offset=spec.phase_offset)
 
@@ -250,7 +280,41 @@ class Codec:
 def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
                         samples: int = 20000) -> str | None:
     """A one-line reason to refuse when two frames of an N-step set look swapped
-    (:func:`~bistair.core.checks.swapped_frames`, on a subsample of the valid pixels)."""
+    (:func:`~bistair.core.checks.swapped_frames`, on a subsample of the valid pixels).
+
+    Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
+    or more steps is checked; captures with fewer than 500 valid pixels are not judged.
+
+    Parameters
+    ----------
+    cols : Prepared
+        The method's frames in method order, column layout.
+    valid : numpy.ndarray
+        (H, W) bool, the pixels to judge (the stage-1 validity).
+    spec : BaseSpec
+        The spec whose ``method_frames`` name the frames and whose ``shift_sign`` gives the
+        direction of the shifts.
+    samples : int, default 20000
+        About how many valid pixels to use.
+
+    Returns
+    -------
+    str or None
+        The reason naming the two frames, or ``None`` when no pair looks swapped.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> shift_order_problem(cols, measure_shifts(cols, spec).valid, spec) is None
+    True
+    >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
+    >>> swapped = prepare(images, spec.frame_count, spec.method)
+    >>> shift_order_problem(swapped, measure_shifts(swapped, spec).valid, spec).split(":")[0]
+    'frames shift-0 and shift-1 look swapped'
+    """
     names = spec.method_frames()
     sets: dict[str, list[int]] = {}
     for i, name in enumerate(names):
@@ -280,7 +344,46 @@ def _refuse(problem: str | None) -> None:
 
 def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     """Refuse captures whose code steps do not sit where the spec's phase convention puts
-    them (:mod:`bistair.core.checks`); returns the warnings worth a line."""
+    them (:mod:`bistair.core.checks`); returns the warnings worth a line.
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2, column layout; its own ``check`` is used if it has one, else its ``edges``
+        are aligned against the wrapped phase (at ``edge_phase``, every ``cycle`` values).
+    spec : BaseSpec
+        The spec whose ``phase_offset`` and ``shift_sign`` the captures should follow.
+
+    Returns
+    -------
+    list of str
+        Warnings (empty when the code's steps sit where they should).
+
+    Raises
+    ------
+    BistairError
+        The code's steps sit clearly elsewhere than the convention puts them (another
+        ``phase_offset`` or ``shift_sign``).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> from bistair.codecs.graycode import code_columns
+    >>> fs = measure_shifts(cols, spec)
+    >>> check_convention(fs, code_columns(cols, spec, fs), spec)
+    []
+    >>> other = spec.replace(phase_offset=1.0)  # not how the patterns were made
+    >>> fs = measure_shifts(cols, other)
+    >>> check_convention(fs, code_columns(cols, other, fs), other)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: the code steps where ...
+    """
     check = code.check or edge_alignment(fs.phi, code.edges, fs.valid, code.edge_phase,
                                          code.cycle)
     problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase)
@@ -297,6 +400,20 @@ def fringe_index(spec: BaseSpec, period: float | None = None) -> np.ndarray:
     spec's period by default). A hair of tolerance keeps pixels that sit exactly on a
     fringe edge of a fractional period (``1920/58``) in the fringe their phase says.
 
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec: ``coded_length`` and (by default) ``period`` are used.
+    period : float, optional
+        The period in projector pixels, instead of the spec's.
+
+    Returns
+    -------
+    numpy.ndarray
+        (coded_length,) int64, the fringe order of every projector pixel.
+
+    Examples
+    --------
     >>> from bistair.codecs import make_spec
     >>> fringe_index(make_spec("graycode", width=120, height=16, period=30))[28:32].tolist()
     [0, 0, 1, 1]
@@ -307,7 +424,30 @@ def fringe_index(spec: BaseSpec, period: float | None = None) -> np.ndarray:
 
 def shift_patterns(spec: BaseSpec, period: float | None = None) -> np.ndarray:
     """The N-step fringe patterns along the coded axis, ``(steps, coded_length)``, in the
-    spec's phase convention (``phase_offset``, ``shift_sign``)."""
+    spec's phase convention (``phase_offset``, ``shift_sign``).
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec: ``coded_length``, ``steps``, ``offset``, ``amplitude``, ``phase_offset``,
+        ``shift_sign`` and (by default) ``period`` are used.
+    period : float, optional
+        The period in projector pixels, instead of the spec's.
+
+    Returns
+    -------
+    numpy.ndarray
+        (steps, coded_length) float64 intensities, ``offset + amplitude * cos(...)``
+        (fractions of full scale).
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> pats = shift_patterns(spec)
+    >>> pats.shape, pats[:, 0].round(2).tolist(), pats[:, 15].round(2).tolist()
+    ((4, 240), [1.0, 0.5, 0.0, 0.5], [0.0, 0.5, 1.0, 0.5])
+    """
     x = np.arange(spec.coded_length)
     return phase_shift_patterns(x, spec.period if period is None else period, spec.steps,
                                 spec.offset, spec.amplitude, spec.phase_offset,
@@ -315,6 +455,28 @@ def shift_patterns(spec: BaseSpec, period: float | None = None) -> np.ndarray:
 
 
 def along_columns(profiles: np.ndarray, spec: BaseSpec) -> np.ndarray:
-    """Patterns that vary along the coded axis only: (frames, coded) -> (frames, other, coded)."""
+    """Patterns that vary along the coded axis only: (frames, coded) -> (frames, other, coded).
+
+    Parameters
+    ----------
+    profiles : numpy.ndarray
+        (frames, coded_length) intensities along the coded axis.
+    spec : BaseSpec
+        The spec whose ``other_length`` is the number of pattern rows.
+
+    Returns
+    -------
+    numpy.ndarray
+        (frames, other_length, coded_length) float32, a read-only broadcast view that
+        repeats each profile on every row (column layout).
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=120, height=16, period=30)
+    >>> pats = along_columns(shift_patterns(spec), spec)
+    >>> pats.shape, pats.dtype, bool((pats[:, 0] == pats[:, 15]).all())
+    ((4, 16, 120), dtype('float32'), True)
+    """
     rows = np.asarray(profiles, dtype=np.float32)[:, None, :]
     return np.broadcast_to(rows, (rows.shape[0], spec.other_length, rows.shape[2]))

@@ -72,6 +72,18 @@ from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_pat
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
     """Decode reflected Gray code integers.
 
+    Parameters
+    ----------
+    gray : numpy.ndarray
+        Non-negative integers in reflected Gray code, any shape and integer dtype.
+
+    Returns
+    -------
+    numpy.ndarray
+        The binary values, a new array of the same shape and dtype.
+
+    Examples
+    --------
     >>> gray_to_binary(np.array([0, 1, 3, 2, 6, 7, 5, 4])).tolist()
     [0, 1, 2, 3, 4, 5, 6, 7]
     """
@@ -138,6 +150,34 @@ class GrayCodeSpec(PeriodSpec):
 
 
 def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
+    """The patterns of a Gray-code spec in the column layout, in method-frame order.
+
+    The N-step set, the second N-step set (with ``second_period``), the ``code_bits`` Gray
+    code patterns most significant first (one more when complementary) and, with
+    ``inverse``, their inverses. A code pattern is ``offset + amplitude`` where its bit is 1,
+    ``offset - amplitude`` where it is 0.
+
+    Parameters
+    ----------
+    spec : GrayCodeSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        (frames, other_length, coded_length) float32 intensities (fractions of full scale),
+        a read-only view whose rows are all the same.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> pats = encode_columns(spec)
+    >>> pats.shape
+    (7, 32, 240)
+    >>> (pats[4:, 0, 15::30] > 0.5).astype(int).tolist()  # the bits of fringes 0..7
+    [[0, 0, 0, 0, 1, 1, 1, 1], [0, 0, 1, 1, 1, 1, 0, 0], [0, 1, 1, 0, 0, 1, 1, 0]]
+    """
     shifts = shift_patterns(spec)
     second = shift_patterns(spec, spec.second_period) if spec.second_period else shifts[:0]
     n_bits = spec.code_bits + spec.complementary
@@ -163,6 +203,39 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
 
     ``edges`` is the code as read, whose steps sit at the code's own edges (at wrapped phase
     ``edge_phase``): the decode checks them against the phase.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : GrayCodeSpec
+        The spec of one coded axis.
+    fs : FringeSet
+        Stage 1: the wrapped phase in [0, 2*pi), the average the bits are binarised against
+        (without inverses) and the valid pixels.
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a pixel of the second N-step set needs.
+
+    Returns
+    -------
+    CodeMap
+        ``code``: (H, W) int32 fringe order, -1 where not decoded; ``maps["edges"]`` the
+        order as read (-1 where invalid), ``maps["second_phase"]`` with a second period;
+        ``edge_phase`` 0 (pi for the shifted code); ``beyond``, the valid pixels whose code
+        names a fringe past the projector's last.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> code.code.dtype, code.code[0, ::30].tolist(), code.edge_phase, code.beyond
+    (dtype('int32'), [0, 1, 2, 3, 4, 5, 6, 7], 0.0, 0)
     """
     n = spec.steps
     start = n * (2 if spec.second_period else 1)
@@ -223,7 +296,48 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
                   strategy: str = "pixel") -> Orders:
     """Stage 3: the code is the order, per pixel (``pixel``, the classic decode), or voted
     per fringe region with the pixels far from the code's edges counting most (``region``:
-    a code misread beside its edges is outvoted by the rest of its fringe)."""
+    a code misread beside its edges is outvoted by the rest of its fringe).
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2 (:func:`code_columns`).
+    spec : GrayCodeSpec
+        The spec of one coded axis.
+    strategy : {"pixel", "region"}
+        Per-pixel orders (the classic decode) or one order per fringe region.
+
+    Returns
+    -------
+    Orders
+        (H, W) fringe order per pixel (-1 where invalid) and ``info``: the strategy, the
+        camera noise, the code bits, and for ``region`` the region counts and the phase
+        jumps across which the orders do not step by one.
+
+    Raises
+    ------
+    BistairError
+        ``strategy`` is neither ``"pixel"`` nor ``"region"``.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> orders = order_columns(fs, code, spec, strategy="region")
+    >>> orders.order[0, ::30].tolist(), orders.info["regions"], orders.info["jump_violations"]
+    ([0, 1, 2, 3, 4, 5, 6, 7], 8, 0)
+    >>> order_columns(fs, code, spec, strategy="mode")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: unknown strategy 'mode' (use 'pixel' or 'region')
+    """
     if strategy not in ("pixel", "region"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'pixel' or 'region')")
     info = {"strategy": strategy, "noise": fs.noise,
@@ -246,7 +360,27 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
-    """The complementary Gray code at the same period."""
+    """The complementary Gray code at the same period.
+
+    Parameters
+    ----------
+    width, height : int
+        Projector size in pixels (not used: the code covers any width).
+    period : int
+        Fringe period in projector pixels.
+    steps : int
+        Phase-shift steps N.
+
+    Returns
+    -------
+    dict
+        Spec parameters for :func:`~bistair.codecs.make_spec` (besides the size).
+
+    Examples
+    --------
+    >>> comparable(1080, 1080, 30, 4)
+    {'period': 30, 'complementary': 1, 'steps': 4}
+    """
     return dict(period=period, complementary=1, steps=steps)
 
 

@@ -76,6 +76,34 @@ class PhaseCodingSpec(PeriodSpec):
 
 
 def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:
+    """The patterns of a phase-coding spec in the column layout, in method-frame order.
+
+    The N-step set, then the code phase of fringe ``k`` (stair level ``k`` of ``levels``,
+    one per fringe) as the ``pair`` ``offset + amplitude * cos / sin(code)``, or
+    ``shifted`` N times like the fringes.
+
+    Parameters
+    ----------
+    spec : PhaseCodingSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        (frames, other_length, coded_length) float32 intensities (fractions of full scale),
+        a read-only view whose rows are all the same.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("phase-coding", width=240, height=32, period=30)
+    >>> pats = encode_columns(spec)
+    >>> pats.shape
+    (6, 32, 240)
+    >>> code = np.arctan2(pats[5, 0] - 0.5, pats[4, 0] - 0.5)  # the code phase, radians
+    >>> (code[15::30] / (2 * np.pi / spec.levels)).round(2).tolist()  # in level steps
+    [-3.5, -2.5, -1.5, -0.5, 0.5, 1.5, 2.5, 3.5]
+    """
     shifts = shift_patterns(spec)
     code = stair_level_phase(fringe_index(spec), spec.levels)
     if spec.form == "pair":
@@ -88,7 +116,39 @@ def encode_columns(spec: PhaseCodingSpec) -> np.ndarray:
 
 def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
-    """Stage 2: the code phase of either form and its stair level on the valid pixels."""
+    """Stage 2: the code phase of either form and its stair level on the valid pixels.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : PhaseCodingSpec
+        The spec of one coded axis.
+    fs : FringeSet
+        Stage 1: the valid pixels, and the average the ``pair`` is read against.
+    min_modulation : float, optional
+        Not used (the code shares the fringes' validity).
+
+    Returns
+    -------
+    CodeMap
+        ``code``: (H, W) int32 stair level (the fringe order it codes), -1 where not
+        valid; ``maps["code_phase"]``: (H, W) float32 code phase in radians, in [-pi, pi)
+        for the pair, [0, 2*pi) for the shifted form (the levels are read modulo 2*pi).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("phase-coding", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> code.code[0, ::30].tolist(), sorted(code.maps)
+    ([0, 1, 2, 3, 4, 5, 6, 7], ['code_phase'])
+    """
     frames = prepared.frames[spec.steps:]
     if spec.form == "pair":
         theta = stair_phase(frames[0], frames[1], fs.avg)[0]
@@ -100,7 +160,48 @@ def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
                   strategy: str = "region") -> Orders:
-    """Stage 3: the code per pixel (``pixel``) or voted per fringe region (``region``)."""
+    """Stage 3: the code per pixel (``pixel``) or voted per fringe region (``region``).
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2 (:func:`code_columns`).
+    spec : PhaseCodingSpec
+        The spec of one coded axis.
+    strategy : {"region", "pixel"}
+        One order per fringe region, checked across the wraps, or the code per pixel.
+
+    Returns
+    -------
+    Orders
+        (H, W) fringe order per pixel (-1 where invalid) and ``info``: the strategy, the
+        camera noise, the levels, and for ``region`` the region counts and the phase jumps
+        across which the orders do not step by one.
+
+    Raises
+    ------
+    BistairError
+        ``strategy`` is neither ``"region"`` nor ``"pixel"``.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("phase-coding", width=240, height=32, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> orders = order_columns(fs, code, spec)
+    >>> orders.order[0, ::30].tolist(), orders.info["strategy"], orders.info["regions"]
+    ([0, 1, 2, 3, 4, 5, 6, 7], 'region', 8)
+    >>> order_columns(fs, code, spec, strategy="mode")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: unknown strategy 'mode' (use 'region' or 'pixel')
+    """
     if strategy not in ("region", "pixel"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'pixel')")
     codes = code.code
@@ -123,7 +224,27 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
-    """One level per fringe at the same period."""
+    """One level per fringe at the same period.
+
+    Parameters
+    ----------
+    width, height : int
+        Projector size in pixels (not used: the levels follow the fringes).
+    period : int
+        Fringe period in projector pixels.
+    steps : int
+        Phase-shift steps N.
+
+    Returns
+    -------
+    dict
+        Spec parameters for :func:`~bistair.codecs.make_spec` (besides the size).
+
+    Examples
+    --------
+    >>> comparable(1080, 1080, 30, 4)
+    {'period': 30, 'steps': 4}
+    """
     return dict(period=period, steps=steps)
 
 
