@@ -46,6 +46,34 @@ def code_sequence(length: int, levels: int, window: int) -> tuple[int, ...]:
 
     Depth-first search that tries the next level up first, which spreads the levels evenly.
     Raises :class:`BistairError` when no such sequence exists.
+
+    Parameters
+    ----------
+    length : int
+        Codes in the sequence (the fringes across the coded axis).
+    levels : int
+        Stair levels a code may take (codes ``0 .. levels - 1``).
+    window : int
+        Adjacent codes whose combination must be unique.
+
+    Returns
+    -------
+    tuple of int
+        The codes, one per fringe (cached: the same tuple for the same arguments).
+
+    Raises
+    ------
+    BistairError
+        The search finds no such sequence, or ``length`` is over 900.
+
+    Examples
+    --------
+    >>> code_sequence(8, levels=3, window=3)
+    (0, 1, 2, 0, 1, 0, 2, 0)
+    >>> code_sequence(20, levels=2, window=3)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: no sequence of 20 codes over 2 levels has unique 3-code windows
     """
     seq: list[int] = []
     seen: set[tuple[int, ...]] = set()
@@ -111,6 +139,34 @@ class LvSpec(PeriodSpec):
 
 
 def encode_columns(spec: LvSpec) -> np.ndarray:
+    """The patterns of an Lv spec in the column layout, in method-frame order.
+
+    The N-step set, then the coded pair ``offset + amplitude * cos / sin(code)`` whose code
+    phase on fringe ``k`` is the stair level ``spec.sequence[k]`` of ``levels``.
+
+    Parameters
+    ----------
+    spec : LvSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        (frames, other_length, coded_length) float32 intensities (fractions of full scale),
+        a read-only view whose rows are all the same.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> from bistair.core.stair import quantize
+    >>> spec = make_spec("lv", width=480, height=32, period=20)
+    >>> pats = encode_columns(spec)
+    >>> pats.shape
+    (6, 32, 480)
+    >>> code = np.arctan2(pats[5, 0] - 0.5, pats[4, 0] - 0.5)  # the code phase, radians
+    >>> quantize(code[10::20], spec.levels).tolist() == list(spec.sequence)
+    True
+    """
     shifts = shift_patterns(spec)
     codes = np.asarray(spec.sequence)[fringe_index(spec)]
     pair = stair_pair(stair_level_phase(codes, spec.levels), spec.offset, spec.amplitude)
@@ -142,6 +198,43 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     each order, weighted by the least sure code in the window. ``info`` receives how many
     complete windows were read (``code_windows``) and how many of them the sequence does
     not hold (``unknown_windows``).
+
+    Parameters
+    ----------
+    region_code : numpy.ndarray
+        (n_regions + 1,) int, each fringe region's code level (-1 where unknown; entry 0,
+        the background, is never read).
+    confidence : numpy.ndarray
+        (n_regions + 1,) float, how sure each region's code is (share of its weight, 0..1).
+    succ : numpy.ndarray
+        (n_regions + 1,) int, each region's neighbour one order up (-1 where none).
+    spec : LvSpec
+        The spec: ``sequence``, ``levels``, ``window`` and ``fringes`` are used.
+    info : dict, optional
+        Receives ``code_windows`` and ``unknown_windows``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_regions + 1, fringes) float64 evidence for every fringe order per region, in
+        [0, 1].
+
+    Examples
+    --------
+    Sixteen regions left to right, each reading its fringe's code:
+
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("lv", width=480, height=64, period=30)
+    >>> region_code = np.r_[-1, spec.sequence]
+    >>> succ = np.r_[-1, np.arange(2, 17), -1]
+    >>> info = {}
+    >>> ev = window_evidence(region_code, np.ones(17), succ, spec, info)
+    >>> ev.shape, ev[1:].argmax(axis=1).tolist() == list(range(16)), info
+    ((17, 16), True, {'code_windows': 13, 'unknown_windows': 0})
+    >>> region_code[5] = 3  # a misread: the windows through region 5 are not in the sequence
+    >>> ev = window_evidence(region_code, np.ones(17), succ, spec, info)
+    >>> ev[1:10].max(axis=1).round(2).tolist(), info["unknown_windows"]
+    ([1.0, 0.5, 0.33, 0.25, 0.0, 0.25, 0.5, 0.75, 1.0], 4)
     """
     n_reg = region_code.size - 1
     table = np.full(spec.levels ** spec.window, -1, np.int64)
@@ -187,7 +280,49 @@ def _window_key(codes: np.ndarray, levels: int) -> np.ndarray:
 
 def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
-    """Stage 2: each valid pixel's code level from the coded pair."""
+    """Stage 2: each valid pixel's code level from the coded pair.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : LvSpec
+        The spec of one coded axis.
+    fs : FringeSet
+        Stage 1: the valid pixels and the average the pair is read against.
+    min_modulation : float, optional
+        Not used (the code shares the fringes' validity).
+
+    Returns
+    -------
+    CodeMap
+        ``code``: (H, W) int32 code level, -1 where not valid; ``maps["code_phase"]``:
+        (H, W) float32 code phase in [-pi, pi) radians; ``cycle``: ``levels``.
+
+    Raises
+    ------
+    BistairError
+        The code phases sit halfway between the levels (``code-cos`` and ``code-sin``
+        swapped, or another number of levels than the patterns').
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("lv", width=480, height=32, period=20)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> code.code[0, 10::20].tolist() == list(spec.sequence), code.cycle
+    (True, 4)
+    >>> eight = spec.replace(levels=8)  # 4-level codes read as 8 levels
+    >>> code_columns(cols, eight, fs)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: the code phases sit ...
+    """
     frames = prepared.frames[spec.steps:]
     theta = stair_phase(frames[0], frames[1], fs.avg)[0]
     codes = np.where(fs.valid, quantize(theta, spec.levels), -1).astype(np.int32)
@@ -199,7 +334,51 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
-    """Stage 3: windows of adjacent fringe regions looked up in the code sequence."""
+    """Stage 3: windows of adjacent fringe regions looked up in the code sequence.
+
+    Each fringe region takes the code most of its pixels read; the windows of adjacent
+    regions vote for orders (:func:`window_evidence`), checked across every wrap
+    (:func:`bistair.core.resolve.orders_from_regions`).
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2 (:func:`code_columns`).
+    spec : LvSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    Orders
+        (H, W) fringe order per pixel (-1 where invalid) and ``info``: the camera noise,
+        the fringes, the code windows read and unknown, the region counts and the phase
+        jumps across which the orders do not step by one.
+
+    Raises
+    ------
+    BistairError
+        Of 20 or more code windows read, over 15% are not in the spec's sequence (the spec
+        does not fit the captures).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("lv", width=480, height=32, period=20)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> orders = order_columns(fs, code_columns(cols, spec, fs), spec)
+    >>> orders.order[0, ::20].tolist() == list(range(24)), orders.info["unknown_windows"]
+    (True, 0)
+    >>> five = spec.replace(levels=5)  # not the patterns' code
+    >>> order_columns(fs, code_columns(cols, five, fs), five)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: 81% of the 21 code windows ...
+    """
     codes = code.code
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     weight = core_weight(fs.phi)
@@ -228,6 +407,20 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
 def levels_for(fringes: int, window: int = 4) -> int:
     """The fewest stair levels (at least the paper's 4) whose windows can tell the fringes.
 
+    Parameters
+    ----------
+    fringes : int
+        Fringes across the coded axis.
+    window : int, default 4
+        Adjacent codes that fix an order.
+
+    Returns
+    -------
+    int
+        The levels: ``levels * (levels - 1) ** (window - 1) + window - 1 >= fringes``.
+
+    Examples
+    --------
     >>> levels_for(36), levels_for(200)
     (4, 5)
     """
@@ -238,7 +431,29 @@ def levels_for(fringes: int, window: int = 4) -> int:
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
-    """The same period with the fewest levels that tell its fringes apart."""
+    """The same period with the fewest levels that tell its fringes apart.
+
+    Parameters
+    ----------
+    width : int
+        Projector width in pixels (the coded axis).
+    height : int
+        Projector height in pixels (not used).
+    period : int
+        Fringe period in projector pixels.
+    steps : int
+        Phase-shift steps N.
+
+    Returns
+    -------
+    dict
+        Spec parameters for :func:`~bistair.codecs.make_spec` (besides the size).
+
+    Examples
+    --------
+    >>> comparable(1080, 1080, 30, 4), comparable(1920, 1080, 8, 4)["levels"]
+    ({'period': 30, 'steps': 4, 'levels': 4}, 5)
+    """
     return dict(period=period, steps=steps, levels=levels_for(-(-width // period)))
 
 

@@ -47,7 +47,23 @@ from .base import Codec, CodeMap, Orders, along_columns, shift_patterns
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     """Levels of beat periods: level 0 the periods ascending, each next the beats of
-    neighbours of the one below, up to a single period."""
+    neighbours of the one below, up to a single period.
+
+    Parameters
+    ----------
+    periods : tuple of float
+        Fringe periods in projector pixels, any order, all different.
+
+    Returns
+    -------
+    list of list of float
+        The levels, each ascending; the last holds one period (the widest beat).
+
+    Examples
+    --------
+    >>> beat_tree((48, 42, 45))
+    [[42.0, 45.0, 48.0], [630.0, 720.0], [5040.0]]
+    """
     levels = [sorted(float(p) for p in periods)]
     while len(levels[-1]) > 1:
         low = levels[-1]
@@ -106,6 +122,28 @@ class MultiFreqSpec(BaseSpec):
 
 
 def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
+    """The patterns of a multi-frequency spec in the column layout: one N-step set per
+    period, in the order the periods are listed.
+
+    Parameters
+    ----------
+    spec : MultiFreqSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        (len(periods) * steps, other_length, coded_length) float32 intensities (fractions
+        of full scale), a read-only view whose rows are all the same.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("multifreq", width=300, height=32, periods=(42, 45, 48))
+    >>> pats = encode_columns(spec)
+    >>> pats.shape, pats[4:8, 0, 45].round(2).tolist()  # the 45-px set at x = 45
+    ((12, 32, 300), [1.0, 0.5, 0.0, 0.5])
+    """
     sets = [shift_patterns(spec, t) for t in spec.periods]
     return along_columns(np.concatenate(sets), spec)
 
@@ -135,6 +173,23 @@ def top_phase(phi: np.ndarray, period: float, length: int) -> np.ndarray:
     back): without this, a pixel at column 1 of a 1920-px projector decoded with beats of
     5040 px lands at 5041.
 
+    Parameters
+    ----------
+    phi : numpy.ndarray
+        Wrapped phase of the coarsest period (or beat) in [0, 2*pi), radians.
+    period : float
+        That period in projector pixels, at least ``length``.
+    length : int
+        Projector pixels along the coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        The absolute phase in radians: ``phi``, less ``2*pi`` where it would put the pixel
+        past the middle of the impossible coordinates.
+
+    Examples
+    --------
     >>> top_phase(np.array([0.1, 6.28]), 5040.0, 1920).round(3).tolist()
     [0.1, -0.003]
     """
@@ -145,7 +200,35 @@ def top_phase(phi: np.ndarray, period: float, length: int) -> np.ndarray:
 
 def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
                     min_modulation: float | None = None) -> FringeSet:
-    """Stage 1: the N-step set of the shortest period (the phase the result refers to)."""
+    """Stage 1: the N-step set of the shortest period (the phase the result refers to).
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : MultiFreqSpec
+        The spec of one coded axis.
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a valid pixel needs; by default a threshold
+        from the measured camera noise.
+
+    Returns
+    -------
+    FringeSet
+        (H, W) float32 wrapped phase of the shortest period in [0, 2*pi) (radians), average
+        and modulation (fractions of full scale), the validity mask and the camera noise.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("multifreq", width=300, height=32, periods=(42, 45, 48))
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_columns(cols, spec)
+    >>> fs.phi.shape, round(float(fs.phi[0, 21]), 3)  # half of the 42-px period
+    ((32, 300), 3.142)
+    """
     i = spec.periods.index(min(spec.periods))
     return measure(prepared, i * spec.steps, spec.steps, min_modulation,
                    shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
@@ -157,6 +240,36 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
 
     ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step and
     ``maps["valid"]`` where every period is well modulated.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : MultiFreqSpec
+        The spec of one coded axis (``unwrap`` chooses the rule).
+    fs : FringeSet
+        Stage 1, the shortest period's set (:func:`measure_columns`).
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a pixel of the other periods needs.
+
+    Returns
+    -------
+    CodeMap
+        ``code``: (H, W) int32 order of the shortest period, -1 where some period is not
+        valid; ``maps``: ``worst`` (float64, fringes), ``valid`` (bool) and ``residual``
+        (the last step's signed miss, fringes), all (H, W).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("multifreq", width=300, height=32, periods=(42, 45, 48))
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_columns(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> code.code[0, ::42].tolist(), sorted(code.maps), bool(code.maps["worst"].max() < 0.01)
+    ([0, 1, 2, 3, 4, 5, 6, 7], ['residual', 'valid', 'worst'], True)
     """
     n = spec.steps
     shortest = float(spec.period)
@@ -198,6 +311,45 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
     the spec (periods, frame order or phase convention) and are refused; a coordinate that
     falls along the image axis is worth a warning (the projector is mirrored, or the shifts
     run the other way: the captures alone cannot tell).
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2 (:func:`code_columns`).
+    spec : MultiFreqSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    Orders
+        (H, W) int32 order of the shortest period per pixel (-1 where invalid) and
+        ``info``: the unwrap rule, the camera noise, the well-modulated pixels
+        (``valid_modulation``), the share where every step agrees (``period_agreement``)
+        and any ``warnings``.
+
+    Raises
+    ------
+    BistairError
+        With 500 or more well-modulated pixels, the periods agree on fewer than half.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("multifreq", width=300, height=32, periods=(42, 45, 48))
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_columns(cols, spec)
+    >>> orders = order_columns(fs, code_columns(cols, spec, fs), spec)
+    >>> orders.order[0, ::42].tolist(), orders.info["period_agreement"]
+    ([0, 1, 2, 3, 4, 5, 6, 7], 1.0)
+    >>> swapped = spec.replace(periods=(45, 42, 48))  # not the frame order
+    >>> fs = measure_columns(cols, swapped)
+    >>> order_columns(fs, code_columns(cols, swapped, fs), swapped)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: the periods agree on 13% ...
     """
     valid = code.maps["valid"]
     agree = code.maps["worst"] < 0.25
@@ -229,7 +381,29 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
     """The paper's three-frequency twelve-step reference: the width, about
-    ``sqrt(width * period)`` and the period (1080/180/30, 1920/240/30)."""
+    ``sqrt(width * period)`` and the period (1080/180/30, 1920/240/30).
+
+    Parameters
+    ----------
+    width : int
+        Projector width in pixels (the coded axis), the longest period.
+    height : int
+        Projector height in pixels (not used).
+    period : int
+        The shortest fringe period in projector pixels.
+    steps : int
+        Not used: the reference has twelve steps per period.
+
+    Returns
+    -------
+    dict
+        Spec parameters for :func:`~bistair.codecs.make_spec` (besides the size).
+
+    Examples
+    --------
+    >>> comparable(1080, 1080, 30, 4), comparable(1920, 1080, 30, 4)["periods"]
+    ({'periods': (1080, 180, 30), 'steps': 12}, (1920, 240, 30))
+    """
     middle = int(round(math.sqrt(width * period) / period)) * period
     return dict(periods=(width, middle, period), steps=12)
 
