@@ -123,7 +123,38 @@ class BidirectionalSpec(PeriodSpec):
 
 
 def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
-    """The N phase-shift patterns and the bidirectional pair, vertical fringes."""
+    """The N phase-shift patterns and the bidirectional pair, vertical fringes.
+
+    On fringe ``k`` the pair ``offset + amplitude * cos / sin(theta)`` carries the local
+    stair level ``k % stairs`` on the first ``local_rows`` of every ``group_rows`` pattern
+    rows and the partition stair level ``k // stairs`` on the rest.
+
+    Parameters
+    ----------
+    spec : BidirectionalSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    numpy.ndarray
+        (steps + 2, other_length, coded_length) float32 intensities (fractions of full
+        scale), column layout: ``shift-0 .. shift-(N-1)``, ``stair-cos``, ``stair-sin``.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> from bistair.core.stair import quantize
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> pats = encode_columns(spec)
+    >>> pats.shape, pats.dtype
+    ((6, 64, 240), dtype('float32'))
+    >>> theta = np.arctan2(pats[5] - 0.5, pats[4] - 0.5)  # the stair phase, radians
+    >>> quantize(theta[0, 10::20], 4).tolist()  # a local row: k % S
+    [0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3]
+    >>> quantize(theta[12, 10::20], 3).tolist()  # a partition row: k // S
+    [0, 0, 0, 0, 1, 1, 1, 1, 2, 2, 2, 2]
+    """
     x = np.arange(spec.coded_length)
     y = np.arange(spec.other_length)
     k = fringe_index(spec)
@@ -140,7 +171,51 @@ def encode_columns(spec: BidirectionalSpec) -> np.ndarray:
 def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
     """Stage 2: the stair phase of the coded pair (Eq. 19), its modulation and ``k_s`` (Eq. 20)
-    on the valid pixels."""
+    on the valid pixels.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout (coded axis along the image
+        rows), as fractions of full scale.
+    spec : BidirectionalSpec
+        The spec of one coded axis.
+    fs : FringeSet
+        Stage 1: the valid pixels and the average the pair is read against.
+    min_modulation : float, optional
+        Not used (the code shares the fringes' validity).
+
+    Returns
+    -------
+    CodeMap
+        ``code``: (H, W) int32 ``k_s``, the stair phase quantised to ``stairs`` levels (-1
+        where not valid); ``maps``: ``stair_phase`` (float32 radians in [-pi, pi)) and
+        ``stair_modulation`` (fraction of full scale); ``cycle``: ``stairs``.
+
+    Raises
+    ------
+    BistairError
+        The stair phases sit halfway between the code's levels (``stair-cos`` and
+        ``stair-sin`` swapped, or other partitions and stairs than the patterns').
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> code.code[0, 10::20].tolist(), code.cycle, sorted(code.maps)
+    ([0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3], 4, ['stair_modulation', 'stair_phase'])
+    >>> other = spec.replace(stairs=5)
+    >>> code_columns(cols, other, fs)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: the stair phases sit ...
+    """
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
@@ -153,7 +228,55 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
                   strategy: str = "region") -> Orders:
-    """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy."""
+    """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy.
+
+    The orders are then checked against the stair phase (:func:`stair_fit`).
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout.
+    code : CodeMap
+        Stage 2 (:func:`code_columns`).
+    spec : BidirectionalSpec
+        The spec of one coded axis.
+    strategy : {"region", "paper"}
+        The band analysis per fringe region (:mod:`.bands`) or the paper's column scan
+        (:func:`~bistair.codecs.bidirectional.paper.paper_orders`).
+
+    Returns
+    -------
+    Orders
+        (H, W) int32 fringe order per pixel (-1 where invalid) and ``info``: the strategy,
+        the camera noise, the well-modulated pixels, the phase jumps across which the
+        orders do not step by one, ``stair_misfit`` and any ``warnings``.
+
+    Raises
+    ------
+    BistairError
+        ``strategy`` is neither ``"region"`` nor ``"paper"``, or over 10% of the decoded
+        pixels' stair phases contradict their orders (the spec does not fit).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> orders = order_columns(fs, code, spec)
+    >>> orders.order[0, ::20].tolist(), orders.info["stair_misfit"]
+    ([0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], 0.0)
+    >>> order_columns(fs, code, spec, strategy="paper").order[0, ::20].tolist()
+    [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11]
+    >>> order_columns(fs, code, spec, strategy="mode")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: unknown strategy 'mode' (use 'region' or 'paper')
+    """
     if strategy not in ("region", "paper"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
     theta, ks = code.maps["stair_phase"], code.code
@@ -189,6 +312,43 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
     (by twice their noise and at least 0.05 rad; levels where this capture shows them, as
     an uncompensated gamma moves them) contradict their order. A right decode has almost
     none; a spec with other partitions or stairs than the captures' has many.
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1, column layout (phase, validity and camera noise).
+    theta : numpy.ndarray
+        (H, W) stair phase in radians (``maps["stair_phase"]``).
+    stair_mod : numpy.ndarray
+        (H, W) modulation of the stair pair, fraction of full scale.
+    order : numpy.ndarray
+        (H, W) int decoded fringe order, -1 where invalid.
+    spec : BidirectionalSpec
+        The spec of one coded axis.
+    samples : int, default 20000
+        About how many decoded pixels to judge.
+
+    Returns
+    -------
+    float
+        The share in [0, 1]; 0.0 when fewer than 500 pixels can be judged.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> theta, stair_mod = code.maps["stair_phase"], code.maps["stair_modulation"]
+    >>> order = order_columns(fs, code, spec).order
+    >>> stair_fit(fs, theta, stair_mod, order, spec)
+    0.0
+    >>> round(stair_fit(fs, theta, stair_mod, np.where(order >= 0, order + 1, -1), spec), 3)
+    0.583
     """
     idx = np.flatnonzero(fs.valid & (order >= 0))
     idx = idx[:: max(1, idx.size // samples)]
@@ -223,6 +383,52 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     jumps, in four or more rows on end, is an edge. Neighbouring fringes often share their
     partition level, so the edge found in the local bands is carried ``reach`` rows up and
     down across the partition bands between them.
+
+    Parameters
+    ----------
+    phi : numpy.ndarray
+        (H, W) wrapped phase in [0, 2*pi), column layout.
+    theta : numpy.ndarray
+        (H, W) stair phase in radians.
+    valid : numpy.ndarray
+        (H, W) bool, the pixels to use.
+    noise : numpy.ndarray
+        (H, W) stair phase noise per pixel, radians.
+    stairs : int
+        Local stair levels ``S`` (the step is ``2*pi/S``).
+    reach : int
+        Rows an edge is carried up and down (0: not carried).
+
+    Returns
+    -------
+    vertical : numpy.ndarray
+        (H-1, W) bool, links between rows to cut (none: all False).
+    horizontal : numpy.ndarray
+        (H, W-1) bool, links between columns to cut.
+
+    Examples
+    --------
+    Two surfaces side by side: right of column 110 the patterns are two fringes further
+    on, so the phase runs on and the stair code jumps (on the local rows only: fringes 5
+    and 7 share their partition level).
+
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> images = encode(spec)
+    >>> images[:, :, 110:] = np.roll(images, -40, axis=2)[:, :, 110:]
+    >>> cols = prepare(images, spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> theta = code_columns(cols, spec, fs).maps["stair_phase"]
+    >>> noise = np.full(theta.shape, 0.01, np.float32)
+    >>> vertical, edge = stair_edges(fs.phi, theta, fs.valid, noise, spec.stairs, 0)
+    >>> vertical.shape, edge.shape, bool(vertical.any()), int(edge[:, 109].sum())
+    ((63, 240), (64, 239), False, 40)
+    >>> _, edge = stair_edges(fs.phi, theta, fs.valid, noise, spec.stairs, 12)
+    >>> int(edge[:, 109].sum()), np.unique(np.nonzero(edge)[1]).tolist()
+    (64, [108, 109, 110])
     """
     h, w = phi.shape
     edge = stair_turns(phi, np.cos(theta), np.sin(theta), valid,
@@ -283,6 +489,18 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
 def stairs_for(fringes: int) -> tuple[int, int]:
     """Partitions and stairs (P, S) with P*S >= fringes, as square as possible.
 
+    Parameters
+    ----------
+    fringes : int
+        Fringes across the coded axis.
+
+    Returns
+    -------
+    tuple of int
+        ``(P, S)``: ``S = ceil(sqrt(fringes))`` and ``P = ceil(fringes / S)``.
+
+    Examples
+    --------
     >>> stairs_for(36), stairs_for(64), stairs_for(121)
     ((6, 6), (8, 8), (11, 11))
     """
@@ -291,7 +509,29 @@ def stairs_for(fringes: int) -> tuple[int, int]:
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
-    """The squarest P x S covering the width at this period (6 x 6 on 1080 px at 30 px)."""
+    """The squarest P x S covering the width at this period (6 x 6 on 1080 px at 30 px).
+
+    Parameters
+    ----------
+    width : int
+        Projector width in pixels (the coded axis).
+    height : int
+        Projector height in pixels (not used).
+    period : int
+        Fringe period in projector pixels.
+    steps : int
+        Phase-shift steps N.
+
+    Returns
+    -------
+    dict
+        Spec parameters for :func:`~bistair.codecs.make_spec` (besides the size).
+
+    Examples
+    --------
+    >>> comparable(1080, 1080, 30, 4)
+    {'period': 30, 'partitions': 6, 'stairs': 6, 'steps': 4}
+    """
     parts, stairs = stairs_for(math.ceil(width / period))
     return dict(period=period, partitions=parts, stairs=stairs, steps=steps)
 
