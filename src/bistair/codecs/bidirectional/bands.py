@@ -44,7 +44,32 @@ class Runs:
 
 @lru_cache(maxsize=32)
 def union_levels(partitions: int, stairs: int) -> np.ndarray:
-    """Phases of all stair levels of both stairs, near-coincident ones merged (read-only)."""
+    """Phases of all stair levels of both stairs, near-coincident ones merged (read-only).
+
+    Levels closer than a quarter of the finer stair's step are one level (the first in
+    ascending order is kept).
+
+    Parameters
+    ----------
+    partitions : int
+        Partition stair levels ``P``.
+    stairs : int
+        Local stair levels ``S``.
+
+    Returns
+    -------
+    numpy.ndarray
+        (levels,) float64 phases in radians, ascending in [-pi, pi), not writeable (the
+        result is cached).
+
+    Examples
+    --------
+    >>> union_levels(6, 6).round(3).tolist()
+    [-2.618, -1.571, -0.524, 0.524, 1.571, 2.618]
+    >>> levels = union_levels(3, 4)  # level 0 of both stairs merged
+    >>> levels.size, levels.flags.writeable
+    (5, False)
+    """
     phases = np.concatenate([stair_level_phase(np.arange(stairs), stairs),
                              stair_level_phase(np.arange(partitions), partitions)])
     phases = np.sort(wrap(phases))
@@ -61,6 +86,26 @@ def union_levels(partitions: int, stairs: int) -> np.ndarray:
 
 
 def nearest_level(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """The index of the level nearest each phase, on the circle.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        (n,) phases in radians (a 1-D array).
+    levels : numpy.ndarray
+        (levels,) level phases in radians, e.g. :func:`union_levels`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n,) int32 indices into ``levels``.
+
+    Examples
+    --------
+    >>> levels = union_levels(6, 6)
+    >>> nearest_level(np.array([0.5, -3.1, 3.1]), levels).tolist()  # both ends: level 0 or 5
+    [3, 0, 5]
+    """
     d = np.abs(wrap(np.asarray(theta)[:, None] - levels[None, :]))
     return d.argmin(axis=1).astype(np.int32)
 
@@ -81,7 +126,29 @@ class RowProfiles:
 
 def stair_values(theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray) -> np.ndarray:
     """The per-pixel values :func:`row_profiles` sums: ``weight*cos(theta)``,
-    ``weight*sin(theta)``, ``weight``, ``ratio`` and the column index, (5, H, W) float32."""
+    ``weight*sin(theta)``, ``weight``, ``ratio`` and the column index, (5, H, W) float32.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        (H, W) stair phase in radians.
+    weight : numpy.ndarray
+        (H, W) weight of each pixel's stair phase.
+    ratio : numpy.ndarray
+        (H, W) stair-pair modulation over the fringe modulation.
+
+    Returns
+    -------
+    numpy.ndarray
+        (5, H, W) float32.
+
+    Examples
+    --------
+    >>> theta = np.zeros((4, 3), np.float32)
+    >>> values = stair_values(theta, np.full((4, 3), 0.5), np.ones((4, 3)))
+    >>> values.shape, values.dtype, values[:, 0, 2].tolist()
+    ((5, 4, 3), dtype('float32'), [0.5, 0.0, 0.5, 1.0, 2.0])
+    """
     h, w = theta.shape
     out = np.empty((5, h, w), np.float32)
     np.multiply(weight, np.cos(theta), out=out[0])
@@ -94,7 +161,35 @@ def stair_values(theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray) -> np
 
 def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
     """Sum each region's pixels row by row (sorted by region, then row); ``values`` from
-    :func:`stair_values`."""
+    :func:`stair_values`.
+
+    Parameters
+    ----------
+    labels : numpy.ndarray
+        (H, W) int fringe region labels, 0 for no region.
+    values : numpy.ndarray
+        (5, H, W) float32 from :func:`stair_values`.
+
+    Returns
+    -------
+    RowProfiles
+        One entry per (region, row) a region has pixels in.
+
+    Examples
+    --------
+    A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
+    with ``S = 4`` stairs and ``P = 3`` partitions, in groups of 16 rows, 10 of them local:
+
+    >>> y = np.arange(48)[:, None]
+    >>> k = np.where(np.arange(16) < 8, 5, 6)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)).astype(np.float32)
+    >>> labels = np.tile(np.where(np.arange(16) < 8, 1, 2), (48, 1)).astype(np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> prof.region.size, prof.region[:2].tolist(), prof.row[:2].tolist(), prof.count[:2].tolist()
+    (96, [1, 1], [0, 1], [8, 8])
+    """
     h = labels.shape[0]
     keys, count, sums = label_row_sums(labels, values, int(labels.max()))
     c, s, wsum, rsum, cols = sums
@@ -114,7 +209,36 @@ def _region_percentile(region: np.ndarray, values: np.ndarray, q: float) -> np.n
 
 
 def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
-    """(row, column) centroid of each region 0..n_regions from its row profiles."""
+    """(row, column) centroid of each region 0..n_regions from its row profiles.
+
+    Parameters
+    ----------
+    prof : RowProfiles
+        From :func:`row_profiles`.
+    n_regions : int
+        The highest region label.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_regions + 1, 2) float64 centroids in camera pixels (0, 0 for a region without
+        pixels, such as 0).
+
+    Examples
+    --------
+    A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
+    with ``S = 4`` stairs and ``P = 3`` partitions, in groups of 16 rows, 10 of them local:
+
+    >>> y = np.arange(48)[:, None]
+    >>> k = np.where(np.arange(16) < 8, 5, 6)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)).astype(np.float32)
+    >>> labels = np.tile(np.where(np.arange(16) < 8, 1, 2), (48, 1)).astype(np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> profile_centroids(prof, 2).tolist()
+    [[0.0, 0.0], [23.5, 3.5], [23.5, 11.5]]
+    """
     count = np.maximum(np.bincount(prof.region, prof.count, n_regions + 1), 1)
     rows = np.bincount(prof.region, prof.row * prof.count, n_regions + 1)
     cols = np.bincount(prof.region, prof.col_sum, n_regions + 1)
@@ -129,6 +253,27 @@ def observed_levels(theta: np.ndarray, weight: np.ndarray, levels: np.ndarray) -
     circular mean of the rows read nearest to it (levels seen in under 1% of the weight keep
     their nominal phase), so band rows are read and judged against it rather than the
     nominal one.
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        (n,) stair phases in radians.
+    weight : numpy.ndarray
+        (n,) their weights.
+    levels : numpy.ndarray
+        (levels,) nominal level phases in radians (:func:`union_levels`).
+
+    Returns
+    -------
+    numpy.ndarray
+        (levels,) float64 observed phase of each level, radians.
+
+    Examples
+    --------
+    >>> levels = union_levels(6, 6)
+    >>> theta = levels[[0, 1, 1, 2]] + 0.1  # three levels read 0.1 rad off
+    >>> observed_levels(theta, np.ones(4), levels).round(3).tolist()
+    [-2.518, -1.471, -0.424, 0.524, 1.571, 2.618]
     """
     uid = nearest_level(theta, levels)
     c = np.bincount(uid, weight * np.cos(theta), levels.size)
@@ -146,6 +291,38 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     their mixed phase would read as a stair level in between. Each row's modulation is
     taken relative to what its level shows across the capture (its 80th percentile), as
     an uncompensated projector gamma gives some levels less modulation than others.
+
+    Parameters
+    ----------
+    prof : RowProfiles
+        From :func:`row_profiles`.
+    levels : numpy.ndarray
+        (levels,) nominal level phases in radians (:func:`union_levels`).
+
+    Returns
+    -------
+    Runs
+        The runs sorted by region, then row: ``uid`` indexes ``levels``; ``length`` is in
+        camera rows; blurred transitions and ragged ends are dropped (empty when no band
+        row is left).
+
+    Examples
+    --------
+    A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
+    with ``S = 4`` stairs and ``P = 3`` partitions, in groups of 16 rows, 10 of them local:
+
+    >>> y = np.arange(48)[:, None]
+    >>> k = np.where(np.arange(16) < 8, 5, 6)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)).astype(np.float32)
+    >>> labels = np.tile(np.where(np.arange(16) < 8, 1, 2), (48, 1)).astype(np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> runs = row_runs(prof, union_levels(3, 4))
+    >>> runs.region.tolist(), runs.uid.tolist()
+    ([1, 1, 1, 1, 1, 1, 2, 2, 2, 2, 2, 2], [1, 2, 1, 2, 1, 2, 3, 2, 3, 2, 3, 2])
+    >>> runs.y0[:6].tolist(), runs.length[:6].tolist()
+    ([0, 10, 16, 26, 32, 42], [10.0, 6.0, 10.0, 6.0, 10.0, 6.0])
     """
     c, s, wsum = prof.cos, prof.sin, prof.weight
     region, row = prof.region, prof.row
@@ -265,6 +442,35 @@ def band_splits(runs: Runs, heights: np.ndarray, local_share: float
     height (``heights``: camera rows per group, per region; ``local_share``: the local
     band's share of a group). Rows left out between the runs (the blurred edge where one
     surface hides the other) do not matter; runs under two rows long do not count.
+
+    Parameters
+    ----------
+    runs : Runs
+        From :func:`row_runs`.
+    heights : numpy.ndarray
+        (n_regions + 1,) group height per region in camera rows (NaN where unknown).
+    local_share : float
+        Local rows over group rows.
+
+    Returns
+    -------
+    list of tuple of int
+        ``(region, first row of the lower part)`` per split.
+
+    Examples
+    --------
+    One region of 64 rows: order 5 above row 32, order 10 below it.
+
+    >>> y = np.arange(64)[:, None]
+    >>> k = np.where(y < 32, 5, 10)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)) * np.ones((1, 8), np.float32)
+    >>> labels = np.ones((64, 8), np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> runs = row_runs(prof, union_levels(3, 4))
+    >>> band_splits(runs, np.array([np.nan, 16.0]), 10 / 16)
+    [(1, 32)]
     """
     splits: list[tuple[int, int]] = []
     if runs.uid.size < 2:
@@ -298,7 +504,31 @@ def band_splits(runs: Runs, heights: np.ndarray, local_share: float
 
 def split_regions(labels: np.ndarray, n_regions: int,
                   splits: list[tuple[int, int]]) -> tuple[np.ndarray, int]:
-    """Give the rows of a region from each split row down a new label."""
+    """Give the rows of a region from each split row down a new label.
+
+    Parameters
+    ----------
+    labels : numpy.ndarray
+        (H, W) int fringe region labels (not changed).
+    n_regions : int
+        The highest label in use.
+    splits : list of tuple of int
+        ``(region, row)`` pairs, as from :func:`band_splits`.
+
+    Returns
+    -------
+    labels : numpy.ndarray
+        A relabelled copy: each split's lower part gets a new label above ``n_regions``.
+    n_regions : int
+        The highest label now in use.
+
+    Examples
+    --------
+    >>> labels = np.ones((6, 2), np.int32)
+    >>> new, n = split_regions(labels, 1, [(1, 4)])
+    >>> n, new[:, 0].tolist()
+    (2, [1, 1, 1, 1, 2, 2])
+    """
     labels = labels.copy()
     for region, row in sorted(splits, key=lambda s: (s[0], -s[1])):
         n_regions += 1
@@ -324,7 +554,40 @@ class BandLayout:
 
 def group_heights(runs: Runs, n_regions: int, centroids: np.ndarray) -> np.ndarray:
     """Group height (camera rows) per region: its own bands where two complete ones show,
-    else the median of the nearest regions that have one."""
+    else the median of the nearest regions that have one.
+
+    Parameters
+    ----------
+    runs : Runs
+        From :func:`row_runs`.
+    n_regions : int
+        The highest region label.
+    centroids : numpy.ndarray
+        (n_regions + 1, 2) region centroids, from :func:`profile_centroids`.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_regions + 1,) float64 camera rows per group: the sum of the median lengths of a
+        region's two most frequent band values, else the median of up to 7 nearest
+        regions' own; NaN for region 0 and where no region has its own.
+
+    Examples
+    --------
+    A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
+    with ``S = 4`` stairs and ``P = 3`` partitions, in groups of 16 rows, 10 of them local:
+
+    >>> y = np.arange(48)[:, None]
+    >>> k = np.where(np.arange(16) < 8, 5, 6)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)).astype(np.float32)
+    >>> labels = np.tile(np.where(np.arange(16) < 8, 1, 2), (48, 1)).astype(np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> runs = row_runs(prof, union_levels(3, 4))
+    >>> group_heights(runs, 2, profile_centroids(prof, 2)).tolist()
+    [nan, 16.0, 16.0]
+    """
     complete = runs.top_ok & runs.bottom_ok & (runs.length >= 2)
     own = np.full(n_regions + 1, np.nan)
     for r in np.unique(runs.region[complete]):
@@ -358,6 +621,42 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
     that shows a single band value gets
     0.4 for every order compatible with it (its neighbours decide), unless the band is far
     longer than a band can be, which is the merged case ``k mod S == k // S``.
+
+    Parameters
+    ----------
+    runs : Runs
+        From :func:`row_runs`.
+    n_regions : int
+        The highest region label.
+    heights : numpy.ndarray
+        (n_regions + 1,) group height per region in camera rows (NaN where unknown), from
+        :func:`group_heights`.
+    layout : BandLayout
+        The code's stairs, partitions, local share and default group height.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n_regions + 1, P*S) float64 evidence per region and order (row 0 and regions whose
+        bands are blurred together stay 0).
+
+    Examples
+    --------
+    A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
+    with ``S = 4`` stairs and ``P = 3`` partitions, in groups of 16 rows, 10 of them local:
+
+    >>> y = np.arange(48)[:, None]
+    >>> k = np.where(np.arange(16) < 8, 5, 6)
+    >>> theta = np.where(y % 16 < 10, stair_level_phase(k % 4, 4),
+    ...                  stair_level_phase(k // 4, 3)).astype(np.float32)
+    >>> labels = np.tile(np.where(np.arange(16) < 8, 1, 2), (48, 1)).astype(np.int32)
+    >>> ones = np.ones(theta.shape, np.float32)
+    >>> prof = row_profiles(labels, stair_values(theta, ones, ones))
+    >>> runs = row_runs(prof, union_levels(3, 4))
+    >>> heights = group_heights(runs, 2, profile_centroids(prof, 2))
+    >>> ev = region_evidence(runs, 2, heights, BandLayout(4, 3, 10 / 16, 16.0))
+    >>> ev.shape, ev[1:].argmax(axis=1).tolist(), ev[1:].max(axis=1).round(2).tolist()
+    ((3, 12), [5, 6], [1.0, 1.0])
     """
     S, P = layout.stairs, layout.partitions
     ks = np.arange(S * P)

@@ -43,6 +43,42 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
        column's valid stretch (between invalid pixels) starts a group.
     4. Where the partitions and stairs differ in number (the paper has 6 x 6), runs are of
        the nearest level of either stair rather than of ``k_s``.
+
+    Parameters
+    ----------
+    ks : numpy.ndarray
+        (H, W) int ``k_s``, the stair phase quantised to ``S`` levels (-1 where invalid),
+        column layout (coded axis along the image rows).
+    theta : numpy.ndarray
+        (H, W) stair phase in radians.
+    fs : FringeSet
+        Stage 1: the wrapped phase in [0, 2*pi) and the valid pixels.
+    spec : BidirectionalSpec
+        The spec of one coded axis.
+    median : int, default 5
+        Pixels of the median filter down each column (1: none).
+    min_run : int, default 3
+        The shortest run, in pixels, the scan counts.
+
+    Returns
+    -------
+    numpy.ndarray
+        (H, W) int64 fringe order per pixel, -1 outside the fringe regions.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.codecs.bidirectional import code_columns
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> code = code_columns(cols, spec, fs)
+    >>> order = paper_orders(code.code, code.maps["stair_phase"], fs, spec)
+    >>> order[0, ::20].tolist(), order[40, ::20].tolist() == order[0, ::20].tolist()
+    ([0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11], True)
     """
     S, P = spec.stairs, spec.partitions
     h, w = ks.shape
