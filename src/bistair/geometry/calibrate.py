@@ -95,6 +95,28 @@ def calibrate_points(object_points: Sequence[np.ndarray], camera_points: Sequenc
     BistairError
         Fewer than :data:`MIN_POSES` poses, OpenCV failing, or poses that leave some
         parameter undetermined.
+
+    Examples
+    --------
+    Four exact views of an 8 x 6 board (see the module's example for more):
+
+    >>> from bistair.sim.boards import synthetic_views
+    >>> cam = Device(640, 480, [[800.0, 0, 320], [0, 800, 240], [0, 0, 1]])
+    >>> proj = Device(800, 600, [[1000.0, 0, 400], [0, 1000, 300], [0, 0, 1]])
+    >>> truth = Calibration(cam, proj, cv2.Rodrigues(np.array([0.0, 0.3, 0.0]))[0],
+    ...                     [-150.0, 0.0, 45.0])
+    >>> views = synthetic_views(truth, Board(columns=8, rows=6, spacing=15), 4,
+    ...                         np.random.default_rng(2))
+    >>> cal = calibrate_points(*views, (640, 480), (800, 600), names=["a", "b", "c", "d"])
+    >>> round(cal.baseline, 2), round(float(cal.camera.K[0, 0]), 2), cal.camera.size
+    (156.6, 800.0, (640, 480))
+    >>> [(pose["name"], pose["features"]) for pose in cal.poses][:2]
+    [('a', 48), ('b', 48)]
+    >>> calibrate_points(views[0][:2], views[1][:2], views[2][:2], (640, 480), (800, 600))
+    ... # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: 2 board poses cannot calibrate a camera and a projector: ...
     """
     if len(object_points) < MIN_POSES:
         raise BistairError(f"{len(object_points)} board poses cannot calibrate a camera and a "
@@ -373,7 +395,28 @@ class PoseCapture:
 
 
 def feature_spacing(points: np.ndarray, columns: int) -> float:
-    """Median image distance between neighbouring features of a row-by-row grid (pixels)."""
+    """Median image distance between neighbouring features of a row-by-row grid (pixels).
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(columns * rows, 2)`` image points ``(u, v)`` in pixels, row by row (as
+        :meth:`Board.detect <bistair.geometry.board.Board.detect>` returns them).
+    columns : int
+        Features per row.
+
+    Returns
+    -------
+    float
+        The median length (pixels) of the steps to the next feature along the rows and
+        down the columns.
+
+    Examples
+    --------
+    >>> u, v = np.meshgrid(np.arange(4) * 12.0, np.arange(3) * 10.0)
+    >>> feature_spacing(np.stack([u.ravel(), v.ravel()], axis=1), 4)
+    12.0
+    """
     grid = np.asarray(points, float).reshape(-1, columns, 2)
     steps = np.concatenate([np.diff(grid, axis=1).reshape(-1, 2),
                             np.diff(grid, axis=0).reshape(-1, 2)])
@@ -405,6 +448,18 @@ def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
     BistairError
         ``min_poses`` below :data:`MIN_POSES`, images of different sizes, fewer than
         ``min_poses`` poses with the board found and mapped, or a failed calibration.
+
+    Examples
+    --------
+    Poses whose white frames do not show the board are refused (``tests/test_calib.py``
+    calibrates from rendered board captures):
+
+    >>> blank = np.ones((60, 80))
+    >>> poses = [PoseCapture(f"pose-{i}", blank, blank, blank) for i in range(3)]
+    >>> calibrate_poses(poses, Board(), (800, 600))
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: board found in 0 of 3 poses, need at least 3
     """
     check_min_poses(min_poses)
     if not poses:
@@ -447,8 +502,19 @@ def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
 def check_min_poses(min_poses: int) -> None:
     """Refuse a pose minimum below :data:`MIN_POSES`.
 
+    Parameters
+    ----------
+    min_poses : int
+        The fewest usable board poses asked for (a Python or NumPy integer, not ``bool``).
+
+    Raises
+    ------
+    BistairError
+        If ``min_poses`` is not a whole number or is below :data:`MIN_POSES`.
+
     Examples
     --------
+    >>> check_min_poses(3)
     >>> check_min_poses(1)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...

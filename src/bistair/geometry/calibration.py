@@ -260,7 +260,42 @@ def _device(data: Mapping[str, Any], name: str) -> Device:
 
 
 def save_calibration(calibration: Calibration, path: str | Path) -> Path:
-    """Write the calibration JSON file atomically; returns ``path``."""
+    """Write the calibration JSON file atomically; returns ``path``.
+
+    The file has the layout of the module docstring (2-space indent, final newline); it is
+    written to a temporary file beside ``path`` and renamed onto it
+    (:func:`~bistair.io.files.output_file`), so a reader never sees half a file.
+
+    Parameters
+    ----------
+    calibration : Calibration
+        What to save.
+    path : str or Path
+        The JSON file (its folder is created if needed; an existing file is replaced).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    BistairError
+        Raised by :func:`~bistair.io.files.output_file` if the file cannot be written.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> proj = Device(800, 600, [[1000.0, 0, 399.5], [0, 1000, 299.5], [0, 0, 1]])
+    >>> path = save_calibration(Calibration(cam, proj, np.eye(3), [-150.0, 0, 0]),
+    ...                         tmp / "calibration.json")
+    >>> data = json.loads(path.read_text())
+    >>> data["format"], data["baseline"], data["camera"]["dist"]
+    ('bistair-calibration', 150.0, [0.0, 0.0, 0.0, 0.0, 0.0])
+    >>> shutil.rmtree(tmp)
+    """
     path = Path(path)
     with output_file(path) as tmp:
         tmp.write_text(json.dumps(calibration.to_dict(), indent=2) + "\n")
@@ -268,7 +303,45 @@ def save_calibration(calibration: Calibration, path: str | Path) -> Path:
 
 
 def load_calibration(path: str | Path) -> Calibration:
-    """Read and validate a calibration file (one-line :class:`BistairError` if it cannot)."""
+    """Read and validate a calibration file (one-line :class:`BistairError` if it cannot).
+
+    Parameters
+    ----------
+    path : str or Path
+        A calibration JSON file (layout in the module docstring), e.g. from
+        :func:`save_calibration` or ``bistair calibrate``.
+
+    Returns
+    -------
+    Calibration
+        The devices, ``R, T`` (``X_p = R @ X_c + T``, mm) and whatever else the file holds
+        (RMS figures, poses, board, uncertainty).
+
+    Raises
+    ------
+    BistairError
+        If the file is missing, unreadable or not JSON, or is not a valid bistair
+        calibration (wrong format or version, a missing or malformed field, ``R`` not a
+        rotation); the message names the file.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> proj = Device(800, 600, [[1000.0, 0, 399.5], [0, 1000, 299.5], [0, 0, 1]])
+    >>> path = save_calibration(Calibration(cam, proj, np.eye(3), [-150.0, 0, 0], rms=0.2),
+    ...                         tmp / "calibration.json")
+    >>> cal = load_calibration(path)
+    >>> cal.baseline, cal.rms, cal.projector.size
+    (150.0, 0.2, (800, 600))
+    >>> _ = (tmp / "other.json").write_text('{"format": "something-else"}')
+    >>> load_calibration(tmp / "other.json")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: calibration file .../other.json: not a bistair calibration ...
+    >>> shutil.rmtree(tmp)
+    """
     path = Path(path)
     data = read_json(path, "calibration file")
     try:

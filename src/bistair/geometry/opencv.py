@@ -70,6 +70,17 @@ def read_filestorage(path: str | Path) -> Values:
     Matrices (``!!opencv-matrix``) keep their shape, sequences become arrays (nested
     sequences 2-D), numbers 0-d arrays.
 
+    Parameters
+    ----------
+    path : str or Path
+        The FileStorage file.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray or None
+        Each top-level key with its value as a float64 array, ``None`` for a value that is
+        not numbers (a string, a map that is not a matrix, a ragged or mixed sequence).
+
     Raises
     ------
     BistairError
@@ -158,7 +169,30 @@ def read_opencv_calibration(paths: Sequence[str | Path], projector_size: tuple[i
 
     Examples
     --------
-    See the module's example.
+    Two files with other key names, the camera size given (see also the module's example):
+
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> cal = _example_calibration()
+    >>> parts = {"intrinsics.yml": {"K_cam": cal.camera.K, "d_cam": cal.camera.dist,
+    ...                             "K_proj": cal.projector.K, "d_proj": cal.projector.dist},
+    ...          "extrinsics.yml": {"R": cal.R, "T": cal.T}}
+    >>> for name, values in parts.items():
+    ...     fs = cv2.FileStorage(str(tmp / name), cv2.FILE_STORAGE_WRITE)
+    ...     for key, value in values.items():
+    ...         fs.write(key, np.asarray(value))
+    ...     fs.release()
+    >>> files = [tmp / "intrinsics.yml", tmp / "extrinsics.yml"]
+    >>> keys = {"camera": "K_cam", "camera_dist": "d_cam", "projector": "K_proj",
+    ...         "projector_dist": "d_proj"}
+    >>> got = read_opencv_calibration(files, (1280, 800), camera_size=(640, 480), keys=keys)
+    >>> got.camera.size, round(got.baseline, 3), bool(np.array_equal(got.T, cal.T))
+    ((640, 480), 150.0, True)
+    >>> read_opencv_calibration(files, (1280, 800), (640, 480))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: no key 'M1' (camera matrix) in ... has K_cam, ...
+    >>> shutil.rmtree(tmp)
     """
     names = _key_names(keys)
     files = [(Path(p), read_filestorage(p)) for p in paths]

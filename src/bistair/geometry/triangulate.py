@@ -104,7 +104,48 @@ def triangulate(pixels: np.ndarray, coord: np.ndarray, calibration: Calibration,
     coordinate along the coded axis is ``coord`` ``(N,)``; NaN rows where there is no
     solution in front of both devices inside the projector image (to ``tolerance`` px).
 
-    With ``sensitivity``, also the depth change per projector pixel, ``|dz/dcoord|``."""
+    With ``sensitivity``, also the depth change per projector pixel, ``|dz/dcoord|``.
+
+    Parameters
+    ----------
+    pixels : numpy.ndarray
+        ``(N, 2)`` camera pixel coordinates ``(u, v)`` (distorted, as in the images).
+    coord : numpy.ndarray
+        ``(N,)`` decoded projector coordinate (pixels) along the coded axis.
+    calibration : Calibration
+        The rig, ``X_p = R @ X_c + T`` (mm).
+    orientation : {"columns", "rows"}, optional
+        The coded axis: ``coord`` is the projector column (``"columns"``) or row (anything
+        else is taken as ``"rows"``).
+    iterations : int, optional
+        Newton steps at most on the depth.
+    tolerance : float, optional
+        Projector pixels the projection of a solution may miss ``coord`` by.
+    sensitivity : bool, optional
+        Also return ``|dz/dcoord|`` (mm per projector pixel).
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(N, 3)`` float64 points in the camera frame (mm), NaN rows where there is no
+        solution.
+    sensitivity : numpy.ndarray
+        Only with ``sensitivity``: ``(N,)`` mm of depth per projector pixel, NaN where
+        there is no solution.
+
+    Examples
+    --------
+    >>> cal = _toy_calibration()
+    >>> point = np.array([10.0, -20.0, 600.0])
+    >>> uv = cal.camera.K @ point / point[2]
+    >>> xp = cal.projector.K @ (cal.R @ point + cal.T)
+    >>> pts, dz = triangulate([uv[:2], [0, 0]], [xp[0] / xp[2], 5000.0], cal,
+    ...                       sensitivity=True)
+    >>> pts.round(6).tolist()  # column 5000 is off the 800-pixel projector
+    [[10.0, -20.0, 600.0], [nan, nan, nan]]
+    >>> dz.round(2).tolist()  # mm per projector column at 600 mm
+    [2.52, nan]
+    """
     cam, proj = calibration.camera, calibration.projector
     axis = 0 if orientation == "columns" else 1
     target = np.asarray(coord, np.float64).ravel()
@@ -135,6 +176,18 @@ def baseline_orientation(calibration: Calibration) -> str:
     At the projector's principal point the epipolar lines (the images of camera rays) run
     along ``(fx * Tx, fy * Ty)``; the axis with the larger component wins.
 
+    Parameters
+    ----------
+    calibration : Calibration
+        The rig.
+
+    Returns
+    -------
+    str
+        ``"columns"`` (ties included) or ``"rows"``.
+
+    Examples
+    --------
     >>> baseline_orientation(_toy_calibration())
     'columns'
     """
@@ -227,7 +280,49 @@ def check_fit(result: DecodeResult | AxesResult, calibration: Calibration,
               spec: BaseSpec | str, orientation: str | None = None) -> str:
     """The coded orientation (``"columns"``, ``"rows"`` or ``"both"``), after checking that
     captures, spec and calibration belong together (one-line :class:`BistairError`
-    otherwise)."""
+    otherwise).
+
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        The decode; its image size must be the calibrated camera's.
+    calibration : Calibration
+        The rig.
+    spec : BaseSpec or str
+        The captures' spec (its projector size must be the calibrated projector's), or just
+        its orientation (then the projector size is not checked).
+    orientation : str or None, optional
+        What the caller expects the spec to code, if anything.
+
+    Returns
+    -------
+    str
+        The spec's orientation: ``"columns"``, ``"rows"`` or ``"both"``.
+
+    Raises
+    ------
+    BistairError
+        An unknown orientation, one other than ``orientation``, a decode of both axes with
+        a spec of one or the reverse, or camera or projector sizes other than the
+        calibration's.
+
+    Examples
+    --------
+    >>> from bistair.core.result import make_result
+    >>> cal = _toy_calibration()
+    >>> res = make_result("demo", np.zeros((480, 640)), np.zeros((480, 640), int), 30.0,
+    ...                   modulation=np.ones((480, 640)))
+    >>> check_fit(res, cal, "columns")
+    'columns'
+    >>> check_fit(res, cal, "both")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: a spec of both axes needs the decode of both axes
+    >>> check_fit(res, cal, "columns", orientation="rows")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the spec codes columns, but rows were asked for
+    """
     coded = spec if isinstance(spec, str) else spec.orientation
     if coded not in ("columns", "rows", "both"):
         raise BistairError(f"orientation must be 'columns', 'rows' or 'both', got {coded!r}")
@@ -251,6 +346,18 @@ def check_fit(result: DecodeResult | AxesResult, calibration: Calibration,
 def check_depth_range(min_depth: float, max_depth: float) -> None:
     """Refuse a depth range that is not ``0 <= min_depth < max_depth`` (NaN included).
 
+    Parameters
+    ----------
+    min_depth, max_depth : float
+        The depths ``z`` (mm, camera frame) to keep; ``max_depth`` may be infinite.
+
+    Raises
+    ------
+    BistairError
+        If not ``0 <= min_depth < max_depth`` (a NaN bound fails too).
+
+    Examples
+    --------
     >>> check_depth_range(400.0, float("inf"))
     >>> check_depth_range(-1.0, 800.0)
     Traceback (most recent call last):
@@ -280,6 +387,57 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
     projector pixels off its epipolar line is dropped as a wrong decode), and with the
     coordinate along the baseline alone (:func:`baseline_orientation`) where only that one
     is valid. ``info`` then counts ``both_axes``, ``one_axis`` and ``off_epipolar`` pixels.
+
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        The decode, ``(height, width)`` of the calibrated camera.
+    calibration : Calibration
+        The rig, ``X_p = R @ X_c + T`` (mm).
+    spec : BaseSpec or str
+        The captures' spec, or just its orientation (``"columns"``, ``"rows"``,
+        ``"both"``); see :func:`check_fit`.
+    orientation : str or None, optional
+        What the caller expects the spec to code, if anything.
+    min_depth, max_depth : float, optional
+        Depth range kept (mm, ``z`` in the camera frame).
+    epipolar_tolerance : float, optional
+        Projector pixels a pair of both axes may lie off its epipolar line (positive).
+    **options
+        Passed to :func:`triangulate` (``iterations``, ``tolerance``).
+
+    Returns
+    -------
+    Reconstruction
+        Points (float32, mm, camera frame; NaN where invalid), depth, grey colours
+        (uint8 RGB), mask and counts in ``info`` (``outside_range``, and for both axes
+        ``both_axes``, ``one_axis``, ``off_epipolar``, ``other_axis_only``).
+
+    Raises
+    ------
+    BistairError
+        Whatever :func:`check_fit` and :func:`check_depth_range` refuse, a tolerance that
+        is not positive, or a coded axis that carries almost no depth in this rig (the
+        baseline across it).
+
+    Examples
+    --------
+    One valid pixel, its projector column that of a point 600 mm away:
+
+    >>> from bistair.core.result import make_result
+    >>> cal = _toy_calibration()
+    >>> ray = np.linalg.solve(cal.camera.K, [320.0, 240.0, 1.0])
+    >>> xp = cal.projector.K @ (cal.R @ (600 * ray) + cal.T)
+    >>> column = xp[0] / xp[2]
+    >>> order = np.full((480, 640), -1)
+    >>> order[240, 320] = column // 30
+    >>> phi = np.full((480, 640), 2 * np.pi * (column / 30 % 1))
+    >>> res = make_result("demo", phi, order, 30.0, modulation=np.ones((480, 640)))
+    >>> rec = reconstruct(res, cal, "columns")
+    >>> [round(float(v), 2) for v in rec.points[240, 320]], int(rec.mask.sum()), rec.info
+    ([0.38, 0.38, 600.0], 1, {'outside_range': 0})
+    >>> reconstruct(res, cal, "columns", max_depth=500.0).info
+    {'outside_range': 1}
     """
     coded = check_fit(result, calibration, spec, orientation)
     check_depth_range(min_depth, max_depth)

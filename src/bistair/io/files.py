@@ -39,7 +39,26 @@ IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp")
 
 
 def natural_key(name: str) -> list:
-    """Sort key that compares digit runs as numbers: ``2.png`` before ``10.png``."""
+    """Sort key that compares digit runs as numbers: ``2.png`` before ``10.png``.
+
+    Parameters
+    ----------
+    name : str
+        A file name (or any string).
+
+    Returns
+    -------
+    list
+        The text between digit runs, lower-cased (``str``), alternating with the digit runs
+        as ``int``; lists compare element by element, so names sort in natural order.
+
+    Examples
+    --------
+    >>> natural_key("Scan10.png")
+    ['scan', 10, '.png']
+    >>> sorted(["pat10.bmp", "pat2.bmp", "Pat1.bmp"], key=natural_key)
+    ['Pat1.bmp', 'pat2.bmp', 'pat10.bmp']
+    """
     return [int(part) if part.isdigit() else part.lower() for part in re.split(r"(\d+)", name)]
 
 
@@ -49,7 +68,30 @@ def _is_image(path: Path) -> bool:
 
 
 def list_images(folder: Path) -> list[Path]:
-    """The images in a folder, in natural name order (hidden files left out)."""
+    """The images in a folder, in natural name order (hidden files left out).
+
+    Parameters
+    ----------
+    folder : Path
+        An existing folder. Sub-folders are not searched.
+
+    Returns
+    -------
+    list of Path
+        The PNG, TIFF and BMP files directly in ``folder`` (suffix in any case), sorted by
+        :func:`natural_key` of the name; files whose name starts with ``.`` are left out.
+        Empty if there are none.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> for name in ("10.png", "2.PNG", "1.tif", "spec.json", ".hidden.png"):
+    ...     _ = (tmp / name).write_bytes(b"")
+    >>> [p.name for p in list_images(tmp)]
+    ['1.tif', '2.PNG', '10.png']
+    >>> shutil.rmtree(tmp)
+    """
     return sorted((p for p in folder.iterdir() if _is_image(p)),
                   key=lambda p: natural_key(p.name))
 
@@ -57,10 +99,40 @@ def list_images(folder: Path) -> list[Path]:
 def read_image(path: str | Path) -> np.ndarray:
     """One image as a 2-D array in its own dtype (colour converted to grey).
 
+    TIFF files (``.tif``, ``.tiff``) are read with tifffile, anything else with Pillow.
+    Colour images (RGB or RGBA; alpha ignored) become ``0.299 R + 0.587 G + 0.114 B``,
+    rounded, in the image's dtype.
+
+    Parameters
+    ----------
+    path : str or Path
+        The image file: 8- or 16-bit PNG, TIFF or BMP, grey or colour.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(height, width)`` array in the file's dtype (e.g. ``uint8``, ``uint16``).
+
     Raises
     ------
     BistairError
         A missing, empty or unreadable file, or one that is not a 2-D grey or colour image.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> write_image(tmp / "rgb.png", np.array([[[255, 0, 0], [0, 255, 0]]], np.uint8))
+    >>> read_image(tmp / "rgb.png")
+    array([[ 76, 150]], dtype=uint8)
+    >>> write_image(tmp / "deep.tif", np.array([[0, 4095]], np.uint16))
+    >>> read_image(tmp / "deep.tif")
+    array([[   0, 4095]], dtype=uint16)
+    >>> shutil.rmtree(tmp)
+    >>> read_image("/nonexistent/00.png")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: image /nonexistent/00.png not found
     """
     path = Path(path)
     try:
@@ -95,6 +167,21 @@ Captures = str | Path | Sequence[str | Path]
 def capture_files(captures: Captures) -> list[Path]:
     """The files of a capture set: folders, image files and glob patterns expanded in order
     (see the module docstring), or a single ``.npy`` stack.
+
+    Nothing is read: image files named directly are taken as they are (their content is
+    checked by :func:`read_image`).
+
+    Parameters
+    ----------
+    captures : str, Path or sequence of str or Path
+        A folder, an image file, a glob pattern (``'scan/pat*.png'``; ``*``, ``?`` or
+        ``[``), a ``.npy`` stack, or a sequence of folders, files and patterns taken in the
+        order given.
+
+    Returns
+    -------
+    list of Path
+        The image files in capture order, or the one ``.npy`` file.
 
     Raises
     ------
@@ -146,11 +233,42 @@ def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
     """A capture stack (frames, height, width) from :func:`capture_files`; the frames at
     the indices ``skip`` are left out (not read).
 
+    Parameters
+    ----------
+    captures : str, Path or sequence of str or Path
+        Folders, image files, glob patterns or a single ``.npy`` stack of shape
+        ``(frames, height, width)`` (see :func:`capture_files`).
+    skip : sequence of int, optional
+        Indices (in capture order) of the frames to leave out; indices past the end are
+        ignored.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(frames, height, width)`` in the images' own dtype (colour converted to grey), or
+        the ``.npy`` stack's dtype; C-contiguous.
+
     Raises
     ------
     BistairError
-        What :func:`capture_files` and :func:`read_image` refuse, and frames of different
-        sizes or bit depths.
+        What :func:`capture_files` and :func:`read_image` refuse, a ``.npy`` file that
+        cannot be read or is not 3-D, and frames of different sizes or bit depths.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> for i in range(3):
+    ...     write_image(tmp / f"{i}.png", np.full((2, 4), 10 * i, np.uint8))
+    >>> stack = read_captures(tmp, skip=[1])
+    >>> stack.shape, stack.dtype, stack[:, 0, 0].tolist()
+    ((2, 2, 4), dtype('uint8'), [0, 20])
+    >>> write_image(tmp / "3.png", np.zeros((4, 4), np.uint8))
+    >>> read_captures(tmp)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: frame 3.png is 4x4 but 0.png is 4x2
+    >>> shutil.rmtree(tmp)
     """
     files = capture_files(captures)
     skip = set(skip)
@@ -181,7 +299,36 @@ def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
 
 
 def load_spec(path: str | Path) -> BaseSpec:
-    """Read and validate a ``spec.json``."""
+    """Read and validate a ``spec.json``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The spec file (JSON, as written by ``spec.to_json()`` next to the patterns).
+
+    Returns
+    -------
+    BaseSpec
+        The spec of the method the file names, validated.
+
+    Raises
+    ------
+    BistairError
+        Raised by the readers it calls: a missing, unreadable or malformed file
+        (:func:`~bistair.io.jsonfile.read_json`) or an invalid spec
+        (:func:`bistair.codecs.spec_from_dict`).
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.codecs import make_spec
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> spec = make_spec("graycode", width=120, height=16, period=30)
+    >>> _ = (tmp / "spec.json").write_text(spec.to_json())
+    >>> load_spec(tmp / "spec.json") == spec
+    True
+    >>> shutil.rmtree(tmp)
+    """
     return spec_from_dict(read_json(path, "spec file"))
 
 
@@ -193,11 +340,47 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     folder of the first file). Frames the spec marks ``ignore`` are not read: the spec
     returned lists the frames of the stack returned.
 
+    Parameters
+    ----------
+    captures : str, Path or sequence of str or Path
+        Folders, image files, glob patterns or a ``.npy`` stack (see
+        :func:`capture_files`).
+    spec : BaseSpec, str, Path or None
+        The spec itself, the path of its JSON file, or ``None`` for ``spec.json`` beside
+        the captures.
+
+    Returns
+    -------
+    stack : numpy.ndarray
+        ``(frames, height, width)`` captures without the ``ignore`` frames, in their own
+        dtype (see :func:`read_captures`).
+    spec : BaseSpec
+        The spec, its frame order without ``ignore`` if it had any.
+
     Raises
     ------
     BistairError
         A spec that cannot be read, captures that cannot be read, or a frame count that
         differs from the spec's.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.codecs import make_spec
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> spec = make_spec("graycode", width=120, height=16, period=30)
+    >>> spec = spec.replace(frame_order=("ignore", *spec.frames))
+    >>> _ = (tmp / "spec.json").write_text(spec.to_json())
+    >>> for i in range(spec.frame_count):
+    ...     write_image(tmp / f"{i:02d}.png", np.full((3, 5), i, np.uint8))
+    >>> stack, used = read_with_spec(tmp, None)
+    >>> stack.shape, stack[:, 0, 0].tolist(), used.frames[0]
+    ((6, 3, 5), [1, 2, 3, 4, 5, 6], 'shift-0')
+    >>> read_with_spec(sorted(tmp.glob("*.png"))[:3], spec)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the graycode spec needs 7 frames, the captures have 3
+    >>> shutil.rmtree(tmp)
     """
     files = capture_files(captures)
     if spec is None:
@@ -223,7 +406,29 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
 
 
 def write_image(path: str | Path, image: np.ndarray) -> None:
-    """Write an 8- or 16-bit image (PNG, TIFF or BMP by suffix)."""
+    """Write an 8- or 16-bit image (PNG, TIFF or BMP by suffix).
+
+    TIFF (``.tif``, ``.tiff``) is written with tifffile, other suffixes with imageio. The
+    file is written in place (not atomically): use :func:`output_folder` or
+    :func:`output_file` for that.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (replaced if it exists); its suffix chooses the format.
+    image : numpy.ndarray
+        ``(height, width)`` grey or ``(height, width, 3)`` RGB, ``uint8`` or ``uint16``
+        (BMP takes ``uint8`` only).
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> write_image(tmp / "ramp.png", np.arange(6, dtype=np.uint16).reshape(2, 3) * 1000)
+    >>> read_image(tmp / "ramp.png").tolist()
+    [[0, 1000, 2000], [3000, 4000, 5000]]
+    >>> shutil.rmtree(tmp)
+    """
     path = Path(path)
     if path.suffix.lower() in (".tif", ".tiff"):
         tifffile.imwrite(path, image)
@@ -233,7 +438,40 @@ def write_image(path: str | Path, image: np.ndarray) -> None:
 
 def check_output(out: str | Path, captures: Captures | None = None) -> Path:
     """Refuse an output path that is empty or is the captures' own folder (writing there
-    would add files to the next decode of that folder); returns it as a Path."""
+    would add files to the next decode of that folder); returns it as a Path.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output folder.
+    captures : str, Path, sequence of str or Path, or None, optional
+        The captures it is made from (as for :func:`capture_files`): a folder, the folder
+        of a file or the folder part of a glob pattern counts as their own folder. Paths
+        are compared resolved.
+
+    Returns
+    -------
+    Path
+        ``out`` as a :class:`~pathlib.Path`.
+
+    Raises
+    ------
+    BistairError
+        If ``out`` is empty (or blank) or is the captures' own folder.
+
+    Examples
+    --------
+    >>> check_output("result", "scan/*.png")
+    PosixPath('result')
+    >>> check_output("scan", "scan/*.png")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the output folder scan is the captures' own folder: ...
+    >>> check_output(" ")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the output path is empty
+    """
     if str(out).strip() == "":
         raise BistairError("the output path is empty")
     out = Path(out)
@@ -251,7 +489,49 @@ def check_output(out: str | Path, captures: Captures | None = None) -> Path:
 @contextlib.contextmanager
 def output_folder(out: str | Path) -> Iterator[Path]:
     """Yield a temporary folder; on success its files are moved into ``out`` (created if
-    needed, other files in it left alone); on any error nothing reaches ``out``."""
+    needed, other files in it left alone); on any error nothing reaches ``out``.
+
+    The temporary folder (``.bistair-<pid>-...``) is made inside ``out``, or beside it if
+    ``out`` does not exist yet, so the moves stay on one file system; temporaries left by
+    killed processes there are removed first (:func:`remove_stale`). A new ``out`` is the
+    temporary folder renamed; into an existing ``out`` each item is moved, replacing a
+    file or folder of the same name.
+
+    Parameters
+    ----------
+    out : str or Path
+        The output folder.
+
+    Yields
+    ------
+    Path
+        The temporary folder to write into; it is removed afterwards in every case.
+
+    Raises
+    ------
+    BistairError
+        If ``out`` exists and is not a folder, or the folder cannot be created or written
+        (any ``OSError``, also one raised in the ``with`` block, in one line). Other errors
+        in the ``with`` block propagate unchanged.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> with output_folder(tmp / "out") as work:
+    ...     _ = (work / "a.txt").write_text("a")
+    >>> sorted(p.name for p in tmp.iterdir()), (tmp / "out" / "a.txt").read_text()
+    (['out'], 'a')
+    >>> with output_folder(tmp / "out") as work:
+    ...     _ = (work / "b.txt").write_text("b")
+    ...     raise RuntimeError("interrupted")
+    Traceback (most recent call last):
+    ...
+    RuntimeError: interrupted
+    >>> sorted(p.name for p in (tmp / "out").iterdir())
+    ['a.txt']
+    >>> shutil.rmtree(tmp)
+    """
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")
@@ -281,7 +561,40 @@ def output_folder(out: str | Path) -> Iterator[Path]:
 
 @contextlib.contextmanager
 def output_file(path: str | Path) -> Iterator[Path]:
-    """Yield a temporary file path beside ``path``; it replaces ``path`` only on success."""
+    """Yield a temporary file path beside ``path``; it replaces ``path`` only on success.
+
+    The temporary file (``.bistair-<pid>-...`` with ``path``'s suffix, so writers that go
+    by the suffix work) is made in ``path``'s folder, which is created if needed; temporaries
+    left there by killed processes are removed first (:func:`remove_stale`). On success it
+    gets the usual permissions (``0o666`` less the umask) and is renamed onto ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write.
+
+    Yields
+    ------
+    Path
+        The temporary file (created empty) to write; it is removed if still there afterwards.
+
+    Raises
+    ------
+    BistairError
+        If the folder or the temporary file cannot be made, or the rename fails (any
+        ``OSError``, also one raised in the ``with`` block, in one line). Other errors in
+        the ``with`` block propagate unchanged.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> with output_file(tmp / "sub" / "info.txt") as work:
+    ...     _ = work.write_text("done")
+    >>> [p.name for p in (tmp / "sub").iterdir()], (tmp / "sub" / "info.txt").read_text()
+    (['info.txt'], 'done')
+    >>> shutil.rmtree(tmp)
+    """
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -310,6 +623,20 @@ def remove_stale(folder: str | Path) -> int:
     """Remove temporary outputs (``.bistair-<pid>-*``) in ``folder`` left by processes that
     no longer run (killed while writing); returns how many were removed.
 
+    Temporaries of running processes (this one included) are left alone.
+
+    Parameters
+    ----------
+    folder : str or Path
+        The folder to clean (not searched recursively).
+
+    Returns
+    -------
+    int
+        How many files or folders were removed.
+
+    Examples
+    --------
     >>> import tempfile, pathlib
     >>> with tempfile.TemporaryDirectory() as tmp:
     ...     _ = (pathlib.Path(tmp) / ".bistair-999999999-x").mkdir()

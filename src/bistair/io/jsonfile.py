@@ -16,6 +16,38 @@ def read_json(path: str | Path, what: str) -> Any:
     """Parse ``path``; missing, unreadable or malformed files raise a one-line
     :class:`BistairError` naming ``what`` the file is (e.g. ``"spec file"``).
 
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file (UTF-8).
+    what : str
+        What the file is, for the messages (``"spec file"``, ``"calibration file"``, ...).
+
+    Returns
+    -------
+    Any
+        The parsed value (``dict``, ``list``, ``str``, ``int``, ``float``, ``bool`` or
+        ``None``), as :func:`json.loads` gives it.
+
+    Raises
+    ------
+    BistairError
+        If the file is missing, cannot be read (a folder, no permission, not UTF-8) or is
+        not valid JSON (with the parser's message and line).
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (tmp / "board.json").write_text('{"type": "checkerboard", "columns": 9}')
+    >>> read_json(tmp / "board.json", "board description")
+    {'type': 'checkerboard', 'columns': 9}
+    >>> _ = (tmp / "bad.json").write_text('{"columns": 9,}')
+    >>> read_json(tmp / "bad.json", "board description")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: board description .../bad.json is not valid JSON (...line 1)
+    >>> shutil.rmtree(tmp)
     >>> read_json("/nonexistent.json", "spec file")
     Traceback (most recent call last):
     ...
@@ -38,6 +70,23 @@ def read_json(path: str | Path, what: str) -> Any:
 def to_jsonable(value: Any) -> Any:
     """``value`` with NumPy scalars as Python numbers and tuples as lists, for ``json.dumps``.
 
+    Dictionaries, lists and tuples are converted recursively (dictionary keys become
+    ``str``); anything else is returned as it is (NumPy arrays are not converted: pass
+    ``arr.tolist()``).
+
+    Parameters
+    ----------
+    value : Any
+        A value made of dictionaries, lists, tuples, NumPy scalars and plain values.
+
+    Returns
+    -------
+    Any
+        A copy of the containers with NumPy scalars replaced by ``int``, ``float`` or
+        ``bool`` (:meth:`numpy.generic.item`) and tuples by lists.
+
+    Examples
+    --------
     >>> to_jsonable({"n": np.int64(3), "t": (np.float32(0.5),)})
     {'n': 3, 't': [0.5]}
     """
@@ -51,5 +100,31 @@ def to_jsonable(value: Any) -> Any:
 
 
 def write_json(path: str | Path, value: Any) -> None:
-    """Write ``value`` as indented JSON with a final newline."""
+    """Write ``value`` as indented JSON with a final newline.
+
+    Written in place (not atomically); NaN and infinities are written as JSON's
+    non-standard ``NaN`` and ``Infinity``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write (replaced if it exists; its folder must exist).
+    value : Any
+        What to write; converted by :func:`to_jsonable` first (2-space indent).
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> write_json(tmp / "info.json", {"valid_pixels": np.int64(1920), "size": (120, 16)})
+    >>> print((tmp / "info.json").read_text(), end="")
+    {
+      "valid_pixels": 1920,
+      "size": [
+        120,
+        16
+      ]
+    }
+    >>> shutil.rmtree(tmp)
+    """
     Path(path).write_text(json.dumps(to_jsonable(value), indent=2) + "\n")

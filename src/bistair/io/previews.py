@@ -20,6 +20,23 @@ def colorize(values: np.ndarray, cmap: str = "jet", vmin: float | None = None,
              vmax: float | None = None) -> np.ndarray:
     """Map a 2-D array to RGB uint8 with a matplotlib colormap; NaN (or masked) -> black.
 
+    Values are scaled linearly from ``[vmin, vmax]`` to the colormap and clipped there.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(height, width)`` values, any real dtype; non-finite values (NaN, inf) are invalid.
+    cmap : str, optional
+        Name of a matplotlib colormap (``"jet"``, ``"gray"``, ``"viridis"``, ...).
+    vmin, vmax : float or None, optional
+        The values mapped to the ends of the colormap; by default the smallest and largest
+        finite value (0 and 1 if there is none).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(height, width, 3)`` ``uint8`` RGB, ``(0, 0, 0)`` where ``values`` is not finite.
+
     Examples
     --------
     >>> import numpy as np
@@ -40,7 +57,33 @@ def colorize(values: np.ndarray, cmap: str = "jet", vmin: float | None = None,
 
 
 def preview_images(result: DecodeResult) -> dict[str, np.ndarray]:
-    """The preview images of a result, by file stem."""
+    """The preview images of a result, by file stem.
+
+    Parameters
+    ----------
+    result : DecodeResult
+        A decode of one axis.
+
+    Returns
+    -------
+    dict of str to numpy.ndarray
+        ``(height, width, 3)`` ``uint8`` RGB images (black where invalid) under
+        ``"wrapped"`` (grey, 0 to 2 pi), ``"ks"`` (the code word, viridis), ``"order"``
+        (fringe order, jet), ``"phase"`` (absolute phase, jet) and ``"modulation"`` (grey,
+        0 to the largest), each scaled to its valid values unless said.
+
+    Examples
+    --------
+    >>> from bistair.core.result import make_result
+    >>> phi = np.full((2, 3), np.pi)
+    >>> res = make_result("demo", phi, np.array([[0, 1, 2], [0, -1, 2]]), 30.0,
+    ...                   modulation=np.full((2, 3), 0.4))
+    >>> images = preview_images(res)
+    >>> list(images), images["order"].shape, images["order"].dtype
+    (['wrapped', 'ks', 'order', 'phase', 'modulation'], (2, 3, 3), dtype('uint8'))
+    >>> images["phase"][1, 1].tolist(), images["wrapped"][1, 1].tolist()  # order -1
+    ([0, 0, 0], [128, 128, 128])
+    """
     code = np.where(result.code >= 0, result.code, np.nan).astype(np.float64)
     order = np.where(result.order >= 0, result.order, np.nan).astype(np.float64)
     return {
@@ -54,7 +97,36 @@ def preview_images(result: DecodeResult) -> dict[str, np.ndarray]:
 
 def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -> list[Path]:
     """Write the preview PNGs of a result into ``folder`` (``STEM + suffix + .png``);
-    returns their paths."""
+    returns their paths.
+
+    The files are written in place (not atomically; see
+    :func:`bistair.io.files.output_folder`) and replace files of the same names.
+
+    Parameters
+    ----------
+    result : DecodeResult
+        A decode of one axis.
+    folder : str or Path
+        An existing folder.
+    suffix : str, optional
+        Added to each stem, e.g. ``"_x"`` for the columns of a decode of both axes.
+
+    Returns
+    -------
+    list of Path
+        The RGB PNGs written, in the order of :func:`preview_images`.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.core.result import make_result
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> res = make_result("demo", np.full((2, 3), 1.0), np.zeros((2, 3), int), 30.0,
+    ...                   modulation=np.ones((2, 3)))
+    >>> [p.name for p in write_previews(res, tmp, suffix="_x")]
+    ['wrapped_x.png', 'ks_x.png', 'order_x.png', 'phase_x.png', 'modulation_x.png']
+    >>> shutil.rmtree(tmp)
+    """
     folder = Path(folder)
     paths = []
     for stem, rgb in preview_images(result).items():

@@ -34,7 +34,36 @@ def write_result(result: DecodeResult | AxesResult, folder: str | Path,
     """Write a decode's arrays (``NAME.npy``), ``info.json`` and, with ``previews``, the PNG
     previews into an existing folder. A decode of both axes writes each axis's files with
     the suffix ``_x`` or ``_y`` (``coord_x.npy``, ``order_y.png``, ...) and ``mask.npy``
-    where both are valid."""
+    where both are valid.
+
+    The files are written in place, replacing files of the same names; make the folder
+    with :func:`bistair.io.files.output_folder` for an atomic result.
+
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        The decode: its arrays (``phase``, ``coord``, ``order``, ``wrapped``,
+        ``modulation``, ``mask``; see :meth:`DecodeResult.arrays
+        <bistair.core.result.DecodeResult.arrays>`) go to ``.npy`` files, its ``info`` to
+        ``info.json``.
+    folder : str or Path
+        An existing folder.
+    previews : bool, optional
+        Also write the PNG previews (:func:`~bistair.io.previews.write_previews`).
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.core.result import AxesResult, make_result
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> res = make_result("demo", np.full((2, 3), 1.0), np.zeros((2, 3), int), 30.0,
+    ...                   modulation=np.ones((2, 3)))
+    >>> write_result(AxesResult(res, res), tmp)
+    >>> names = sorted(p.name for p in tmp.iterdir())
+    >>> len(names), names[:4]
+    (24, ['coord_x.npy', 'coord_y.npy', 'info.json', 'ks_x.png'])
+    >>> shutil.rmtree(tmp)
+    """
     folder = Path(folder)
     for name, arr in result.arrays().items():
         np.save(folder / f"{name}.npy", arr)
@@ -48,7 +77,44 @@ def write_result(result: DecodeResult | AxesResult, folder: str | Path,
 
 def write_ply(path: str | Path, points: np.ndarray, colors: np.ndarray | None = None) -> Path:
     """Write a coloured point cloud as binary little-endian PLY (``x y z`` float32, ``red
-    green blue`` uchar) atomically; readable by Open3D, MeshLab and plyfile."""
+    green blue`` uchar) atomically; readable by Open3D, MeshLab and plyfile.
+
+    The file is written to a temporary file beside ``path`` and renamed onto it
+    (:func:`~bistair.io.files.output_file`); its header comment says the points are in the
+    camera frame, in millimetres. Points are written as given: drop invalid (NaN) points
+    first (e.g. :meth:`Reconstruction.cloud
+    <bistair.geometry.triangulate.Reconstruction.cloud>`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The PLY file (its folder is created if needed).
+    points : numpy.ndarray
+        ``(N, 3)`` (or anything reshaped to it) coordinates in mm, cast to float32.
+    colors : numpy.ndarray or None, optional
+        ``(N, 3)`` RGB, cast to uint8; white if ``None``.
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    BistairError
+        Raised by :func:`~bistair.io.files.output_file` if the file cannot be written.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from plyfile import PlyData
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> path = write_ply(tmp / "cloud.ply", [[0, 0, 600], [1.5, -2, 601]], [[255, 0, 0]] * 2)
+    >>> vertex = PlyData.read(str(path))["vertex"]
+    >>> vertex["z"].tolist(), vertex["red"].tolist(), vertex["green"].tolist()
+    ([600.0, 601.0], [255, 255], [0, 0])
+    >>> shutil.rmtree(tmp)
+    """
     pts = np.asarray(points, np.float32).reshape(-1, 3)
     cols = (np.full((len(pts), 3), 255, np.uint8) if colors is None
             else np.asarray(colors, np.uint8).reshape(-1, 3))
@@ -67,7 +133,28 @@ def write_ply(path: str | Path, points: np.ndarray, colors: np.ndarray | None = 
 
 
 def write_depth(depth: np.ndarray, folder: str | Path) -> None:
-    """Write ``depth.npy`` (float32, NaN where invalid) and the ``depth.png`` preview."""
+    """Write ``depth.npy`` (float32, NaN where invalid) and the ``depth.png`` preview.
+
+    The preview maps the 1st to 99th percentile of the valid depths to the reversed turbo
+    colormap (near red, far blue), invalid pixels black. Both files are written in place
+    (make the folder with :func:`bistair.io.files.output_folder` for atomic output).
+
+    Parameters
+    ----------
+    depth : numpy.ndarray
+        ``(height, width)`` depth ``z`` in mm (camera frame), NaN where invalid.
+    folder : str or Path
+        An existing folder.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> write_depth(np.array([[600.0, 610.0], [620.0, np.nan]]), tmp)
+    >>> sorted(p.name for p in tmp.iterdir()), np.load(tmp / "depth.npy").dtype
+    (['depth.npy', 'depth.png'], dtype('float32'))
+    >>> shutil.rmtree(tmp)
+    """
     folder = Path(folder)
     depth = np.asarray(depth, np.float32)
     np.save(folder / "depth.npy", depth)
