@@ -40,6 +40,7 @@ from ..io.files import (
     Captures,
     capture_files,
     check_output,
+    find_spec,
     load_spec,
     natural_key,
     output_file,
@@ -188,25 +189,35 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
                        calibration: Calibration | str | Path, out_ply: str | Path,
                        depth_dir: str | Path | None = None, orientation: str | None = None,
                        min_depth: float = 0.0, max_depth: float = np.inf,
-                       epipolar_tolerance: float = 1.5, **options: Any) -> Reconstruction:
+                       epipolar_tolerance: float = 1.5,
+                       decoded: DecodeResult | AxesResult | None = None,
+                       **options: Any) -> Reconstruction:
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
     ``CAPTURES/spec.json``; ``options`` go to the decoder. A spec of both axes triangulates
     with both projector coordinates (``epipolar_tolerance``: see
-    :func:`~bistair.geometry.triangulate.reconstruct`). Nothing is written on error."""
+    :func:`~bistair.geometry.triangulate.reconstruct`). ``decoded``: the decode of these
+    captures if already made (by :func:`decode_folder`), triangulated without reading or
+    decoding them again. Nothing is written on error."""
     check_depth_range(min_depth, max_depth)
     if not epipolar_tolerance > 0:
         raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
-    stack, spec = read_with_spec(captures, spec)
+    if decoded is None:
+        stack, spec = read_with_spec(captures, spec)
+        shape = stack.shape[1:]
+    else:
+        spec, shape = find_spec(captures, spec), decoded.mask.shape
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)
-    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8,
+    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(shape),) * 8,
                                                     period=1.0, method="")
     if spec.orientation == "both":
         blank = AxesResult(blank, blank)
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
-    rec = reconstruct(decode(stack, spec, **options), calibration, spec, orientation,
-                      min_depth, max_depth, epipolar_tolerance)
+    if decoded is None:
+        decoded = decode(stack, spec, **options)
+    rec = reconstruct(decoded, calibration, spec, orientation, min_depth, max_depth,
+                      epipolar_tolerance)
     pts, cols = rec.cloud()
     if depth_dir is None:
         write_ply(out_ply, pts, cols)
