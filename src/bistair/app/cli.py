@@ -201,8 +201,9 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 
 
 @cli.command()
-@click.option("--scene", required=True, help="preset scene (paper-sim, two-masks, mask-prism, "
-              "two-sculptures, plane, sphere-on-plane)")
+@click.option("--scene", default=None, help="preset scene (paper-sim, two-masks, mask-prism, "
+              "two-sculptures, plane, sphere-on-plane, objects-on-plane, mugs-on-wall) or "
+              "calibration (board captures)")
 @click.option("--method", "methods", required=True, multiple=True,
               help="method to render (repeatable), or all")
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
@@ -219,20 +220,63 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 @click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
               show_default=True, help="camera bit depth")
 @click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--count", type=int, default=None,
+              help="a data set: COUNT scenes in OUT/scene-NNNN/ and OUT/index.csv, rendered "
+              "in parallel")
+@click.option("--vary", default=None, metavar="optics,objects,pose",
+              help="with --count: what each scene draws at random (see README)")
+@click.option("--workers", type=int, default=None,
+              help="with --count: processes of the local cluster [default: the cores]")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="with --count: run on an existing Dask cluster instead")
 @reports_errors
-def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int, int] | None,
-             noise: float, blur: float, gamma: float, compensated: bool, ambient: float,
-             bits: str, seed: int) -> None:
-    """Render a preset scene on the virtual rig: one capture folder per method + the truth."""
-    from .simulate import simulate as run
+def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
+             camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
+             compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
+             vary: str | None, workers: int | None, scheduler: str | None) -> None:
+    """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
+    With --count N, a data set of N scenes (deterministic for a --seed whatever the number
+    of workers), each varied as --vary says."""
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
-    run(scene, chosen, out, camera_size=camera, compensated=compensated, gamma=gamma,
-        read_noise=noise, camera_blur=blur, ambient=ambient, bits=int(bits), seed=seed)
-    if scene == "calibration":
-        click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to {out}")
-    else:
-        click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth to {out}")
+    imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
+                   bits=int(bits))
+    if count is None:
+        for name, value in (("--vary", vary), ("--workers", workers),
+                            ("--scheduler", scheduler)):
+            if value is not None:
+                raise CliError(f"{name} applies to a data set: give --count too")
+        if scene is None:
+            raise CliError("name a --scene (or give --count with --vary objects)")
+        from .simulate import simulate as run
+
+        run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
+            **imaging)
+        if scene == "calibration":
+            click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to "
+                       f"{out}")
+        else:
+            click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
+                       f"to {out}")
+        return
+    from .simulate import simulate_many
+
+    try:
+        report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
+                               camera_size=camera, compensated=compensated, workers=workers,
+                               scheduler=scheduler, show_progress=sys.stderr.isatty(),
+                               **imaging)
+    except KeyboardInterrupt:
+        click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
+                   "written", err=True)
+        raise click.exceptions.Abort() from None
+    for name, error in report.failed:
+        click.echo(f"failed {name}: {error}")
+    click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
+               f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
+               f"{report.workers} worker{'s' if report.workers != 1 else ''}")
+    if report.failed:
+        raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
 
 
 @cli.command()
