@@ -18,11 +18,13 @@ import numpy as np
 import pytest
 from conftest import cli_run
 
+from bistair.app import batch as batch_module
 from bistair.app import engine
-from bistair.app.batch import MARKER, find_sets
+from bistair.app.batch import MARKER, Options, SetJob, find_sets, run_set
 from bistair.app.simulate import simulate
 from bistair.errors import BistairError
 from bistair.geometry.calibration import Calibration, save_calibration
+from bistair.io.files import replace_folder
 from bistair.sim import preset
 
 CAMERA = (160, 128)
@@ -315,3 +317,26 @@ def test_batch_on_a_separate_scheduler_and_worker(scans, scheduler, tmp_path, mo
     assert rows["sphere"]["resumed"] == "yes" and rows["plane"]["resumed"] == "no"
     _same_outputs(out / "plane", tmp_path / "loop" / "plane")
     _no_temporaries(out)
+
+
+def test_replace_folder_keeps_the_old_folder_on_error(tmp_path):
+    out = tmp_path / "set"
+    out.mkdir()
+    (out / "old.npy").write_bytes(b"old")
+    with pytest.raises(RuntimeError), replace_folder(out, ".bistair-batch-test-") as tmp:
+        (tmp / "new.npy").write_bytes(b"new")
+        raise RuntimeError("interrupted")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["set"]
+    assert [p.name for p in out.iterdir()] == ["old.npy"]
+
+
+def test_a_set_that_breaks_the_decoder_is_an_error_row(scans, tmp_path, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("something unforeseen\nwith a second line")
+
+    monkeypatch.setattr(batch_module, "decode_folder", broken)
+    job = SetJob("plane", str(scans / "plane"), None, None, str(tmp_path / "out" / "plane"))
+    row = run_set(job, Options())
+    assert row["status"] == "error"
+    assert row["error"] == "RuntimeError: something unforeseen"
+    assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
