@@ -188,3 +188,18 @@ def test_saturated_pixels_are_invalid(spec36):
     assert not res.mask[heavily].any()
     m = metrics.score(res, truth.coord(spec36), truth.mask)
     assert m["order_errors"] == 0 and m["phase_rmse"] < 0.05
+
+
+@pytest.mark.parametrize("bits", [10, 12, 14])
+def test_saturation_of_msb_aligned_16_bit_containers(spec36, bits):
+    """A 10-14-bit camera's images stored MSB-aligned in 16-bit PNGs saturate at
+    ``65536 - 2**(16 - bits)``: those pixels are flagged as in the 8-bit capture."""
+    images, _ = render_warp(spec36, warped_scene(0, noise=0.005, blur=0.5))
+    exposed = np.clip(images * 2.2, 0, 1)
+    codes = np.round(exposed * ((1 << bits) - 1)).astype(np.uint16) << (16 - bits)
+    res = bistair.decode(codes, spec36)
+    heavily = (images[:4] * 2.2 > 1.05).sum(axis=0) >= 2
+    assert heavily.sum() > 1000
+    assert not res.mask[heavily].any()
+    lsb = bistair.decode(codes >> (16 - bits), spec36)  # the same data LSB-aligned
+    np.testing.assert_array_equal(res.mask, lsb.mask)

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from bistair.core.phase import TWO_PI, phase_shift_patterns, residual_noise, wrapped_phase
-from bistair.core.regions import fill_from_neighbours, fringe_regions, region_links
+from bistair.core.regions import fill_orders, fringe_regions, region_links
 from bistair.core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 
 
@@ -80,11 +80,10 @@ def test_fringe_regions_cut_a_phase_step_and_invalid_pixels():
     assert labels[5, 100] == 0
 
 
-def test_fill_from_neighbours_uses_the_nearest_absolute_phase():
+def test_fill_orders_uses_the_nearest_absolute_phase():
     phi, coord = _ramp()
-    absolute = (TWO_PI * coord / 30).astype(np.float32)
-    known = absolute.copy()
-    known[10:12, 28:33] = np.nan  # a hole across a wrap
-    target = np.isnan(known)
-    filled = fill_from_neighbours(phi, known, target, max_distance=3)
-    assert np.allclose(filled, absolute, atol=1e-4)
+    orders = np.floor(coord / 30).astype(np.int32)
+    known = orders.copy()
+    known[10:12, 28:33] = -1  # a hole across a wrap
+    filled = fill_orders(phi, known, known < 0, max_distance=3)
+    assert np.array_equal(filled, orders)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import signal
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -39,6 +40,12 @@ def reports_errors(func: Callable) -> Callable:
             raise CliError("not enough memory for these captures") from None
 
     return wrapper
+
+
+def _quiet(func: Callable) -> Callable:
+    """``--quiet``: no progress and no summary; errors and warnings are still printed."""
+    return click.option("--quiet", "-q", is_flag=True,
+                        help="print only errors and warnings (no progress, no summary)")(func)
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -144,20 +151,26 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@_quiet
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
-           min_modulation: float | None, no_previews: bool) -> None:
+           min_modulation: float | None, no_previews: bool, quiet: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order.
 
     CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
     order; a folder's or pattern's images in natural name order; or one .npy stack.
     """
     from .jobs import decode_folder
+    from .progress import Progress
 
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
-    result = decode_folder(list(captures), out, spec_path, previews=not no_previews, **options)
+    with Progress(quiet) as say:
+        result = decode_folder(list(captures), out, spec_path, previews=not no_previews,
+                               progress=say, **options)
     _warn(result)
+    if quiet:
+        return
     if hasattr(result, "x"):
         click.echo(f"decoded {result.method} on both axes: {int(result.mask.sum())} of "
                    f"{result.mask.size} pixels valid on both ({100 * result.mask.mean():.1f}%; "
@@ -229,11 +242,13 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
               help="with --count: processes of the local cluster [default: the cores]")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="with --count: run on an existing Dask cluster instead")
+@_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None) -> None:
+             vary: str | None, workers: int | None, scheduler: str | None,
+             quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
@@ -248,10 +263,14 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                 raise CliError(f"{name} applies to a data set: give --count too")
         if scene is None:
             raise CliError("name a --scene (or give --count with --vary objects)")
+        from .progress import Progress
         from .simulate import simulate as run
 
-        run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-            **imaging)
+        with Progress(quiet) as say:
+            run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
+                progress=say, **imaging)
+        if quiet:
+            return
         if scene == "calibration":
             click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to "
                        f"{out}")
@@ -264,17 +283,18 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
     try:
         report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
                                camera_size=camera, compensated=compensated, workers=workers,
-                               scheduler=scheduler, show_progress=sys.stderr.isatty(),
-                               **imaging)
+                               scheduler=scheduler,
+                               show_progress=sys.stderr.isatty() and not quiet, **imaging)
     except KeyboardInterrupt:
         click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
                    "written", err=True)
         raise click.exceptions.Abort() from None
     for name, error in report.failed:
-        click.echo(f"failed {name}: {error}")
-    click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
-               f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
-               f"{report.workers} worker{'s' if report.workers != 1 else ''}")
+        click.echo(f"failed {name}: {error}", err=quiet)
+    if not quiet:
+        click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
+                   f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
+                   f"{report.workers} worker{'s' if report.workers != 1 else ''}")
     if report.failed:
         raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
 
@@ -287,18 +307,24 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
               help="board description [default: CAPTURES/board.json]")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found and mapped (3 or more)")
+@_quiet
 @reports_errors
-def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int) -> None:
+def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
+              quiet: bool) -> None:
     """Calibrate camera and projector from board captures (both orientations per pose).
 
     Prints the reprojection errors and one standard deviation of every parameter."""
     from ..geometry.calibrate import MIN_POSES
     from .jobs import calibrate_folder
+    from .progress import Progress
 
     if min_poses < MIN_POSES:
         raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
                        f"needs at least {MIN_POSES} board poses")
-    cal = calibrate_folder(captures, out, board=board, min_poses=min_poses)
+    with Progress(quiet) as say:
+        cal = calibrate_folder(captures, out, board=board, min_poses=min_poses, progress=say)
+    if quiet:
+        return
     sigma = cal.uncertainty
     click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
                f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} +/- "
@@ -361,23 +387,28 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="specs of both axes: drop pixels whose projector column and "
               "row lie farther than this (projector pixels) from the camera ray's projection")
+@_quiet
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
                 depth: Path | None, strategy: str | None, depth_range: str | None,
-                epipolar_tolerance: float) -> None:
+                epipolar_tolerance: float, quiet: bool) -> None:
     """Decode, triangulate with a calibration, write a coloured PLY and a depth map.
 
     With a spec of both axes (orientation both), each point fits both projector
     coordinates, and pixels whose coordinates no point on their camera ray shows are
     dropped as wrong decodes."""
     from .jobs import parse_depth_range, reconstruct_folder
+    from .progress import Progress
 
     depth = depth or out.with_name(out.stem + "-depth")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {} if strategy is None else {"strategy": strategy}
-    rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
-                             min_depth=low, max_depth=high,
-                             epipolar_tolerance=epipolar_tolerance, **options)
+    with Progress(quiet) as say:
+        rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
+                                 min_depth=low, max_depth=high,
+                                 epipolar_tolerance=epipolar_tolerance, progress=say, **options)
+    if quiet:
+        return
     notes = []
     if "both_axes" in rec.info:
         notes.append(f"{rec.info['both_axes']} pixels with both axes, {rec.info['one_axis']} "
@@ -433,11 +464,12 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="with --calibration and specs of both axes: see "
               "'bistair reconstruct --help'")
+@_quiet
 @reports_errors
 def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
           workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
           min_modulation: float | None, no_previews: bool, depth_range: str | None,
-          epipolar_tolerance: float) -> None:
+          epipolar_tolerance: float, quiet: bool) -> None:
     """Decode (with --calibration also reconstruct) many capture sets on Dask.
 
     ROOT: a folder whose sub-folders are the capture sets, or a CSV manifest with the
@@ -456,17 +488,24 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
                            scheduler=scheduler, resume=resume, previews=not no_previews,
                            min_depth=low, max_depth=high,
                            epipolar_tolerance=epipolar_tolerance,
-                           show_progress=sys.stderr.isatty(), **options)
+                           show_progress=sys.stderr.isatty() and not quiet, **options)
     except KeyboardInterrupt:
         click.echo(f"Interrupted: the finished sets are in {out} (listed in batch.csv); "
                    "run again with --resume to go on", err=True)
         raise click.exceptions.Abort() from None
     for row in report.failed:
-        click.echo(f"failed {row['name']}: {row['error']}")
-    click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
+        click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
+    if not quiet:
+        click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
+
+
+def _terminated(signum: int, frame: Any) -> None:
+    """SIGTERM ends the command like Ctrl-C: temporary outputs are removed on the way out."""
+    raise SystemExit(128 + signum)
 
 
 def main() -> None:
+    signal.signal(signal.SIGTERM, _terminated)
     try:
         cli(standalone_mode=False)
     except click.exceptions.Abort:

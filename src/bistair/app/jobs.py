@@ -19,7 +19,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -115,19 +115,36 @@ def read_gamma(path: str | Path) -> float:
 
 
 def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Path | None = None,
-                  previews: bool = True, **options: Any) -> DecodeResult | AxesResult:
+                  previews: bool = True, progress: Say | None = None,
+                  **options: Any) -> DecodeResult | AxesResult:
     """Decode captures (folders, files, glob patterns or a ``.npy`` stack; see
     :func:`~bistair.io.files.capture_files`) and write the result into the folder ``out``.
 
     ``spec`` defaults to ``spec.json`` in the captures' folder. A decode with no valid pixel
-    is refused.
+    is refused. ``progress`` is called with each stage's name as it starts.
     """
+    say = progress or _silent
     check_output(out, captures)
+    say("reading the captures")
     stack, spec = read_with_spec(captures, spec)
+    say(_decoding(stack, spec))
     result = require_valid(decode(stack, spec, **options))
+    say("writing " + ("outputs and previews" if previews else "outputs"))
     with output_folder(out) as tmp:
         write_result(result, tmp, previews=previews)
     return result
+
+
+Say = Callable[[str], None]
+
+
+def _silent(stage: str) -> None:
+    """The progress callback of a job nobody watches."""
+
+
+def _decoding(stack: np.ndarray, spec: BaseSpec) -> str:
+    return (f"decoding {len(stack)} frames of {stack.shape[2]}x{stack.shape[1]} "
+            f"({spec.method})")
 
 
 def require_valid(result: DecodeResult | AxesResult) -> DecodeResult | AxesResult:
@@ -191,6 +208,7 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
                        min_depth: float = 0.0, max_depth: float = np.inf,
                        epipolar_tolerance: float = 1.5,
                        decoded: DecodeResult | AxesResult | None = None,
+                       progress: Say | None = None,
                        **options: Any) -> Reconstruction:
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
@@ -198,11 +216,15 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     with both projector coordinates (``epipolar_tolerance``: see
     :func:`~bistair.geometry.triangulate.reconstruct`). ``decoded``: the decode of these
     captures if already made (by :func:`decode_folder`), triangulated without reading or
-    decoding them again. Nothing is written on error."""
+    decoding them again. Nothing is written on error. ``progress`` is called with each
+    stage's name as it starts."""
+    say = progress or _silent
     check_depth_range(min_depth, max_depth)
     if not epipolar_tolerance > 0:
         raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
+    stack = None
     if decoded is None:
+        say("reading the captures")
         stack, spec = read_with_spec(captures, spec)
         shape = stack.shape[1:]
     else:
@@ -215,10 +237,13 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
         blank = AxesResult(blank, blank)
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
     if decoded is None:
+        say(_decoding(stack, spec))
         decoded = decode(stack, spec, **options)
+    say("triangulating")
     rec = reconstruct(decoded, calibration, spec, orientation, min_depth, max_depth,
                       epipolar_tolerance)
     pts, cols = rec.cloud()
+    say(f"writing {len(pts)} points")
     if depth_dir is None:
         write_ply(out_ply, pts, cols)
         return rec
@@ -263,7 +288,7 @@ def read_pose(folder: Path, orientation: str) -> tuple[np.ndarray, np.ndarray, B
 
 def calibrate_folder(folder: str | Path, out: str | Path | None = None,
                      board: Board | str | Path | None = None, min_poses: int = MIN_POSES,
-                     **options: Any) -> Calibration:
+                     progress: Say | None = None, **options: Any) -> Calibration:
     """Calibrate from board captures; write the calibration file to ``out`` (atomically) if
     given. ``options`` go to :func:`~bistair.geometry.calibrate.calibrate_poses` and
     :func:`~bistair.geometry.calibrate.calibrate_points` (``fix_k3``, ``refine``).
@@ -283,8 +308,9 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
     Every sub-folder holding ``columns/`` and ``rows/`` is a pose (in natural name order);
     both specs must code the same projector size. ``board.json``: see
     :mod:`bistair.geometry.board` (``columns x rows`` inner corners or circles, ``spacing``
-    in mm).
+    in mm). ``progress`` is called with each stage's name as it starts.
     """
+    say = progress or _silent
     check_min_poses(min_poses)
     folder = Path(folder)
     if not folder.is_dir():
@@ -295,7 +321,8 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
     if not folders:
         raise BistairError(f"no pose folders with columns/ and rows/ in {folder}")
     poses, proj_size, cam_size = [], None, None
-    for sub in folders:
+    for number, sub in enumerate(folders, 1):
+        say(f"decoding pose {number} of {len(folders)} ({sub.name})")
         x, white, sx = read_pose(sub, "columns")
         y, _, sy = read_pose(sub, "rows")
         for s, o in ((sx, "columns"), (sy, "rows")):
@@ -312,6 +339,7 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
                                    f"earlier ones {cam_size[1]}x{cam_size[0]}")
         poses.append(PoseCapture(sub.name, white, x, y))
     assert proj_size is not None
+    say(f"calibrating from {len(poses)} poses")
     cal = calibrate_poses(poses, board, proj_size, min_poses=min_poses, **options)
     if out is not None:
         save_calibration(cal, out)

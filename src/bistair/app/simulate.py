@@ -34,7 +34,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -68,12 +68,12 @@ from .engine import (
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
              camera_size: tuple[int, int] | None = None, compensated: bool = True,
-             **imaging: Any) -> Path:
+             progress: Callable[[str], None] | None = None, **imaging: Any) -> Path:
     """Render ``scene`` for each of ``methods`` and write the capture folders into ``out``.
 
     ``imaging`` goes to :class:`bistair.sim.Imaging` (``gamma``, ``read_noise``,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
-    the projector's gamma.
+    the projector's gamma. ``progress`` is called with each stage's name as it starts.
 
     Raises
     ------
@@ -91,23 +91,29 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     if scene == "calibration":
         return _calibration(methods, out, camera_size, compensated, im)
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
+    say = progress or (lambda stage: None)
     with output_folder(out) as tmp:
         write_scene(tmp, rig, geometry, im, methods, compensated,
-                    {"scene": scene, "methods": methods, "compensated": compensated})
+                    {"scene": scene, "methods": methods, "compensated": compensated},
+                    progress=say)
     return Path(out)
 
 
 def write_scene(folder: Path, rig: Rig, geometry: Scene, imaging: Imaging,
                 methods: Sequence[str], compensated: bool, about: dict[str, Any],
-                threads: int | None = None) -> None:
+                threads: int | None = None,
+                progress: Callable[[str], None] | None = None) -> None:
     """Render ``geometry`` for each method into the existing ``folder``: the capture
     folders, ``truth/``, ``calibration.json`` and ``scene.json`` (``about``, the imaging and
     the rig). ``threads`` for ray casting and exposure (default: the cores; the images do
-    not depend on it)."""
+    not depend on it). ``progress`` is called with each stage's name as it starts."""
+    say = progress or (lambda stage: None)
     specs = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
                          methods=methods)
+    say(f"tracing the scene ({rig.camera.size[0]}x{rig.camera.size[1]})")
     traced = trace(rig, geometry, imaging, workers=threads)
     for method, (spec, _) in specs.items():
+        say(f"rendering and writing {method}")
         sub = folder / method
         sub.mkdir()
         images = expose(traced, encode(spec), imaging, workers=threads)

@@ -49,7 +49,7 @@ from ..core.checks import (
 )
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
-from ..core.result import AxesResult, DecodeResult, result_from_phase
+from ..core.result import AxesResult, DecodeResult, result_from_orders
 from ..errors import BistairError
 from ..spec import AXES, BaseSpec, PeriodSpec
 
@@ -91,9 +91,10 @@ class CodeMap:
 
 @dataclass
 class Orders:
-    """Stage 3 of a decode: the absolute phase (NaN where invalid) and figures about it."""
+    """Stage 3 of a decode: the fringe order per pixel (int, -1 where invalid) and figures
+    about it."""
 
-    abs_phase: np.ndarray
+    order: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
 
 
@@ -173,9 +174,7 @@ class Codec:
                            select=[frames.index(name) for name in spec.method_frames()],
                            **roles)
         if spec.orientation == "rows":
-            return prepared, Prepared(
-                prepared.frames.transpose(0, 2, 1), prepared.clipped.T, prepared.full_scale,
-                *(None if a is None else a.T for a in (prepared.white, prepared.black)))
+            return prepared, prepared.transposed()
         return prepared, prepared
 
     def phase_map(self, images: np.ndarray, spec: BaseSpec,
@@ -222,7 +221,7 @@ class Codec:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         _refuse(jump_problem(orders.info.get("jump_violations", 0),
                              orders.info.get("jump_links", 0)))
-        result = result_from_phase(self.name, fs, orders.abs_phase, spec.period,
+        result = result_from_orders(self.name, fs, orders.order, spec.period,
                                    code=code.code, info=orders.info, length=spec.coded_length)
         _refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
                                 spec.coded_length))

@@ -63,7 +63,7 @@ from ..core.captures import Prepared
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, wrap
 from ..core.regions import core_weight, fringe_regions
-from ..core.resolve import code_evidence, phase_from_regions
+from ..core.resolve import code_evidence, orders_from_regions
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
@@ -228,7 +228,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
             "bits": spec.code_bits + spec.complementary}
     k = code.code
     if strategy == "pixel":
-        return Orders(np.where(k >= 0, fs.phi + TWO_PI * k, np.nan), info)
+        return Orders(k, info)
     labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
@@ -238,9 +238,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     def agrees(order: np.ndarray) -> np.ndarray:
         return (k == order) | (k < 0)
 
-    abs_phase = phase_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
+    order = orders_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
                                    info)
-    return Orders(abs_phase, info)
+    return Orders(order, info)
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:

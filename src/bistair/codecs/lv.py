@@ -12,7 +12,7 @@ deterministic depth-first search). Decoding: each fringe region (2-D stripe betw
 jumps) takes the code most of its pixels read; regions are chained to their right-hand
 neighbours across wraps; every chain of ``window`` regions is looked up in the sequence and
 votes for the orders of its members; the votes are checked against each other and against
-the one-order step across every wrap (:func:`bistair.core.resolve.phase_from_regions`). A region
+the one-order step across every wrap (:func:`bistair.core.resolve.orders_from_regions`). A region
 in an object narrower than ``window`` fringes gets no window and stays invalid: that is the
 method's known limit, which the bidirectional coding removes.
 
@@ -33,7 +33,7 @@ from ..core.captures import Prepared
 from ..core.checks import stair_misfit
 from ..core.measure import FringeSet
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
-from ..core.resolve import code_evidence, phase_from_regions
+from ..core.resolve import code_evidence, orders_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
@@ -209,10 +209,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
 
     sequence = np.asarray(spec.sequence)
     info = {"noise": fs.noise, "fringes": spec.fringes}
-    abs_phase = phase_from_regions(
+    order = orders_from_regions(
         fs.phi, fs.valid, labels, evidence_of, info=info,
         agrees=lambda k: (codes == sequence[np.clip(k, 0, None)]) | (codes < 0))
-    return Orders(abs_phase, info)
+    return Orders(order, info)
 
 
 def levels_for(fringes: int, window: int = 4) -> int:

@@ -217,13 +217,14 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
             f"the modulated pixels (check the periods, the frame order, phase_offset and "
             f"shift_sign{hint})")
     ok = valid & agree & (code.code >= 0)
-    abs_phase = np.where(ok, fs.phi + TWO_PI * code.code, np.nan)
-    slope = np.nanmedian(np.diff(abs_phase[::4], axis=1)) if ok.sum() > 100 else 0.0
+    order = np.where(ok, code.code, -1).astype(np.int32)
+    sub = np.where(ok[::4], fs.phi[::4] + TWO_PI * code.code[::4], np.nan)
+    slope = np.nanmedian(np.diff(sub, axis=1)) if ok.sum() > 100 else 0.0
     if slope < 0:
         info["warnings"] = ["the projector coordinate falls along the image's coded axis: "
                             "if the projector is not mirrored, is shift_sign "
                             f"{-spec.shift_sign:+d}?"]
-    return Orders(abs_phase, info)
+    return Orders(order, info)
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:

@@ -15,7 +15,7 @@ Forms:
     Frames ``shift-n``, ``code-n``.
 
 Strategies: ``region`` (default) votes the code over each fringe region and checks orders
-step by one across wraps (:func:`bistair.core.resolve.phase_from_regions`); ``pixel`` is the
+step by one across wraps (:func:`bistair.core.resolve.orders_from_regions`); ``pixel`` is the
 classic per-pixel ``k = code``, which misorders pixels where the code and the wrapped phase
 change together.
 
@@ -39,9 +39,9 @@ import numpy as np
 
 from ..core.captures import Prepared
 from ..core.measure import FringeSet
-from ..core.phase import TWO_PI, shifts_of, wrapped_phase
+from ..core.phase import shifts_of, wrapped_phase
 from ..core.regions import core_weight, fringe_regions
-from ..core.resolve import code_evidence, phase_from_regions
+from ..core.resolve import code_evidence, orders_from_regions
 from ..core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
@@ -106,7 +106,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
     codes = code.code
     info = {"strategy": strategy, "noise": fs.noise, "levels": spec.levels}
     if strategy == "pixel":
-        return Orders(np.where(codes >= 0, fs.phi + TWO_PI * codes, np.nan), info)
+        return Orders(codes, info)
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     weight = core_weight(fs.phi)
 
@@ -118,7 +118,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
         off = np.abs(codes - k) % spec.levels
         return (np.minimum(off, spec.levels - off) <= 1) | (codes < 0)
 
-    return Orders(phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info), info)
+    return Orders(orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info),
+                  info)
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:

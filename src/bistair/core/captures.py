@@ -9,7 +9,7 @@ Examples
 >>> import numpy as np
 >>> stack = np.full((4, 8, 8), 200, np.uint8)
 >>> prepared = prepare(stack, frame_count=4, method="test")
->>> prepared.full_scale, prepared.frames.dtype, bool(prepared.clipped.any())
+>>> prepared.full_scale, prepared.frames[0].dtype, bool(prepared.clipped.any())
 (255.0, dtype('float32'), False)
 """
 
@@ -17,28 +17,102 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from ..errors import BistairError
 
 
+class ScaledStack:
+    """A capture stack read as fractions of full scale: indexing returns float32 arrays
+    (``raw[key] * scale``), so only the frames a step asks for are converted.
+
+    >>> s = ScaledStack(np.full((2, 3, 4), 51, np.uint8), 1 / 255)
+    >>> s.shape, s[1].dtype, round(float(s[0, 0, 0]), 6)
+    ((2, 3, 4), dtype('float32'), 0.2)
+    """
+
+    def __init__(self, raw: np.ndarray, scale: float) -> None:
+        self.raw = raw
+        self.scale = np.float32(scale)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return self.raw.shape
+
+    def __len__(self) -> int:
+        return self.raw.shape[0]
+
+    def __getitem__(self, key: Any) -> np.ndarray:
+        return np.multiply(self.raw[key], self.scale, dtype=np.float32)
+
+    def __array__(self, dtype: Any = None, copy: Any = None) -> np.ndarray:
+        out = self[...]
+        return out if dtype is None else out.astype(dtype)
+
+
 @dataclass(frozen=True)
 class Prepared:
-    """A capture stack scaled so that full scale is 1.0."""
+    """A capture stack ready for decoding: the method's frames in its order (``raw``, the
+    capture's own dtype), read as fractions of full scale through ``frames``."""
 
-    frames: np.ndarray  # (F, H, W) float32 in [0, 1]
+    raw: np.ndarray  # (F, H, W) the method's frames, any dtype
     clipped: np.ndarray  # (H, W) bool: some frame at full scale
     full_scale: float  # the input value that maps to 1.0
     white: np.ndarray | None = None  # (H, W) the fully lit frame, if the capture has one
     black: np.ndarray | None = None  # (H, W) the dark frame, if the capture has one
 
+    @property
+    def scale(self) -> np.float32:
+        """Multiply a raw value by this for its fraction of full scale."""
+        return np.float32(1.0 / self.full_scale)
+
+    @property
+    def frames(self) -> ScaledStack:
+        """The frames as float32 fractions of full scale (converted when indexed)."""
+        return ScaledStack(self.raw, 1.0 / self.full_scale)
+
+    def transposed(self) -> Prepared:
+        """The same captures with image axes swapped (for the rows orientation)."""
+        return Prepared(np.ascontiguousarray(self.raw.transpose(0, 2, 1)),
+                        np.ascontiguousarray(self.clipped.T), self.full_scale,
+                        *(None if a is None else np.ascontiguousarray(a.T)
+                          for a in (self.white, self.black)))
+
 
 def full_scale_of(stack: np.ndarray) -> float:
-    """Full-scale value of a stack: its dtype's range, or the smallest common range above it."""
+    """Full-scale value of a stack: its dtype's range, or the smallest common range above it.
+
+    A 10-, 12- or 14-bit camera's data stored MSB-aligned in 16-bit containers (values that
+    are all multiples of ``2**z``, the top above 16383) saturates at ``65536 - 2**z``, not at
+    65535: its full scale is detected from the bits that are never set.
+
+    Parameters
+    ----------
+    stack : numeric array of any shape.
+
+    Returns
+    -------
+    float
+        255 for ``uint8``; for other integers and for floats above 1 the smallest of
+        255, 1023, 4095, 16383 and 65535 at or above the maximum (or the MSB-aligned full
+        scale above), the maximum itself beyond that; 1 for floats within [0, 1].
+
+    Examples
+    --------
+    >>> full_scale_of(np.array([0, 4095], np.uint16)), full_scale_of(np.array([0.2, 0.9]))
+    (4095.0, 1.0)
+    >>> full_scale_of(np.array([0, 16, 65520], np.uint16))  # 12 bits, MSB-aligned
+    65520.0
+    """
     if stack.dtype == np.uint8:
         return 255.0
     top = float(np.nanmax(stack)) if stack.size else 0.0
+    if stack.dtype == np.uint16 and top > 16383:
+        used_bits = int(np.bitwise_or.reduce(stack, axis=None))
+        zeros = (used_bits & -used_bits).bit_length() - 1
+        return 65536.0 - 2**zeros if 2 <= zeros <= 8 else 65535.0
     if np.issubdtype(stack.dtype, np.integer) or top > 1.0:
         for scale in (255.0, 1023.0, 4095.0, 16383.0, 65535.0):
             if top <= scale:
@@ -102,16 +176,15 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
     lit = [stack[i][None] for i in (white, black) if i is not None]
     scale = max(full_scale_of(a) for a in (used, *lit))
     if np.issubdtype(stack.dtype, np.integer):
-        clipped = (used >= scale).any(axis=0)
+        clipped = used.max(axis=0) >= scale
     else:
         if not np.isfinite(stack).all():
             raise BistairError("captures contain NaN or infinite values")
-        clipped = (used >= scale * (1.0 - 1e-6)).any(axis=0)
+        clipped = used.max(axis=0) >= scale * (1.0 - 1e-6)
     factor = np.float32(1.0 / scale)
-    frames = np.multiply(used, factor, dtype=np.float32)
     extra = [None if i is None else np.multiply(stack[i], factor, dtype=np.float32)
              for i in (white, black)]
-    return Prepared(frames, clipped, scale, *extra)
+    return Prepared(used, clipped, scale, *extra)
 
 
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:

@@ -137,7 +137,7 @@ def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str) -> str | 
     >>> axis_problem(phi, ok, "columns") is None, axis_problem(phi.T, ok.T, "columns")[:34]
     (True, 'the phase changes down the image (')
     """
-    sub = (slice(None, None, 2), slice(None, None, 2))
+    sub = (slice(None, None, 4), slice(None, None, 2))
     p, v = phi[sub], valid[sub]
     along = np.abs(wrap(np.diff(p, axis=1)))[v[:, 1:] & v[:, :-1]]
     across = np.abs(wrap(np.diff(p, axis=0)))[v[1:] & v[:-1]]
@@ -190,7 +190,7 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     >>> round(stair_misfit(np.array([[0.1, 1.0, -2.0]]), np.ones((1, 3), bool), lv), 2)
     0.1
     """
-    t = theta[valid][:: max(1, int(valid.sum()) // 200000)].astype(np.float64)
+    t = theta[::4, ::4][valid[::4, ::4]][:20000].astype(np.float64)  # plenty for a median
     if t.size == 0:
         return 0.0
     gap = (np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * 9).min(axis=1)

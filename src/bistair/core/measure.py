@@ -24,12 +24,14 @@ from scipy import stats
 
 from .captures import (
     Prepared,
+    ScaledStack,
     check_decodable,
     modulation_threshold,
     saturation,
     validity,
 )
-from .phase import residuals, wrapped_phase
+from .kernels import keep_coherent, nstep_sums
+from .phase import phase_of_sums, residuals, shifts_of
 from .regions import fringe_regions
 
 
@@ -126,8 +128,14 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
 
     With ``check``, captures with (almost) no valid pixel are refused as dark or saturated.
     """
-    frames = prepared.frames[start:start + steps]
-    phi, avg, mod = wrapped_phase(frames, shift_sign, phase_offset)
+    shifts = shifts_of(steps, shift_sign)
+    raw = prepared.raw if prepared.raw.flags.c_contiguous else np.ascontiguousarray(prepared.raw)
+    num, den, avg = nstep_sums(raw, start, steps, float(prepared.scale),
+                               np.sin(shifts).astype(np.float32),
+                               np.cos(shifts).astype(np.float32))
+    phi, mod = phase_of_sums(num, den, steps, phase_offset)
+    del num, den
+    frames = ScaledStack(prepared.raw[start:start + steps], float(prepared.scale))
     noise = noise_level(frames, phi, avg, mod, shift_sign, phase_offset)
     threshold = modulation_threshold(noise, min_modulation)
     saturated = saturation(prepared.clipped, avg, mod)
@@ -154,8 +162,4 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     whose phase runs on smoothly with a region's is part of a lit surface.
     """
     labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
-    size = np.bincount(labels.ravel(), minlength=n + 1)
-    bright = np.bincount(labels.ravel(), weights=strong.ravel(), minlength=n + 1)
-    keep = (bright >= min_strong) | (size >= min_size)
-    keep[0] = False
-    return strong | (weak & keep[labels])
+    return keep_coherent(labels, weak, strong, n, min_strong, min_size)

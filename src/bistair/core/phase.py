@@ -72,14 +72,23 @@ def wrapped_phase(frames: np.ndarray, shift_sign: int = 1, phase_offset: float =
     shifts = shifts_of(steps, shift_sign)
     num = -np.tensordot(np.sin(shifts).astype(np.float32), stack, axes=1)
     den = np.tensordot(np.cos(shifts).astype(np.float32), stack, axes=1)
+    phi, mod = phase_of_sums(num, den, steps, phase_offset)
+    avg = stack.mean(axis=0)
+    return phi, avg.astype(np.float32), mod
+
+
+def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: float = 0.0
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The wrapped phase in ``[0, 2*pi)`` and the modulation of an N-step set from its sums
+    ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32)."""
     phi = np.arctan2(num, den)
     if phase_offset:
         phi = (phi - np.float32(phase_offset)) % np.float32(TWO_PI)
-    phi = np.where(phi < 0, phi + np.float32(TWO_PI), phi)
+    np.add(phi, np.float32(TWO_PI), out=phi, where=phi < 0)
     phi[phi >= np.float32(TWO_PI)] = 0.0  # float32 rounding of tiny negatives
-    mod = np.hypot(num, den) * np.float32(2.0 / steps)
-    avg = stack.mean(axis=0)
-    return phi.astype(np.float32), avg.astype(np.float32), mod.astype(np.float32)
+    mod = np.hypot(num, den)
+    mod *= np.float32(2.0 / steps)
+    return phi.astype(np.float32, copy=False), mod.astype(np.float32, copy=False)
 
 
 def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,

@@ -22,9 +22,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
-from scipy import ndimage
 
+from .kernels import fringe_links, period_jump_links, reattach, wrap_links
 from .phase import TWO_PI, order_from_reference
 
 
@@ -173,52 +174,21 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     valid = np.asarray(valid, dtype=bool)
     if cut is None:
         cut = default_cut(phi, valid)
-    if phase_noise is None:
-        sigma = np.full((phi.shape[0], phi.shape[1] - 1), 0.02 * np.sqrt(2.0))
-    else:  # noise of the difference of two neighbours
-        sigma = np.sqrt(2.0) * np.maximum(phase_noise[:, :-1], phase_noise[:, 1:])
+    h, w = phi.shape
+    noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
+             else np.ascontiguousarray(phase_noise, dtype=np.float32))
     sign = fringe_direction(phi, valid)
-    jump_v, jump_h = period_jumps(phi, valid, 0.02 if phase_noise is None else phase_noise)
+    jump_v, jump_h = period_jump_links(phi, valid, noise, 3, 0.3)
     if boundaries is not None:
         jump_v, jump_h = jump_v | boundaries[0], jump_h | boundaries[1]
-    vert, drop_up, drop_down = _link_cuts(phi[:-1], phi[1:], valid[:-1], valid[1:], cut)
-    drop_up |= jump_v & vert
-    drop_down |= jump_v & vert
-    vert &= ~jump_v
-    if sign > 0:
-        horiz, drop_left, drop_right = _link_cuts(phi[:, :-1], phi[:, 1:], valid[:, :-1],
-                                                  valid[:, 1:], cut, sigma)
-    else:  # walk the rows the other way
-        horiz, drop_right, drop_left = _link_cuts(phi[:, 1:], phi[:, :-1], valid[:, 1:],
-                                                  valid[:, :-1], cut, sigma[:, ::-1])
-        horiz, drop_right, drop_left = horiz[:, ::-1], drop_right[:, ::-1], drop_left[:, ::-1]
-    drop_left |= jump_h & horiz
-    drop_right |= jump_h & horiz
-    horiz &= ~jump_h
-    keep = valid.copy()
-    keep[:-1] &= ~drop_up
-    keep[1:] &= ~drop_down
-    keep[:, :-1] &= ~drop_left
-    keep[:, 1:] &= ~drop_right
-    labels, n = ndimage.label(keep)
-    labels = labels.astype(np.int32)
+    vert, horiz, keep = fringe_links(phi, valid, float(np.float32(cut)), sign, noise,
+                                     jump_v, jump_h)
+    n, labels = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
+                                        ltype=cv2.CV_32S)
+    n -= 1
     # Reattach the removed pixels through links that are not cut (a few passes, on the
     # removed pixels only: they are thin lines along the wraps).
-    h, w = labels.shape
-    ty, tx = np.nonzero(valid & ~keep)
-    for _ in range(3):
-        if ty.size == 0:
-            break
-        got = np.zeros(ty.size, np.int32)
-        for dy, dx, link in ((1, 0, vert), (-1, 0, vert), (0, 1, horiz), (0, -1, horiz)):
-            ny, nx = ty + dy, tx + dx
-            inside = (ny >= 0) & (ny < h) & (nx >= 0) & (nx < w)
-            ly, lx = np.minimum(ty, ny), np.minimum(tx, nx)  # the link's own index
-            ok = inside & (got == 0)
-            ok[ok] = link[ly[ok], lx[ok]]
-            got[ok] = labels[ny[ok], nx[ok]]
-        labels[ty, tx] = got
-        ty, tx = ty[got == 0], tx[got == 0]
+    reattach(labels, valid, keep, vert, horiz, 3)
     sizes = np.bincount(labels.ravel(), minlength=n + 1)
     small = sizes < min_size
     small[0] = False
@@ -265,17 +235,7 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     (``src`` before ``dst``). ``direction`` is :func:`fringe_direction`, computed if not given.
     """
     sign = fringe_direction(phi, labels > 0) if direction is None else direction
-    src, dst, step = [], [], []
-    for a, b, la, lb, along in ((phi[:-1], phi[1:], labels[:-1], labels[1:], False),
-                                (phi[:, :-1], phi[:, 1:], labels[:, :-1], labels[:, 1:], True)):
-        sel = (la != lb) & (la > 0) & (lb > 0)
-        sel[sel] = np.abs(b[sel] - a[sel]) > np.pi
-        st = np.where(a[sel] > b[sel], 1, -1)
-        keep = st == sign if along else np.ones(st.size, bool)
-        src.append(la[sel][keep])
-        dst.append(lb[sel][keep])
-        step.append(st[keep])
-    s, d, st = (np.concatenate(v).astype(np.int64) for v in (src, dst, step))
+    s, d, st = wrap_links(phi, labels, sign)
     if s.size == 0:
         empty = np.zeros(0, np.int64)
         return RegionLinks(empty, empty, empty, empty)
@@ -284,15 +244,15 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     return RegionLinks(key // 2 // n, key // 2 % n, np.where(key % 2 == 1, 1, -1), count)
 
 
-def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndarray,
-                         max_distance: float = 3.0) -> np.ndarray:
-    """Absolute phase for ``target`` pixels from the nearest pixel that has one.
-
-    The fringe order is ``round((Phi_near - phi) / 2pi)``; target pixels farther than
-    ``max_distance`` from any absolute phase stay NaN.
+def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
+                max_distance: float = 3.0) -> np.ndarray:
+    """Fringe orders for ``target`` pixels without one (``order < 0``) from the nearest
+    pixel that has one: the order that brings the pixel's phase nearest that pixel's
+    absolute phase, ``round((phi_near + 2 pi k_near - phi) / 2pi)``. Target pixels farther
+    than ``max_distance`` from any order keep -1. Returns a new int32 array.
     """
-    out = abs_phase.copy()
-    ty, tx = np.nonzero(target & ~np.isfinite(abs_phase))
+    out = np.array(order, dtype=np.int32)
+    ty, tx = np.nonzero(target & (out < 0))
     if ty.size == 0:
         return out
     r = int(np.floor(max_distance))
@@ -301,15 +261,15 @@ def fill_from_neighbours(phi: np.ndarray, abs_phase: np.ndarray, target: np.ndar
     near = np.argsort(dist, kind="stable")
     near = near[(dist[near] > 0) & (dist[near] <= max_distance)]
     dy, dx = dy.ravel()[near], dx.ravel()[near]
-    h, w = abs_phase.shape
+    h, w = out.shape
     yy = np.clip(ty[:, None] + dy[None, :], 0, h - 1)
     xx = np.clip(tx[:, None] + dx[None, :], 0, w - 1)
-    cand = abs_phase[yy, xx]  # (targets, offsets), nearest offsets first
-    found = np.isfinite(cand)
+    cand = order[yy, xx]  # (targets, offsets), nearest offsets first
+    found = cand >= 0
     first = found.argmax(axis=1)
     has = found.any(axis=1)
-    ref = cand[np.arange(ty.size), first][has]
+    pick_y, pick_x = yy[np.arange(ty.size), first][has], xx[np.arange(ty.size), first][has]
+    ref = phi[pick_y, pick_x] + TWO_PI * order[pick_y, pick_x]  # absolute phase, float64
     sel_y, sel_x = ty[has], tx[has]
-    k = order_from_reference(phi[sel_y, sel_x], ref)
-    out[sel_y, sel_x] = phi[sel_y, sel_x] + TWO_PI * k
+    out[sel_y, sel_x] = order_from_reference(phi[sel_y, sel_x], ref)
     return out

@@ -19,11 +19,11 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+import cv2
 import numpy as np
 from scipy import ndimage
 
-from .phase import TWO_PI
-from .regions import RegionLinks, fill_from_neighbours, fringe_direction, region_links
+from .regions import RegionLinks, fill_orders, fringe_direction, region_links
 
 
 def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
@@ -96,11 +96,12 @@ Evidence = Callable[[np.ndarray, int], tuple[np.ndarray, int, np.ndarray]]
 Agreement = Callable[[np.ndarray], np.ndarray]
 
 
-def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
-                       evidence_of: Evidence, agrees: Agreement | None = None,
-                       info: dict | None = None, min_score: float = 0.45,
-                       min_margin: float = 0.1) -> np.ndarray:
-    """Absolute phase from fringe regions and each region's evidence for every order.
+def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
+                        evidence_of: Evidence, agrees: Agreement | None = None,
+                        info: dict | None = None, min_score: float = 0.45,
+                        min_margin: float = 0.1) -> np.ndarray:
+    """Fringe orders (int32, -1 where undecided) from fringe regions and each region's
+    evidence for every order.
 
     ``evidence_of(labels, n)`` returns ``(labels, n, evidence)``, the codec's evidence for
     every order per region (it may refine the labels). Regions are resolved with their wrap
@@ -127,9 +128,8 @@ def phase_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
         bad, total = jump_violations(links, k_reg)
         info.update(regions=n, regions_decoded=int((k_reg[1:] >= 0).sum()),
                     regions_detached=detached, jump_violations=bad, jump_links=total)
-    k_pix = k_reg[labels]
-    abs_phase = np.where(k_pix >= 0, phi + TWO_PI * k_pix, np.nan)
-    return fill_from_neighbours(phi, abs_phase, valid & (labels == 0), max_distance=3.0)
+    return fill_orders(phi, k_reg.astype(np.int32)[labels], valid & (labels == 0),
+                       max_distance=3.0)
 
 
 def _decide(evidence: np.ndarray, links: RegionLinks, min_score: float,
@@ -158,13 +158,25 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     bad = decided & ~agrees(k_pix)
     if not _dense_somewhere(bad, decided, share):
         return labels, n, 0
-    num = ndimage.uniform_filter(bad.astype(np.float32), window)
-    den = ndimage.uniform_filter(decided.astype(np.float32), window)
-    seeds = bad & (num > share * den)
+    # the window means only matter at bad pixels: filter their bounding box, with a margin
+    # the window cannot see past (the filters' running sums are exact for 0/1 images)
+    ys, xs = np.nonzero(bad)
+    m = 2 * window
+    box = (slice(max(ys.min() - m, 0), ys.max() + m + 1),
+           slice(max(xs.min() - m, 0), xs.max() + m + 1))
+    num = ndimage.uniform_filter(bad[box].astype(np.float32), window)
+    den = ndimage.uniform_filter(decided[box].astype(np.float32), window)
+    seeds = np.zeros(bad.shape, bool)
+    seeds[box] = bad[box] & (num > share * den)
     if not seeds.any():
         return labels, n, 0
-    grown = ndimage.binary_propagation(seeds, mask=bad)
-    parts, m = ndimage.label(grown)
+    _, parts = cv2.connectedComponents(bad.view(np.uint8), connectivity=4, ltype=cv2.CV_32S)
+    seeded = np.zeros(int(parts.max()) + 1, bool)
+    seeded[parts[seeds]] = True
+    seeded[0] = False
+    grown = seeded[parts]  # the bad pixels connected to a seed
+    _, parts = cv2.connectedComponents(grown.view(np.uint8), connectivity=4,
+                                       ltype=cv2.CV_32S)
     key = parts.astype(np.int64) * (n + 1) + labels
     uniq, inv, size = np.unique(key[grown], return_inverse=True, return_counts=True)
     new = np.where(size >= min_size, n + 1 + np.cumsum(size >= min_size) - 1, 0)

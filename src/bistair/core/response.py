@@ -12,11 +12,11 @@ patterns pre-compensate with (``spec.gamma``: each pattern value ``p`` is sent a
 Examples
 --------
 >>> levels = np.linspace(0.0, 1.0, 9)
->>> albedo = np.linspace(0.3, 0.9, 64).reshape(8, 8)
+>>> albedo = np.linspace(0.3, 0.9, 256).reshape(16, 16)
 >>> frames = 0.05 + 0.8 * albedo[None] * (levels[:, None, None] ** 2.2)
 >>> fit = estimate_response(frames, levels)
 >>> round(fit.gamma, 3), fit.pixels
-(2.2, 64)
+(2.2, 256)
 """
 
 from __future__ import annotations

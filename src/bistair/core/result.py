@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from .measure import FringeSet
-from .phase import TWO_PI, order_from_reference
+from .phase import TWO_PI
 
 
 @dataclass
@@ -151,13 +151,11 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
     )
 
 
-def result_from_phase(method: str, fs: FringeSet, abs_phase: np.ndarray, period: float,
-                      code: np.ndarray | None = None, info: dict[str, Any] | None = None,
-                      length: float | None = None) -> DecodeResult:
-    """A result from a measured fringe set and its absolute phase (NaN = invalid); with
+def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: float,
+                       code: np.ndarray | None = None, info: dict[str, Any] | None = None,
+                       length: float | None = None) -> DecodeResult:
+    """A result from a measured fringe set and its fringe orders (-1 = invalid); with
     ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`)."""
-    order = order_from_reference(fs.phi, abs_phase)
-    order[~np.isfinite(order)] = -1
     return make_result(method, fs.phi, order, period, fs.mod, fs.avg,
                        code=code, wrapped=np.where(fs.valid, fs.phi, np.float32(np.nan)),
                        info=info, length=length)

@@ -269,7 +269,7 @@ TEMP_PREFIX = ".bistair-"  # the names of every temporary beside an output
 
 
 @contextlib.contextmanager
-def output_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
+def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
     """Yield a temporary folder; on success its files are moved into ``out`` (created if
     needed, other files in it left alone); on any error nothing reaches ``out``.
 
@@ -282,7 +282,8 @@ def output_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
     parent = out if out.exists() else out.parent
     try:
         parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=prefix, dir=parent))
+        remove_stale(parent)
+        tmp = Path(tempfile.mkdtemp(prefix=prefix or _prefix(), dir=parent))
         tmp.chmod(0o777 & ~_umask())  # mkdtemp makes it private; outputs are not
     except OSError as exc:
         raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
@@ -379,13 +380,15 @@ def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Pa
 
 
 @contextlib.contextmanager
-def output_file(path: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
+def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
     """Yield a temporary file path beside ``path`` (named ``prefix`` + random letters); it
     replaces ``path`` only on success."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        fd, name = tempfile.mkstemp(prefix=prefix, suffix=path.suffix, dir=path.parent)
+        remove_stale(path.parent)
+        fd, name = tempfile.mkstemp(prefix=prefix or _prefix(), suffix=path.suffix,
+                                    dir=path.parent)
         os.close(fd)
     except OSError as exc:
         raise BistairError(f"cannot write {path}: {exc.strerror}") from None
@@ -398,6 +401,44 @@ def output_file(path: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
         raise BistairError(f"cannot write {path}: {exc.strerror}") from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _prefix() -> str:
+    """Temporary outputs are named ``.bistair-<pid>-...``: whose they are stays known."""
+    return f".bistair-{os.getpid()}-"
+
+
+def remove_stale(folder: str | Path) -> int:
+    """Remove temporary outputs (``.bistair-<pid>-*``) in ``folder`` left by processes that
+    no longer run (killed while writing); returns how many were removed.
+
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (pathlib.Path(tmp) / ".bistair-999999999-x").mkdir()
+    ...     remove_stale(tmp), list(pathlib.Path(tmp).iterdir())
+    (1, [])
+    """
+    removed = 0
+    for item in Path(folder).glob(".bistair-*-*"):
+        pid = item.name.split("-")[1]
+        if not pid.isdigit() or _running(int(pid)):
+            continue
+        if item.is_dir() and not item.is_symlink():
+            shutil.rmtree(item, ignore_errors=True)
+        else:
+            item.unlink(missing_ok=True)
+        removed += 1
+    return removed
+
+
+def _running(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return pid < 2**22  # someone else's process, or no process at all
+    return True
 
 
 def _umask() -> int:

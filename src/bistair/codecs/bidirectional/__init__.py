@@ -46,11 +46,12 @@ from scipy import ndimage
 
 from ...core.captures import Prepared
 from ...core.checks import stair_misfit
+from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI
 from ...core.regions import core_weight, fringe_regions
-from ...core.resolve import phase_from_regions
-from ...core.stair import quantize, stair_level_phase, stair_pair, stair_phase
+from ...core.resolve import orders_from_regions
+from ...core.stair import stair_level_phase, stair_pair, stair_phase
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
@@ -63,6 +64,7 @@ from .bands import (
     row_profiles,
     row_runs,
     split_regions,
+    stair_values,
     union_levels,
 )
 from .paper import paper_orders
@@ -139,7 +141,7 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     on the valid pixels."""
     frames = prepared.frames
     theta, stair_mod = stair_phase(frames[spec.steps], frames[spec.steps + 1], fs.avg)
-    ks = np.where(fs.valid, quantize(theta, spec.stairs), -1).astype(np.int32)
+    ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
         raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
                            "between the levels of the code: are stair-cos and stair-sin "
@@ -156,10 +158,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
     if strategy == "paper":
         order = paper_orders(ks, theta, fs, spec)
-        abs_phase = np.where(order >= 0, fs.phi + TWO_PI * order, np.nan)
+        order = order.astype(np.int32)
     else:
-        abs_phase = _region_phase(fs, theta, code.maps["stair_modulation"], ks, spec, info)
-    return Orders(abs_phase, info)
+        order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
+    return Orders(order, info)
 
 
 def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
@@ -176,28 +178,24 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     down across the partition bands between them.
     """
     h, w = phi.shape
-    step = TWO_PI / stairs
-    z = np.exp(1j * theta.astype(np.float32)) * valid
-    left = z[:, :-3] + z[:, 1:-2]
-    right = z[:, 2:-1] + z[:, 3:]
-    turn = np.abs(np.angle(right * np.conj(left)))
-    spread = np.sqrt(np.maximum(noise[:, :-3], noise[:, 3:]) ** 2
-                     + np.maximum(noise[:, 1:-2], noise[:, 2:-1]) ** 2)
-    mid = phi[:, 1:-2]
-    inside = (mid > 0.15 * TWO_PI) & (mid < 0.85 * TWO_PI)
-    ok = valid[:, :-3] & valid[:, 1:-2] & valid[:, 2:-1] & valid[:, 3:] & inside
-    edge = np.zeros((h, w - 1), bool)
-    edge[:, 1:-1] = ok & (turn > np.maximum(0.75 * step, 4.0 * spread))
-    if not edge.any():
+    edge = stair_turns(phi, np.cos(theta), np.sin(theta), valid,
+                       np.ascontiguousarray(noise, dtype=np.float32), TWO_PI / stairs)
+    ys, xs = np.nonzero(edge)
+    if ys.size == 0:
         return np.zeros((h - 1, w), bool), edge
-    wide = ndimage.binary_dilation(edge, np.ones((1, 3), bool))
-    edge &= ndimage.binary_opening(wide, np.ones((4, 1), bool))  # four rows on end
-    if reach > 0 and edge.any():
-        edge = ndimage.binary_dilation(edge, np.ones((2 * reach + 1, 1), bool))
+    # morphology on the edges' bounding box (with margins the structures cannot reach past)
+    y0, y1 = max(ys.min() - reach - 8, 0), min(ys.max() + reach + 9, h)
+    x0, x1 = max(xs.min() - 4, 0), min(xs.max() + 5, w - 1)
+    box = edge[y0:y1, x0:x1]
+    wide = ndimage.binary_dilation(box, np.ones((1, 3), bool))
+    box &= ndimage.binary_opening(wide, np.ones((4, 1), bool))  # four rows on end
+    if reach > 0 and box.any():
+        box = ndimage.binary_dilation(box, np.ones((2 * reach + 1, 1), bool))
+    edge[y0:y1, x0:x1] = box
     return np.zeros((h - 1, w), bool), edge
 
 
-def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
+def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
                   spec: BidirectionalSpec, info: dict) -> np.ndarray:
     # stair phase noise: the pair's two frames against the fringes' average
     noise = fs.noise * np.sqrt(2.0) / np.maximum(stair_mod, 1e-6)
@@ -207,14 +205,16 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
     weight = core_weight(fs.phi) * np.minimum(ratio, 1.0)
     levels = union_levels(spec.partitions, spec.stairs)
 
+    values = stair_values(theta, weight, ratio)
+
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        prof = row_profiles(labels, theta, weight, ratio)
+        prof = row_profiles(labels, values)
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = band_splits(runs, heights, spec.local_rows / spec.group_rows)
         if splits:  # surfaces stacked in one fringe region: decode them apart
             labels, n = split_regions(labels, n, splits)
-            prof = row_profiles(labels, theta, weight, ratio)
+            prof = row_profiles(labels, values)
             runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
@@ -224,13 +224,13 @@ def _region_phase(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: n
                     group_height=default)
         return labels, n, region_evidence(runs, n, heights, layout)
 
-    q_part = quantize(theta, spec.partitions)
+    q_part = quantize32(theta, spec.partitions, np.ones(theta.shape, bool))
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """A pixel reads its order's local or partition level (its row decides which)."""
         return (ks == k % spec.stairs) | (q_part == k // spec.stairs)
 
-    return phase_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
+    return orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
 
 
 def stairs_for(fringes: int) -> tuple[int, int]:

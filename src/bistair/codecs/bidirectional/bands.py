@@ -18,6 +18,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ...core.kernels import label_row_sums
 from ...core.phase import TWO_PI, wrap
 from ...core.stair import level_misfit, quantize, stair_level_phase
 
@@ -78,29 +79,27 @@ class RowProfiles:
     col_sum: np.ndarray  # sum of the pixels' column indices
 
 
-def row_profiles(labels: np.ndarray, theta: np.ndarray, weight: np.ndarray,
-                 ratio: np.ndarray) -> RowProfiles:
-    """Sum each region's pixels row by row (sorted by region, then row).
+def stair_values(theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray) -> np.ndarray:
+    """The per-pixel values :func:`row_profiles` sums: ``weight*cos(theta)``,
+    ``weight*sin(theta)``, ``weight``, ``ratio`` and the column index, (5, H, W) float32."""
+    h, w = theta.shape
+    out = np.empty((5, h, w), np.float32)
+    np.multiply(weight, np.cos(theta), out=out[0])
+    np.multiply(weight, np.sin(theta), out=out[1])
+    out[2] = weight
+    out[3] = ratio
+    out[4] = np.arange(w, dtype=np.float32)
+    return out
 
-    Dense bincounts over ``region * height + row`` while that table stays small, else a sort.
-    """
-    h, w = labels.shape
-    values = [weight * np.cos(theta), weight * np.sin(theta), weight, ratio,
-              np.broadcast_to(np.arange(w, dtype=np.float32), (h, w))]
-    n_bins = (int(labels.max()) + 1) * h
-    key = (labels.astype(np.int64) * h + np.arange(h)[:, None]).ravel()
-    if n_bins <= 4 * labels.size:
-        count = np.bincount(key, minlength=n_bins)
-        used = np.flatnonzero(count)
-        used = used[used >= h]  # region 0 is no region
-        count = count[used]
-        sums = [np.bincount(key, v.ravel(), minlength=n_bins)[used] for v in values]
-    else:
-        sel = labels.ravel() > 0
-        used, inv, count = np.unique(key[sel], return_inverse=True, return_counts=True)
-        sums = [np.bincount(inv, v.ravel()[sel], minlength=used.size) for v in values]
+
+def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
+    """Sum each region's pixels row by row (sorted by region, then row); ``values`` from
+    :func:`stair_values`."""
+    h = labels.shape[0]
+    keys, count, sums = label_row_sums(labels, values, int(labels.max()))
     c, s, wsum, rsum, cols = sums
-    return RowProfiles(used // h, used % h, c, s, wsum, rsum / np.maximum(count, 1), count, cols)
+    return RowProfiles(keys // h, keys % h, c, s, wsum, rsum / np.maximum(count, 1), count,
+                       cols)
 
 
 def _region_percentile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndarray:

@@ -1,0 +1,491 @@
+"""Compiled loops for the per-pixel and per-link work NumPy cannot express in one pass.
+
+Every kernel here is written in plain Python over arrays and compiled with numba on its
+first call (``cache=True``: once per machine, kept in ``__pycache__``); numba itself is
+imported only then, so importing bistair or starting the command line does not pay for it.
+Kernels that loop over image rows run them on every core (``prange``); :func:`set_threads`
+limits that.
+
+Examples
+--------
+>>> import numpy as np
+>>> x = np.arange(40, dtype=np.float32)
+>>> phi = np.tile(np.where(x < 20, 0.2 * x, 0.6 * x) % np.float32(2 * np.pi), (6, 1))
+>>> vert, horiz = period_jump_links(phi, np.ones(phi.shape, bool),
+...                                 np.full(phi.shape, 0.01, np.float32), 3, 0.3)
+>>> np.flatnonzero(horiz[0]).tolist(), bool(vert.any())
+([16, 17, 18, 19, 21, 22], False)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from functools import wraps
+from typing import Any
+
+import numpy as np
+
+prange = range  # numba's prange once the first kernel compiles
+_COMPILED: dict[str, Any] = {}
+
+
+def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
+    """Compile the decorated function with ``numba.njit`` on its first call."""
+
+    def wrap(fn: Callable) -> Callable:
+        @wraps(fn)
+        def call(*args: Any) -> Any:
+            compiled = _COMPILED.get(fn.__name__)
+            if compiled is None:
+                import numba  # heavy: imported when the first kernel runs
+
+                module = globals()
+                if module["prange"] is range:  # the first kernel: helpers compiled once
+                    module["prange"] = numba.prange
+                    for name, value in list(module.items()):
+                        if getattr(value, "_inline", False):
+                            module[name] = numba.njit(cache=True, inline="always")(value)
+                compiled = numba.njit(cache=True, parallel=parallel, fastmath=False,
+                                      error_model="numpy")(fn)
+                _COMPILED[fn.__name__] = compiled
+            return compiled(*args)
+
+        call.py_func = fn  # type: ignore[attr-defined]
+        return call
+
+    return wrap
+
+
+def set_threads(count: int | None) -> int:
+    """Use ``count`` threads in the kernels (all cores when ``None``); returns the count."""
+    import numba
+
+    count = count or os.cpu_count() or 1
+    numba.set_num_threads(max(1, min(int(count), numba.config.NUMBA_NUM_THREADS)))
+    return numba.get_num_threads()
+
+
+TWO_PI32 = np.float32(2.0 * math.pi)
+PI32 = np.float32(math.pi)
+
+
+def _numba_inline(fn: Callable) -> Callable:
+    """Mark a helper that the kernels call: compiled into them with ``numba.njit``."""
+    fn._inline = True  # type: ignore[attr-defined]
+    return fn
+
+
+@_numba_inline
+def _wrapped(raw: np.float32) -> np.float32:
+    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it, for ``|raw| < 2pi``."""
+    d = raw + PI32
+    if d >= TWO_PI32:
+        d = d - TWO_PI32
+    elif d < 0:
+        d = d + TWO_PI32
+    return d - PI32
+
+
+@_numba_inline
+def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np.float32,
+          qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
+          half: np.float32) -> bool:
+    """Whether two mean gradients differ by more than ``rel`` of the larger and four times
+    their noise (float32, as :func:`bistair.core.regions.period_jumps` computes it)."""
+    if pn < half or qn < half:
+        return False
+    one = np.float32(1.0)
+    spread = np.float32(2.0) * max(noise_p / np.float32(math.sqrt(max(pn, one))),
+                                   noise_q / np.float32(math.sqrt(max(qn, one))))
+    dx, dy = px - qx, py - qy
+    limit = np.float32(4.0) * spread
+    if dx * dx + dy * dy < limit * limit * np.float32(0.9999):
+        return False  # clearly below the noise: no square root needed
+    step = np.float32(math.hypot(dx, dy))
+    if not step > np.float32(4.0) * spread:
+        return False
+    size = max(np.float32(math.hypot(px, py)), np.float32(math.hypot(qx, qy)))
+    return step > rel * size
+
+
+@kernel(parallel=True)
+def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
+                      relative: float) -> tuple[np.ndarray, np.ndarray]:
+    """The links across which the fringes' spacing or slant jumps (see
+    :func:`bistair.core.regions.period_jumps`): ``(vertical (H-1, W), horizontal (H, W-1))``.
+
+    Gradients are wrapped phase differences along the row (``x``) and down the column
+    (``y``), averaged over windows of columns: ``[x-half, x+half)`` around a pixel (for the
+    vertical links), ``[x-half, x)`` and ``[x+1, x+1+half)`` either side of a horizontal
+    link. Float32 throughout, in the order of the NumPy formulation.
+    """
+    h, w = phi.shape
+    rel = np.float32(relative)
+    fhalf = np.float32(half)
+    one = np.float32(1.0)
+    ax = np.zeros((h, w), np.float32)
+    ay = np.zeros((h, w), np.float32)
+    an = np.zeros((h, w), np.float32)
+    horiz = np.zeros((h, w - 1), np.bool_)
+    vert = np.zeros((h - 1, w), np.bool_)
+    for y in prange(h):
+        sx = np.zeros(w + 1, np.float32)
+        cx = np.zeros(w + 1, np.float32)
+        sy = np.zeros(w + 1, np.float32)
+        cy = np.zeros(w + 1, np.float32)
+        for x in range(w):
+            gx = np.float32(0.0)
+            nx = np.float32(0.0)
+            if x < w - 1 and valid[y, x] and valid[y, x + 1]:
+                gx = _wrapped(phi[y, x + 1] - phi[y, x])
+                nx = one
+            gy = np.float32(0.0)
+            ny = np.float32(0.0)
+            if y < h - 1 and valid[y, x] and valid[y + 1, x]:
+                gy = _wrapped(phi[y + 1, x] - phi[y, x])
+                ny = one
+            sx[x + 1] = sx[x] + gx
+            cx[x + 1] = cx[x] + nx
+            sy[x + 1] = sy[x] + gy
+            cy[x + 1] = cy[x] + ny
+        for x in range(w):
+            lo = max(x - half, 0)
+            hi = min(x + half, w)
+            nxs = cx[hi] - cx[lo]
+            nys = cy[hi] - cy[lo]
+            ax[y, x] = (sx[hi] - sx[lo]) / max(nxs, one)
+            ay[y, x] = (sy[hi] - sy[lo]) / max(nys, one)
+            an[y, x] = min(nxs, nys)
+        for x in range(w - 1):
+            lo, hi = max(x - half, 0), x
+            n1 = cx[hi] - cx[lo]
+            m1 = cy[hi] - cy[lo]
+            px = (sx[hi] - sx[lo]) / max(n1, one)
+            py = (sy[hi] - sy[lo]) / max(m1, one)
+            pn = min(n1, m1)
+            lo, hi = x + 1, min(x + 1 + half, w)
+            n2 = cx[hi] - cx[lo]
+            m2 = cy[hi] - cy[lo]
+            qx = (sx[hi] - sx[lo]) / max(n2, one)
+            qy = (sy[hi] - sy[lo]) / max(m2, one)
+            qn = min(n2, m2)
+            horiz[y, x] = _jump(px, py, pn, qx, qy, qn, noise[y, x], noise[y, x + 1], rel,
+                                fhalf)
+    for y in prange(h - 1):
+        for x in range(w):
+            vert[y, x] = _jump(ax[y, x], ay[y, x], an[y, x], ax[y + 1, x], ay[y + 1, x],
+                               an[y + 1, x], noise[y, x], noise[y + 1, x], rel, fhalf)
+    return vert, horiz
+
+
+@kernel(parallel=True)
+def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
+                 noise: np.ndarray, jump_v: np.ndarray, jump_h: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The links of :func:`bistair.core.regions.fringe_regions`: ``(vertical links kept
+    (H-1, W), horizontal links kept (H, W-1), pixels kept (H, W))``.
+
+    A link between two valid pixels is cut at a wrap (its high-phase end is dropped), at a
+    step above ``cut`` or a cut given in ``jump_v``/``jump_h`` (both ends dropped), and,
+    along the rows, in a run of links against the phase's direction ``sign`` whose fall
+    exceeds ``max(0.15, 4 sigma)`` (``sigma``: ``sqrt(2)`` times the larger per-pixel phase
+    noise of a link, ``noise``; both ends dropped).
+    """
+    h, w = phi.shape
+    cut32 = np.float32(cut)
+    sqrt2 = math.sqrt(2.0)
+    vert = np.zeros((h - 1, w), np.bool_)
+    drop_up = np.zeros((h - 1, w), np.bool_)
+    drop_down = np.zeros((h - 1, w), np.bool_)
+    for y in prange(h - 1):
+        for x in range(w):
+            if not (valid[y, x] and valid[y + 1, x]):
+                continue
+            raw = phi[y + 1, x] - phi[y, x]
+            if abs(raw) > PI32:
+                if raw <= 0:
+                    drop_up[y, x] = True
+                else:
+                    drop_down[y, x] = True
+            elif abs(raw) > cut32 or jump_v[y, x]:
+                drop_up[y, x] = True
+                drop_down[y, x] = True
+            else:
+                vert[y, x] = True
+    horiz = np.zeros((h, w - 1), np.bool_)
+    keep = np.zeros((h, w), np.bool_)
+    for y in prange(h):
+        raw = np.zeros(w - 1, np.float32)
+        state = np.zeros(w - 1, np.int8)  # 0 none, 1 ok, 2 wrap high-a, 3 wrap high-b, 4 cut
+        for x in range(w - 1):
+            if not (valid[y, x] and valid[y, x + 1]):
+                continue
+            r = (phi[y, x + 1] - phi[y, x]) if sign > 0 else (phi[y, x] - phi[y, x + 1])
+            raw[x] = r
+            if abs(r) > PI32:
+                state[x] = 2 if r <= 0 else 3
+            elif abs(r) > cut32:
+                state[x] = 4
+            else:
+                state[x] = 1
+        x = 0
+        while x < w - 1:  # runs of ok links against the phase's direction
+            if not (state[x] == 1 and raw[x] < 0):
+                x += 1
+                continue
+            start = x
+            fall = 0.0
+            spread = 0.0
+            while x < w - 1 and state[x] == 1 and raw[x] < 0:
+                fall += -np.float64(raw[x])
+                spread = max(spread, sqrt2 * np.float64(max(noise[y, x], noise[y, x + 1])))
+                x += 1
+            if fall > max(0.15, 4.0 * spread):
+                for k in range(start, x):
+                    state[k] = 4
+        drop_lo = np.zeros(w, np.bool_)  # dropped by a link on the pixel's low-x side...
+        for x in range(w - 1):
+            s = state[x]
+            if s == 1 and jump_h[y, x]:
+                s = 4
+            if s == 1:
+                horiz[y, x] = True
+            elif s == 4:
+                drop_lo[x] = True
+                drop_lo[x + 1] = True
+            elif s == 2:  # raw <= 0: the first pixel along the walk is the high end
+                if sign > 0:
+                    drop_lo[x] = True
+                else:
+                    drop_lo[x + 1] = True
+            elif s == 3:
+                if sign > 0:
+                    drop_lo[x + 1] = True
+                else:
+                    drop_lo[x] = True
+        for x in range(w):
+            k = valid[y, x] and not drop_lo[x]
+            if y < h - 1 and drop_up[y, x]:
+                k = False
+            if y > 0 and drop_down[y - 1, x]:
+                k = False
+            keep[y, x] = k
+    return vert, horiz, keep
+
+
+@kernel()
+def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.ndarray,
+             horiz: np.ndarray, passes: int) -> None:
+    """Give valid pixels that were dropped the label of a neighbour they are linked to
+    (below, above, right, left: the first labelled one), ``passes`` times, in place; each
+    pass reads the labels the previous one left."""
+    h, w = labels.shape
+    ys = []
+    xs = []
+    for y in range(h):
+        for x in range(w):
+            if valid[y, x] and not keep[y, x]:
+                ys.append(y)
+                xs.append(x)
+    n = len(ys)
+    ty = np.array(ys, np.int64)
+    tx = np.array(xs, np.int64)
+    got = np.zeros(n, np.int32)
+    for _ in range(passes):
+        if n == 0:
+            break
+        for i in range(n):
+            y, x = ty[i], tx[i]
+            g = 0
+            if y + 1 < h and vert[y, x]:
+                g = labels[y + 1, x]
+            if g == 0 and y > 0 and vert[y - 1, x]:
+                g = labels[y - 1, x]
+            if g == 0 and x + 1 < w and horiz[y, x]:
+                g = labels[y, x + 1]
+            if g == 0 and x > 0 and horiz[y, x - 1]:
+                g = labels[y, x - 1]
+            got[i] = g
+        m = 0
+        for i in range(n):
+            labels[ty[i], tx[i]] = got[i]
+            if got[i] == 0:
+                ty[m] = ty[i]
+                tx[m] = tx[i]
+                m += 1
+        n = m
+
+
+@kernel()
+def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Sums of ``values`` (V, H, W) per (label, row) over the labelled pixels (label > 0):
+    ``(keys, counts, sums (V, K))``, ``keys = label * H + row`` ascending. Float64 sums in
+    raster order, as ``np.bincount`` adds them."""
+    nv, h, w = values.shape
+    n_bins = (n_labels + 1) * h
+    count = np.zeros(n_bins, np.int64)
+    acc = np.zeros((nv, n_bins), np.float64)
+    for y in range(h):
+        for x in range(w):
+            lab = labels[y, x]
+            if lab > 0:
+                k = lab * h + y
+                count[k] += 1
+                for v in range(nv):
+                    acc[v, k] += np.float64(values[v, y, x])
+    used = 0
+    for k in range(n_bins):
+        if count[k] > 0:
+            used += 1
+    keys = np.empty(used, np.int64)
+    counts = np.empty(used, np.int64)
+    sums = np.empty((nv, used), np.float64)
+    i = 0
+    for k in range(n_bins):
+        if count[k] > 0:
+            keys[i] = k
+            counts[i] = count[k]
+            for v in range(nv):
+                sums[v, i] = acc[v, k]
+            i += 1
+    return keys, counts, sums
+
+
+@kernel()
+def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Neighbour pairs of different regions across a phase wrap, walking down the columns
+    and along the rows (a wrap along a row against the phase's direction ``sign`` is left
+    out): ``(src, dst, step)``, step +1 where the phase falls from ``src`` to ``dst``."""
+    h, w = phi.shape
+    src = []
+    dst = []
+    step = []
+    for y in range(h):
+        for x in range(w):
+            la = labels[y, x]
+            if la <= 0:
+                continue
+            if y + 1 < h:
+                lb = labels[y + 1, x]
+                if lb > 0 and lb != la and abs(phi[y + 1, x] - phi[y, x]) > PI32:
+                    src.append(la)
+                    dst.append(lb)
+                    step.append(1 if phi[y, x] > phi[y + 1, x] else -1)
+            if x + 1 < w:
+                lb = labels[y, x + 1]
+                if lb > 0 and lb != la and abs(phi[y, x + 1] - phi[y, x]) > PI32:
+                    st = 1 if phi[y, x] > phi[y, x + 1] else -1
+                    if st == sign:
+                        src.append(la)
+                        dst.append(lb)
+                        step.append(st)
+    return (np.array(src, np.int64), np.array(dst, np.int64), np.array(step, np.int64))
+
+
+@kernel(parallel=True)
+def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.ndarray,
+               cos_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(num, den, avg)`` of frames ``start .. start+steps-1`` of a raw capture stack (any
+    dtype; each value times ``scale`` is its fraction of full scale): ``num = -sum
+    sin_w[n] I_n``, ``den = sum cos_w[n] I_n`` and the mean, in one pass (float32, summed in
+    frame order as :func:`bistair.core.phase.wrapped_phase` sums them)."""
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    num = np.empty((h, w), np.float32)
+    den = np.empty((h, w), np.float32)
+    avg = np.empty((h, w), np.float32)
+    n32 = np.float32(steps)
+    for y in prange(h):
+        for x in range(w):
+            s = np.float32(0.0)
+            c = np.float32(0.0)
+            total = np.float32(0.0)
+            for n in range(steps):
+                f = np.float32(raw[start + n, y, x]) * s32
+                s += sin_w[n] * f
+                c += cos_w[n] * f
+                total += f
+            num[y, x] = -s
+            den[y, x] = c
+            avg[y, x] = total / n32
+    return num, den, avg
+
+
+@kernel(parallel=True)
+def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np.ndarray,
+                noise: np.ndarray, step: float) -> np.ndarray:
+    """Horizontal links (H, W-1) where the stair phase (given by its cosine and sine) turns
+    by more than ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of
+    the link, away from the phase jumps (see
+    :func:`bistair.codecs.bidirectional.stair_edges`)."""
+    h, w = phi.shape
+    edge = np.zeros((h, w - 1), np.bool_)
+    lo = np.float32(0.15 * 2.0 * math.pi)
+    hi = np.float32(0.85 * 2.0 * math.pi)
+    base = 0.75 * step
+    cb, sb = math.cos(base), math.sin(base)
+    for y in prange(h):
+        for x in range(1, w - 2):
+            if not (valid[y, x - 1] and valid[y, x] and valid[y, x + 1] and valid[y, x + 2]):
+                continue
+            mid = phi[y, x]
+            if not (mid > lo and mid < hi):
+                continue
+            lr = cos_t[y, x - 1] + cos_t[y, x]
+            li = sin_t[y, x - 1] + sin_t[y, x]
+            rr = cos_t[y, x + 1] + cos_t[y, x + 2]
+            ri = sin_t[y, x + 1] + sin_t[y, x + 2]
+            re = rr * lr + ri * li
+            im = ri * lr - rr * li
+            # well inside the base angle: no edge, and no arctangent needed
+            if cb * abs(im) - sb * re < -1e-6 * (abs(im) + abs(re)):
+                continue
+            turn = abs(np.float32(math.atan2(im, re)))
+            a = max(noise[y, x - 1], noise[y, x + 2])
+            b = max(noise[y, x], noise[y, x + 1])
+            spread = np.float32(math.sqrt(a * a + b * b))
+            if turn > max(base, 4.0 * spread):
+                edge[y, x] = True
+    return edge
+
+
+@kernel(parallel=True)
+def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
+    """:func:`bistair.core.stair.quantize` of a float32 phase map, -1 where not ``valid``."""
+    h, w = theta.shape
+    scale = np.float32(levels / (2.0 * math.pi))
+    out = np.empty((h, w), np.int32)
+    for y in prange(h):
+        for x in range(w):
+            if valid[y, x]:
+                out[y, x] = np.int32(math.floor((theta[y, x] + PI32) * scale)) % levels
+            else:
+                out[y, x] = -1
+    return out
+
+
+@kernel(parallel=True)
+def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
+                  min_strong: int, min_size: int) -> np.ndarray:
+    """``strong | (weak & region kept)``, a region kept when it holds ``min_strong`` strong
+    pixels or ``min_size`` pixels (see :func:`bistair.core.measure.coherent_pixels`)."""
+    h, w = labels.shape
+    size = np.zeros(n + 1, np.int64)
+    bright = np.zeros(n + 1, np.int64)
+    for y in range(h):
+        for x in range(w):
+            lab = labels[y, x]
+            size[lab] += 1
+            if strong[y, x]:
+                bright[lab] += 1
+    keep = (bright >= min_strong) | (size >= min_size)
+    keep[0] = False
+    out = np.empty((h, w), np.bool_)
+    for y in prange(h):
+        for x in range(w):
+            out[y, x] = strong[y, x] or (weak[y, x] and keep[labels[y, x]])
+    return out

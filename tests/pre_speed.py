@@ -1,0 +1,64 @@
+"""The scenes whose decoded fringe orders were recorded before the decoders were made fast
+(tests/data/pre_speed.npz), and the code that records them: ``python tests/pre_speed.py``.
+
+The fast decoders must give the same orders (tests/test_speed.py)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import bistair  # noqa: E402
+from bistair.sim import Imaging, expose, preset, trace  # noqa: E402
+from bistair.sim.warp import render_warp  # noqa: E402
+
+DATA = Path(__file__).resolve().parent / "data" / "pre_speed.npz"
+HARD = dict(gamma=2.2, read_noise=0.03, camera_blur=1.2, projector_blur=1.0, ambient=0.15)
+CODECS = {
+    "bidirectional": ("bidirectional", dict(period=30), {}),
+    "paper": ("bidirectional", dict(period=30), {"strategy": "paper"}),
+    "lv": ("lv", dict(period=30), {}),
+    "phase-coding": ("phase-coding", dict(period=30), {}),
+    "phase-coding-pixel": ("phase-coding", dict(period=30, form="shifted"),
+                           {"strategy": "pixel"}),
+    "graycode": ("graycode", dict(period=30, complementary=1), {}),
+    "graycode-region": ("graycode", dict(period=30), {"strategy": "region"}),
+    "multifreq": ("multifreq", dict(periods=(1080, 180, 30)), {}),
+    "heterodyne": ("multifreq", dict(periods=(42, 45, 48), steps=12), {}),
+}
+
+
+def cases():
+    """(name, images, spec, options) of every recorded decode."""
+    from conftest import warped_scene
+
+    for seed, noise, blur in ((0, 0.01, 1.0), (1, 0.02, 1.5)):
+        scene = warped_scene(seed, noise, blur)
+        for label, (method, params, options) in CODECS.items():
+            spec = bistair.make_spec(method, width=1080, height=1080, **params)
+            yield f"warp{seed}-{label}", render_warp(spec, scene)[0], spec, options
+    for scene_name, optics, params in (
+            ("paper-sim", HARD, dict(width=1080, height=1080)),
+            ("mugs-on-wall", {}, dict(width=1920, height=1080, partitions=8, stairs=8))):
+        rig, scene = preset(scene_name, camera_size=(640, 512))
+        imaging = Imaging(**optics, seed=3)
+        traced = trace(rig, scene, imaging)
+        spec = bistair.make_spec("bidirectional", period=30, **params)
+        yield f"{scene_name}-bidirectional", expose(traced, bistair.encode(spec), imaging), \
+            spec, {}
+
+
+def record() -> None:
+    orders = {name: bistair.decode(images, spec, **options).order.astype(np.int16)
+              for name, images, spec, options in cases()}
+    DATA.parent.mkdir(exist_ok=True)
+    np.savez_compressed(DATA, **orders)
+    print(f"recorded {len(orders)} decodes in {DATA} ({DATA.stat().st_size} bytes)")
+
+
+if __name__ == "__main__":
+    record()
