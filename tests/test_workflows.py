@@ -53,8 +53,8 @@ def test_simulate_then_decode(tmp_path, monkeypatch, capsys):
                        "--method", "bidirectional", "--method", "graycode", "--camera",
                        "640x512", "--out", out)
     assert code == 0, err
-    assert sorted(p.name for p in out.iterdir()) == ["bidirectional", "graycode", "scene.json",
-                                                     "truth"]
+    assert sorted(p.name for p in out.iterdir()) == ["bidirectional", "calibration.json",
+                                                     "graycode", "scene.json", "truth"]
     scene = json.loads((out / "scene.json").read_text())
     assert scene["rig"]["camera"]["width"] == 640 and scene["imaging"]["read_noise"] == 0.01
     code, _, err = run(monkeypatch, capsys, "decode", out / "bidirectional", "--out",

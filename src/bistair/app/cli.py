@@ -246,8 +246,9 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 
 
 @cli.command()
-@click.option("--scene", required=True, help="preset scene (paper-sim, two-masks, mask-prism, "
-              "two-sculptures, plane, sphere-on-plane)")
+@click.option("--scene", default=None, help="preset scene (paper-sim, two-masks, mask-prism, "
+              "two-sculptures, plane, sphere-on-plane, objects-on-plane, mugs-on-wall) or "
+              "calibration (board captures)")
 @click.option("--method", "methods", required=True, multiple=True,
               help="method to render (repeatable), or all")
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
@@ -264,27 +265,72 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 @click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
               show_default=True, help="camera bit depth")
 @click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--count", type=int, default=None,
+              help="a data set: COUNT scenes in OUT/scene-NNNN/ and OUT/index.csv, rendered "
+              "in parallel")
+@click.option("--vary", default=None, metavar="optics,objects,pose",
+              help="with --count: what each scene draws at random (see README)")
+@click.option("--workers", type=int, default=None,
+              help="with --count: processes of the local cluster [default: the cores]")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="with --count: run on an existing Dask cluster instead")
 @_quiet
 @reports_errors
-def simulate(scene: str, methods: tuple[str, ...], out: Path, camera: tuple[int, int] | None,
-             noise: float, blur: float, gamma: float, compensated: bool, ambient: float,
-             bits: str, seed: int, quiet: bool) -> None:
-    """Render a preset scene on the virtual rig: one capture folder per method + the truth."""
+def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
+             camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
+             compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
+             vary: str | None, workers: int | None, scheduler: str | None,
+             quiet: bool) -> None:
+    """Render a preset scene on the virtual rig: one capture folder per method + the truth.
+
+    With --count N, a data set of N scenes (deterministic for a --seed whatever the number
+    of workers), each varied as --vary says."""
     from ..codecs import REGISTRY
-    from .progress import Progress
-    from .simulate import simulate as run
 
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
-    with Progress(quiet) as say:
-        run(scene, chosen, out, camera_size=camera, compensated=compensated, gamma=gamma,
-            read_noise=noise, camera_blur=blur, ambient=ambient, bits=int(bits), seed=seed,
-            progress=say)
-    if quiet:
+    imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
+                   bits=int(bits))
+    if count is None:
+        for name, value in (("--vary", vary), ("--workers", workers),
+                            ("--scheduler", scheduler)):
+            if value is not None:
+                raise CliError(f"{name} applies to a data set: give --count too")
+        if scene is None:
+            raise CliError("name a --scene (or give --count with --vary objects)")
+        from .progress import Progress
+        from .simulate import simulate as run
+
+        with Progress(quiet) as say:
+            run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
+                progress=say, **imaging)
+        if quiet:
+            return
+        if scene == "calibration":
+            click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to "
+                       f"{out}")
+        else:
+            click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
+                       f"to {out}")
         return
-    if scene == "calibration":
-        click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to {out}")
-    else:
-        click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth to {out}")
+    from .simulate import simulate_many
+
+    try:
+        report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
+                               camera_size=camera, compensated=compensated, workers=workers,
+                               scheduler=scheduler,
+                               show_progress=sys.stderr.isatty() and not quiet, **imaging)
+    except KeyboardInterrupt:
+        click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
+                   "written", err=True)
+        raise click.exceptions.Abort() from None
+    for name, error in report.failed:
+        click.echo(f"failed {name}: {error}", err=quiet)
+    if not quiet:
+        click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
+                   f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
+                   f"{report.workers} worker{'s' if report.workers != 1 else ''}")
+    if report.failed:
+        raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
 
 
 @cli.command()
@@ -427,6 +473,65 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
 
     h = height_folder(captures, reference, out, spec_path, planes, geometry)
     click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
+
+
+@cli.command()
+@click.argument("root", type=click.Path(path_type=Path))
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder: OUT/<set name>/ per set and OUT/batch.csv")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of every set [default: spec.json in each set's folder]")
+@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+              help="calibration file: also reconstruct every set (cloud.ply, depth.npy)")
+@click.option("--workers", type=int, default=None,
+              help="processes of the local cluster [default: the cores]")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="run on an existing Dask cluster instead (its workers must see the same "
+              "paths)")
+@click.option("--resume", is_flag=True, help="skip sets whose outputs are complete")
+@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@click.option("--min-modulation", type=float, default=None,
+              help="modulation threshold as a fraction of full scale, between 0 and 1 "
+              "[default: from noise]")
+@click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="with --calibration: keep points with depth z in [MIN, MAX] mm")
+@click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
+              metavar="PX", help="with --calibration and specs of both axes: see "
+              "'bistair reconstruct --help'")
+@_quiet
+@reports_errors
+def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
+          workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
+          min_modulation: float | None, no_previews: bool, depth_range: str | None,
+          epipolar_tolerance: float, quiet: bool) -> None:
+    """Decode (with --calibration also reconstruct) many capture sets on Dask.
+
+    ROOT: a folder whose sub-folders are the capture sets, or a CSV manifest with the
+    columns captures, spec, calibration, out (paths relative to the manifest; empty cells
+    take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
+    into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
+    """
+    from .batch import run_batch
+    from .jobs import parse_depth_range
+
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
+               if v is not None}
+    try:
+        report = run_batch(root, out, spec_path, calibration, workers=workers,
+                           scheduler=scheduler, resume=resume, previews=not no_previews,
+                           min_depth=low, max_depth=high,
+                           epipolar_tolerance=epipolar_tolerance,
+                           show_progress=sys.stderr.isatty() and not quiet, **options)
+    except KeyboardInterrupt:
+        click.echo(f"Interrupted: the finished sets are in {out} (listed in batch.csv); "
+                   "run again with --resume to go on", err=True)
+        raise click.exceptions.Abort() from None
+    for row in report.failed:
+        click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
+    if not quiet:
+        click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
 
 
 def _terminated(signum: int, frame: Any) -> None:

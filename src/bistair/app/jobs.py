@@ -40,6 +40,7 @@ from ..io.files import (
     Captures,
     capture_files,
     check_output,
+    find_spec,
     load_spec,
     natural_key,
     output_file,
@@ -205,31 +206,41 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
                        calibration: Calibration | str | Path, out_ply: str | Path,
                        depth_dir: str | Path | None = None, orientation: str | None = None,
                        min_depth: float = 0.0, max_depth: float = np.inf,
-                       epipolar_tolerance: float = 1.5, progress: Say | None = None,
+                       epipolar_tolerance: float = 1.5,
+                       decoded: DecodeResult | AxesResult | None = None,
+                       progress: Say | None = None,
                        **options: Any) -> Reconstruction:
     """Decode a capture folder (or ``.npy`` stack), triangulate it and write the PLY (and
     ``depth.npy``, ``depth.png`` into ``depth_dir``). ``spec`` defaults to
     ``CAPTURES/spec.json``; ``options`` go to the decoder. A spec of both axes triangulates
     with both projector coordinates (``epipolar_tolerance``: see
-    :func:`~bistair.geometry.triangulate.reconstruct`). Nothing is written on error.
-    ``progress`` is called with each stage's name as it starts."""
+    :func:`~bistair.geometry.triangulate.reconstruct`). ``decoded``: the decode of these
+    captures if already made (by :func:`decode_folder`), triangulated without reading or
+    decoding them again. Nothing is written on error. ``progress`` is called with each
+    stage's name as it starts."""
     say = progress or _silent
     check_depth_range(min_depth, max_depth)
     if not epipolar_tolerance > 0:
         raise BistairError(f"the epipolar tolerance must be positive, got {epipolar_tolerance}")
-    say("reading the captures")
-    stack, spec = read_with_spec(captures, spec)
+    stack = None
+    if decoded is None:
+        say("reading the captures")
+        stack, spec = read_with_spec(captures, spec)
+        shape = stack.shape[1:]
+    else:
+        spec, shape = find_spec(captures, spec), decoded.mask.shape
     if not isinstance(calibration, Calibration):
         calibration = load_calibration(calibration)
-    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(stack.shape[1:]),) * 8,
+    blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(shape),) * 8,
                                                     period=1.0, method="")
     if spec.orientation == "both":
         blank = AxesResult(blank, blank)
     check_fit(blank, calibration, spec, orientation)  # before the work of decoding
-    say(_decoding(stack, spec))
-    result = decode(stack, spec, **options)
+    if decoded is None:
+        say(_decoding(stack, spec))
+        decoded = decode(stack, spec, **options)
     say("triangulating")
-    rec = reconstruct(result, calibration, spec, orientation, min_depth, max_depth,
+    rec = reconstruct(decoded, calibration, spec, orientation, min_depth, max_depth,
                       epipolar_tolerance)
     pts, cols = rec.cloud()
     say(f"writing {len(pts)} points")

@@ -4,11 +4,20 @@ For a preset scene and one method (or all) it writes::
 
     OUT/<method>/00.png ...   the captures (8 bit; 16-bit PNG for deeper cameras)
     OUT/<method>/spec.json    the pattern set, so ``bistair decode OUT/<method>`` works
-    OUT/truth/                coord_x.npy, coord_y.npy, depth.npy, object_id.npy, mask.npy
+    OUT/truth/                coord.npy (projector coordinate along the specs' coded axis),
+                              order.npy (its fringe order, -1 outside the mask), coord_x.npy,
+                              coord_y.npy, depth.npy, object_id.npy, mask.npy
+    OUT/calibration.json      the rig's exact calibration (for ``bistair reconstruct``)
     OUT/scene.json            the scene, rig (intrinsics, distortion, pose) and imaging
 
 The scene ``calibration`` writes a checkerboard in eight poses instead, in the layout
 ``bistair calibrate`` reads (``board.json``, ``pose-NN/columns``, ``pose-NN/rows``).
+
+:func:`simulate_many` (``bistair simulate --count N``) writes a data set of N scenes in
+that layout, ``DATA/scene-0000/`` ..., in parallel on Dask (see
+:mod:`~bistair.app.engine`), each scene's parameters drawn from its own seed
+(:mod:`bistair.sim.variation`), and ``DATA/index.csv``, which is also a manifest for
+``bistair batch``.
 
 Examples
 --------
@@ -17,17 +26,21 @@ Examples
 ...     out = simulate("plane", ["graycode"], pathlib.Path(tmp) / "sim",
 ...                    camera_size=(64, 48))
 ...     sorted(p.name for p in out.iterdir()), len(list((out / "graycode").glob("*.png")))
-(['graycode', 'scene.json', 'truth'], 11)
+(['calibration.json', 'graycode', 'scene.json', 'truth'], 11)
 """
 
 from __future__ import annotations
 
+import csv
 import dataclasses
-from collections.abc import Callable, Iterable
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm import tqdm
 
 from ..codecs import encode
 from ..codecs import methods as known_methods
@@ -35,10 +48,22 @@ from ..core.captures import to_bit_depth
 from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
 from ..geometry.board import Board
-from ..io.files import output_folder, write_image
+from ..geometry.calibration import Calibration, save_calibration
+from ..io.files import output_file, output_folder, replace_folder, write_image
 from ..io.jsonfile import write_json
-from ..sim import Imaging, Rig, expose, preset, scene_names, trace
+from ..sim import Imaging, Rig, Scene, Truth, expose, preset, scene_names, trace
 from ..sim.boards import write_board_captures
+from ..sim.rig import check_size
+from ..sim.variation import build, check_vary, draw, streams
+from ..spec import BaseSpec
+from .engine import (
+    BATCH_PREFIX,
+    check_workers,
+    dask_client,
+    remove_run_temporaries,
+    run_prefix,
+    run_tasks,
+)
 
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
@@ -61,46 +86,66 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     if scene not in (*scene_names(), "calibration"):
         raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
                            "calibration)")
-    methods = list(methods)
-    unknown = set(methods) - set(known_methods())
-    if unknown:
-        raise BistairError(f"unknown method(s) {', '.join(sorted(unknown))} "
-                           f"(known: {', '.join(known_methods())}, all)")
-    try:
-        im = Imaging(**imaging)
-    except TypeError as exc:  # a parameter Imaging does not have
-        raise BistairError(f"bad imaging parameters: {exc}") from None
-    if compensated and not 0.2 <= im.gamma <= 5.0:
-        raise BistairError(f"patterns cannot pre-compensate a projector gamma of {im.gamma:g} "
-                           "(a spec's gamma lies in [0.2, 5]); simulate it uncompensated")
+    methods = _check_methods(methods)
+    im = _imaging(compensated, imaging)
     if scene == "calibration":
         return _calibration(methods, out, camera_size, compensated, im)
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
-    specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
-                         methods=methods)
     say = progress or (lambda stage: None)
-    say(f"tracing {scene} ({rig.camera.size[0]}x{rig.camera.size[1]})")
-    traced = trace(rig, geometry, im)
     with output_folder(out) as tmp:
-        for method, (spec, _) in specs.items():
-            say(f"rendering and writing {method}")
-            folder = tmp / method
-            folder.mkdir()
-            images = expose(traced, encode(spec), im)
-            if images.dtype.kind == "f":
-                images = to_bit_depth(images, 16)
-            for i, img in enumerate(images):
-                write_image(folder / f"{i:02d}.png", img)
-            (folder / "spec.json").write_text(spec.to_json())
-        truth_dir = tmp / "truth"
-        truth_dir.mkdir()
-        t = traced.truth
-        for name in ("coord_x", "coord_y", "depth", "object_id", "mask"):
-            np.save(truth_dir / f"{name}.npy", getattr(t, name))
-        write_json(tmp / "scene.json",
-                   {"scene": scene, "methods": methods, "compensated": compensated,
-                    "imaging": dataclasses.asdict(im), "rig": _rig_dict(rig)})
+        write_scene(tmp, rig, geometry, im, methods, compensated,
+                    {"scene": scene, "methods": methods, "compensated": compensated},
+                    progress=say)
     return Path(out)
+
+
+def write_scene(folder: Path, rig: Rig, geometry: Scene, imaging: Imaging,
+                methods: Sequence[str], compensated: bool, about: dict[str, Any],
+                threads: int | None = None,
+                progress: Callable[[str], None] | None = None) -> None:
+    """Render ``geometry`` for each method into the existing ``folder``: the capture
+    folders, ``truth/``, ``calibration.json`` and ``scene.json`` (``about``, the imaging and
+    the rig). ``threads`` for ray casting and exposure (default: the cores; the images do
+    not depend on it). ``progress`` is called with each stage's name as it starts."""
+    say = progress or (lambda stage: None)
+    specs = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
+                         methods=methods)
+    say(f"tracing the scene ({rig.camera.size[0]}x{rig.camera.size[1]})")
+    traced = trace(rig, geometry, imaging, workers=threads)
+    for method, (spec, _) in specs.items():
+        say(f"rendering and writing {method}")
+        sub = folder / method
+        sub.mkdir()
+        images = expose(traced, encode(spec), imaging, workers=threads)
+        if images.dtype.kind == "f":
+            images = to_bit_depth(images, 16)
+        for i, img in enumerate(images):
+            write_image(sub / f"{i:02d}.png", img)
+        (sub / "spec.json").write_text(spec.to_json())
+    codes = {(spec.orientation, spec.period) for spec, _ in specs.values()}
+    if len(codes) != 1:  # every comparable set codes the columns with one period
+        raise BistairError(f"the methods code {len(codes)} different axes or periods")
+    write_truth(folder / "truth", traced.truth, next(iter(specs.values()))[0])
+    save_calibration(Calibration.from_rig(rig), folder / "calibration.json")
+    write_json(folder / "scene.json", {**about, "imaging": dataclasses.asdict(imaging),
+                                       "rig": _rig_dict(rig)})
+
+
+def write_truth(folder: Path, truth: Truth, spec: BaseSpec) -> None:
+    """Write the ground truth into the new folder ``folder``: ``coord.npy`` (the projector
+    coordinate along the spec's coded axis), ``order.npy`` (int32 ``floor(coord/period)``,
+    -1 outside the mask), ``coord_x.npy``, ``coord_y.npy``, ``depth.npy`` (mm, camera
+    frame), ``object_id.npy`` and ``mask.npy``."""
+    folder.mkdir()
+    coord = truth.coord(spec)
+    order = np.full(coord.shape, -1, np.int32)
+    ok = truth.mask & np.isfinite(coord)
+    order[ok] = np.floor(coord[ok] / spec.period).astype(np.int32)
+    arrays = {"coord": coord, "order": order, "coord_x": truth.coord_x,
+              "coord_y": truth.coord_y, "depth": truth.depth, "object_id": truth.object_id,
+              "mask": truth.mask}
+    for name, arr in arrays.items():
+        np.save(folder / f"{name}.npy", arr)
 
 
 def _rig_dict(rig: Any) -> dict[str, Any]:
@@ -122,3 +167,184 @@ def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, in
     specs = {o: base.replace(orientation=o, white=1) for o in ("columns", "rows")}
     return write_board_captures(rig, Board("checkerboard", 9, 6, 20.0), specs, out,
                                 imaging=imaging)
+
+
+def _check_methods(methods: Iterable[str]) -> list[str]:
+    methods = list(methods)
+    if not methods:
+        raise BistairError("name a method to render (or all)")
+    unknown = set(methods) - set(known_methods())
+    if unknown:
+        raise BistairError(f"unknown method(s) {', '.join(sorted(unknown))} "
+                           f"(known: {', '.join(known_methods())}, all)")
+    return methods
+
+
+def _imaging(compensated: bool, imaging: dict[str, Any]) -> Imaging:
+    try:
+        im = Imaging(**imaging)
+    except TypeError as exc:  # a parameter Imaging does not have
+        raise BistairError(f"bad imaging parameters: {exc}") from None
+    if compensated and not 0.2 <= im.gamma <= 5.0:
+        raise BistairError(f"patterns cannot pre-compensate a projector gamma of {im.gamma:g} "
+                           "(a spec's gamma lies in [0.2, 5]); simulate it uncompensated")
+    return im
+
+
+# -- data sets: many scenes on Dask -----------------------------------------------------------
+INDEX_COLUMNS = ("captures", "spec", "calibration", "out", "scene", "method", "content",
+                 "read_noise", "camera_blur", "gamma", "ambient", "noise_seed")
+
+
+@dataclass
+class DataSetReport:
+    """What :func:`simulate_many` wrote: one index row per capture set, the failed scenes
+    (``(name, message)``), the time and the workers."""
+
+    rows: list[dict[str, Any]]
+    failed: list[tuple[str, str]]
+    seconds: float
+    workers: int
+    out: Path
+
+
+def scene_parameters(count: int, seed: int, vary: Iterable[str] = (), scene: str | None = None,
+                     camera_size: tuple[int, int] | None = None,
+                     imaging: dict[str, Any] | None = None) -> list[dict[str, Any]]:
+    """The parameters of the scenes ``0 .. count-1`` of a data set: scene ``i`` draws from
+    the ``i``-th child of ``numpy.random.SeedSequence(seed)`` (``spawn``), so it is the same
+    whatever the count and the number of workers (see :mod:`bistair.sim.variation`).
+
+    Examples
+    --------
+    >>> a = scene_parameters(3, seed=5, vary=["optics"], scene="plane")
+    >>> b = scene_parameters(5, seed=5, vary=["optics"], scene="plane")
+    >>> a == b[:3], a[0]["imaging"]["read_noise"] != a[1]["imaging"]["read_noise"]
+    (True, True)
+    """
+    vary = check_vary(vary)
+    out = []
+    for i, child in enumerate(np.random.SeedSequence(seed).spawn(count)):
+        params = draw(streams(child), vary, base=scene, camera_size=camera_size,
+                      imaging=imaging)
+        out.append({"index": i, "seed": seed, "spawn_key": list(child.spawn_key),
+                    "vary": list(vary), **params})
+    return out
+
+
+def simulate_scene(params: dict[str, Any], methods: Sequence[str], compensated: bool,
+                   out: str, prefix: str = BATCH_PREFIX, threads: int | None = 1
+                   ) -> dict[str, Any]:
+    """Render one scene of a data set into the folder ``out`` (replaced as a whole); runs on
+    a worker. Returns ``{"name", "error", "seconds"}`` (error empty on success)."""
+    start = time.perf_counter()
+    name = Path(out).name
+    try:
+        rig, geometry, imaging = build(params)
+        content = params.get("preset") or "objects"
+        with replace_folder(out, prefix) as tmp:
+            write_scene(tmp, rig, geometry, imaging, methods, compensated,
+                        {"scene": content, "methods": list(methods), "compensated": compensated,
+                         "parameters": params}, threads=threads)
+        return {"name": name, "error": "", "seconds": round(time.perf_counter() - start, 3)}
+    except BistairError as exc:
+        return {"name": name, "error": str(exc), "seconds": None}
+    except Exception as exc:  # a bug must not stop the data set
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        return {"name": name, "error": f"{type(exc).__name__}: {first}".rstrip(": "),
+                "seconds": None}
+
+
+def simulate_many(count: int, methods: Iterable[str], out: str | Path, seed: int = 0,
+                  scene: str | None = None, vary: Iterable[str] = (),
+                  camera_size: tuple[int, int] | None = None, compensated: bool = True,
+                  workers: int | None = None, scheduler: str | None = None,
+                  show_progress: bool = False, **imaging: Any) -> DataSetReport:
+    """Render ``count`` scenes into ``out/scene-NNNN/`` (each in the layout of
+    :func:`simulate`, its parameters in ``scene.json``) on Dask and write
+    ``out/index.csv``: one row per capture set (:data:`INDEX_COLUMNS`; the captures,
+    spec, calibration and out columns make it a ``bistair batch`` manifest).
+
+    ``scene``: the preset of every scene, unless ``vary`` holds ``objects``; ``vary``:
+    ``optics``, ``objects``, ``pose`` (:mod:`bistair.sim.variation`; drawn optics replace
+    the ``imaging`` values of noise, blur, gamma and ambient). ``workers`` and
+    ``scheduler`` as for :func:`~bistair.app.batch.run_batch`. The files are the same for
+    a given ``seed`` whatever the number of workers. ``imaging``'s ``seed`` is not used:
+    each scene's noise seed is drawn from ``seed``.
+
+    Raises
+    ------
+    BistairError
+        Bad parameters (checked before anything is rendered) or a scheduler that cannot be
+        reached. Scenes that fail while rendering are reported in ``failed``.
+    """
+    started = time.perf_counter()
+    if isinstance(count, bool) or not isinstance(count, int) or count < 1:
+        raise BistairError(f"--count must be 1 or more, got {count!r}")
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise BistairError(f"--seed must be a whole number of 0 or more, got {seed!r}")
+    check_workers(workers, scheduler)
+    vary = check_vary(vary)
+    methods = _check_methods(methods)
+    if "objects" in vary and scene is not None:
+        raise BistairError("--vary objects draws the scenes: leave out --scene")
+    if scene == "calibration":
+        raise BistairError("--count renders scenes; board captures come from --scene "
+                           "calibration without --count")
+    if scene is not None and scene not in scene_names():
+        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())})")
+    if camera_size is not None:
+        camera_size = check_size(camera_size, "camera")
+    imaging.pop("seed", None)
+    _imaging(compensated, imaging)
+    params = scene_parameters(count, seed, vary, scene, camera_size, imaging)
+    for p in params:  # drawn optics stay in range; check before any work
+        _imaging(compensated, p["imaging"])
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise BistairError(f"output {out} exists and is not a folder")
+    digits = max(4, len(str(count - 1)))
+    names = [f"scene-{i:0{digits}d}" for i in range(count)]
+    remove_run_temporaries([out])
+    prefix = run_prefix()
+    results: dict[int, dict[str, Any]] = {}
+    bar = tqdm(total=count, desc="scenes", unit="scene", disable=not show_progress,
+               dynamic_ncols=True)
+    used = 0
+    try:
+        with dask_client(workers, scheduler, tasks=count) as client:
+            used = len(client.nthreads())
+
+            def failed(i: int, message: str) -> dict[str, Any]:
+                return {"name": names[i], "error": message, "seconds": None}
+
+            def done(i: int, result: dict[str, Any]) -> None:
+                results[i] = result
+                bar.update()
+
+            absolute = out.absolute()
+            run_tasks(client, simulate_scene,
+                      [(p, methods, compensated, str(absolute / n), prefix)
+                       for p, n in zip(params, names, strict=True)], failed, done)
+    finally:
+        bar.close()
+        remove_run_temporaries([out], prefix)
+    rows = []
+    for i, (p, name) in enumerate(zip(params, names, strict=True)):
+        if results[i]["error"]:
+            continue
+        im = p["imaging"]
+        for method in methods:
+            rows.append({"captures": f"{name}/{method}", "spec": "",
+                         "calibration": f"{name}/calibration.json", "out": f"{name}/{method}",
+                         "scene": name, "method": method,
+                         "content": p.get("preset") or "objects",
+                         **{k: im.get(k, getattr(Imaging, k)) for k in
+                            ("read_noise", "camera_blur", "gamma", "ambient")},
+                         "noise_seed": im["seed"]})
+    with output_file(out / "index.csv", prefix) as tmp, tmp.open("w", newline="") as fh:
+        writer = csv.DictWriter(fh, INDEX_COLUMNS)
+        writer.writeheader()
+        writer.writerows(rows)
+    failures = [(r["name"], r["error"]) for _, r in sorted(results.items()) if r["error"]]
+    return DataSetReport(rows, failures, time.perf_counter() - started, used, out)

@@ -332,6 +332,28 @@ def load_spec(path: str | Path) -> BaseSpec:
     return spec_from_dict(read_json(path, "spec file"))
 
 
+def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
+              files: Sequence[Path] | None = None) -> BaseSpec:
+    """The spec of a capture set, read as its file says (frames marked ``ignore`` kept):
+    ``spec`` itself, the file it names, or by default ``spec.json`` in the captures' folder
+    (the folder given, or the folder of the first file). ``files``: the captures' files if
+    already listed (:func:`capture_files`).
+
+    Raises
+    ------
+    BistairError
+        Captures or a spec file that cannot be read.
+    """
+    if isinstance(spec, BaseSpec):
+        return spec
+    if spec is None:
+        files = capture_files(captures) if files is None else files
+        first = captures if isinstance(captures, str | Path) else next(iter(captures))
+        first = Path(first)
+        spec = first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
+    return load_spec(spec)
+
+
 def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
                    ) -> tuple[np.ndarray, BaseSpec]:
     """The capture stack and the spec that describes it.
@@ -383,12 +405,7 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     >>> shutil.rmtree(tmp)
     """
     files = capture_files(captures)
-    if spec is None:
-        first = captures if isinstance(captures, str | Path) else next(iter(captures))
-        first = Path(first)
-        spec = first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
-    if not isinstance(spec, BaseSpec):
-        spec = load_spec(spec)
+    spec = find_spec(captures, spec, files)
     skip = [i for i, name in enumerate(spec.frames) if name == "ignore"]
     npy = files[0].suffix.lower() == ".npy"
     stack = read_captures(files) if npy else None
@@ -486,8 +503,11 @@ def check_output(out: str | Path, captures: Captures | None = None) -> Path:
     return out
 
 
+TEMP_PREFIX = ".bistair-"  # the names of every temporary beside an output
+
+
 @contextlib.contextmanager
-def output_folder(out: str | Path) -> Iterator[Path]:
+def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
     """Yield a temporary folder; on success its files are moved into ``out`` (created if
     needed, other files in it left alone); on any error nothing reaches ``out``.
 
@@ -501,6 +521,9 @@ def output_folder(out: str | Path) -> Iterator[Path]:
     ----------
     out : str or Path
         The output folder.
+    prefix : str, optional
+        The temporary folder's name prefix (it must start with :data:`TEMP_PREFIX`); by
+        default ``.bistair-<pid>-``. A batch run gives its own, to find its leftovers.
 
     Yields
     ------
@@ -539,7 +562,7 @@ def output_folder(out: str | Path) -> Iterator[Path]:
     try:
         parent.mkdir(parents=True, exist_ok=True)
         remove_stale(parent)
-        tmp = Path(tempfile.mkdtemp(prefix=_prefix(), dir=parent))
+        tmp = Path(tempfile.mkdtemp(prefix=prefix or _prefix(), dir=parent))
         tmp.chmod(0o777 & ~_umask())  # mkdtemp makes it private; outputs are not
     except OSError as exc:
         raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
@@ -560,7 +583,118 @@ def output_folder(out: str | Path) -> Iterator[Path]:
 
 
 @contextlib.contextmanager
-def output_file(path: str | Path) -> Iterator[Path]:
+def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
+    """Yield a temporary folder beside ``out`` that replaces ``out`` as a whole on success.
+
+    Unlike :func:`output_folder`, files already in ``out`` do not survive: the old folder
+    is renamed aside (``prefix`` + random letters) just before the new one is renamed in,
+    then deleted, so ``out`` is at every moment absent, the old folder or the new one,
+    never a mixture. On any error ``out`` is left as it was.
+
+    Parameters
+    ----------
+    out : str or Path
+        The folder to replace (created with its parents if missing).
+    prefix : str
+        Name prefix of the temporary and of the old folder set aside.
+
+    Yields
+    ------
+    Path
+        The new folder's contents go here; removed afterwards if not renamed in.
+
+    Raises
+    ------
+    BistairError
+        If ``out`` exists and is not a folder, or the folders cannot be made or renamed
+        (in one line; the old folder is put back).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     out = pathlib.Path(tmp) / "set"
+    ...     out.mkdir(); _ = (out / "old.txt").write_text("old")
+    ...     with replace_folder(out) as new:
+    ...         _ = (new / "new.txt").write_text("new")
+    ...     sorted(p.name for p in pathlib.Path(tmp).rglob("*"))
+    ['new.txt', 'set']
+    """
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise BistairError(f"output {out} exists and is not a folder")
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
+        tmp.chmod(0o777 & ~_umask())
+    except OSError as exc:
+        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
+    old = None
+    try:
+        yield tmp
+        if out.exists():
+            old = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
+            os.replace(out, old)  # an empty folder is replaced by a rename
+        os.replace(tmp, out)
+    except OSError as exc:
+        if old is not None and not out.exists():
+            os.replace(old, out)  # put the old folder back
+            old = None
+        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Path]:
+    """Delete the temporaries named ``prefix*`` directly inside ``folder`` (left behind by a
+    process killed while writing).
+
+    Parameters
+    ----------
+    folder : str or Path
+        Where to look (a missing folder has nothing to delete).
+    prefix : str
+        The temporaries' name prefix; it must start with :data:`TEMP_PREFIX`.
+
+    Returns
+    -------
+    list of Path
+        What was deleted.
+
+    Raises
+    ------
+    ValueError
+        If ``prefix`` does not start with :data:`TEMP_PREFIX` (a guard against deleting
+        anything else).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     (pathlib.Path(tmp) / ".bistair-abc").mkdir()
+    ...     _ = (pathlib.Path(tmp) / "result").mkdir()
+    ...     [p.name for p in remove_temporaries(tmp)], sorted(os.listdir(tmp))
+    (['.bistair-abc'], ['result'])
+    """
+    folder = Path(folder)
+    if not prefix.startswith(TEMP_PREFIX):
+        raise ValueError(f"temporaries are named {TEMP_PREFIX}*, not {prefix}*")
+    try:
+        found = sorted(p for p in folder.iterdir() if p.name.startswith(prefix))
+    except OSError:  # no folder, nothing left behind
+        return []
+    for path in found:
+        if path.is_dir() and not path.is_symlink():
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                path.unlink()
+    return found
+
+
+def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
     """Yield a temporary file path beside ``path``; it replaces ``path`` only on success.
 
     The temporary file (``.bistair-<pid>-...`` with ``path``'s suffix, so writers that go
@@ -572,6 +706,8 @@ def output_file(path: str | Path) -> Iterator[Path]:
     ----------
     path : str or Path
         The file to write.
+    prefix : str, optional
+        The temporary file's name prefix, as for :func:`output_folder`.
 
     Yields
     ------
@@ -599,7 +735,8 @@ def output_file(path: str | Path) -> Iterator[Path]:
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_stale(path.parent)
-        fd, name = tempfile.mkstemp(prefix=_prefix(), suffix=path.suffix, dir=path.parent)
+        fd, name = tempfile.mkstemp(prefix=prefix or _prefix(), suffix=path.suffix,
+                                    dir=path.parent)
         os.close(fd)
     except OSError as exc:
         raise BistairError(f"cannot write {path}: {exc.strerror}") from None

@@ -1,0 +1,208 @@
+"""The engine behind ``bistair batch`` and ``bistair simulate --count``: many independent
+tasks on Dask, each reading its own files and writing its own outputs.
+
+A local cluster of worker processes (one thread each: a decode is NumPy, one set at a time
+per worker keeps the memory of a worker at one set's) or an existing cluster reached through
+its scheduler's address. Tasks are plain functions of paths and small parameters that return
+a small summary (a dictionary); no image array passes through the scheduler, so the workers
+of a remote cluster must see the same files under the same (absolute) paths.
+
+Temporaries: every output a task writes goes through a temporary named with the run's
+prefix (:func:`run_prefix`, ``.bistair-batch-<run id>-``) beside it, so the temporaries of
+workers killed mid-write (Ctrl-C, a lost worker) are recognised and deleted
+(:func:`remove_run_temporaries`) when the next run starts and when this one ends.
+
+Examples
+--------
+>>> import operator
+>>> with dask_client(workers=1) as client:
+...     run_tasks(client, operator.add, [(1, 2), (3, 4)], lambda i, exc: None)
+[3, 7]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import os
+import signal
+import threading
+import uuid
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import dask
+from distributed import Client, LocalCluster, as_completed
+
+from ..errors import BistairError
+from ..io.files import TEMP_PREFIX, remove_temporaries
+
+BATCH_PREFIX = TEMP_PREFIX + "batch-"  # the temporaries of every batch run
+CONNECT_TIMEOUT = 20  # seconds to reach a scheduler
+# Dask starts its worker processes with MALLOC_TRIM_THRESHOLD_=65536, which turns off
+# glibc's growing mmap threshold: every large NumPy temporary is then a fresh mmap with its
+# pages faulted in, some 15% more time for a decode. Unset for the local cluster's workers.
+WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+WORKER_TIMEOUT = 60  # seconds to wait for a scheduler's first worker
+
+
+def default_workers() -> int:
+    """The cores this process may use (the default number of local workers)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def check_workers(workers: int | None, scheduler: str | None) -> None:
+    """Refuse a worker count that is not a positive whole number, or one given with a
+    scheduler (whose cluster has its own workers).
+
+    Raises
+    ------
+    BistairError
+        One line naming the problem.
+
+    Examples
+    --------
+    >>> check_workers(2, None)
+    >>> check_workers(0, None)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: --workers must be 1 or more, got 0
+    """
+    if workers is not None and scheduler is not None:
+        raise BistairError("--workers starts a local cluster; with --scheduler the cluster's "
+                           "own workers run the tasks")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise BistairError(f"--workers must be 1 or more, got {workers!r}")
+    if scheduler is not None and not str(scheduler).strip():
+        raise BistairError("--scheduler is empty: give the address, e.g. tcp://HOST:8786")
+
+
+@contextlib.contextmanager
+def dask_client(workers: int | None = None, scheduler: str | None = None,
+                tasks: int | None = None) -> Iterator[Client]:
+    """A Dask client: on a new local cluster of ``workers`` processes with one thread each
+    (default :func:`default_workers`, at most ``tasks``), or on the cluster whose scheduler
+    listens at ``scheduler`` (``tcp://HOST:PORT``). The local cluster is closed, and its
+    worker processes ended, when the block is left (also on Ctrl-C or an error).
+
+    Raises
+    ------
+    BistairError
+        A bad worker count, a scheduler that cannot be reached or has no workers.
+    """
+    check_workers(workers, scheduler)
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT, set_as_default=False)
+        except (OSError, TimeoutError, ValueError) as exc:
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise BistairError(f"cannot reach the Dask scheduler at {scheduler}: "
+                               f"{reason}") from None
+        try:
+            try:
+                client.wait_for_workers(1, timeout=WORKER_TIMEOUT)
+            except TimeoutError:
+                raise BistairError(f"the Dask scheduler at {scheduler} has no workers "
+                                   f"(none joined in {WORKER_TIMEOUT} s)") from None
+            yield client
+        finally:
+            client.close()
+        return
+    count = workers or default_workers()
+    if tasks is not None:
+        count = max(1, min(count, tasks))
+    # The worker processes start with Ctrl-C ignored (an ignored signal stays ignored in a
+    # new process): a Ctrl-C on the terminal reaches the whole process group, and only this
+    # process should answer it, by closing the cluster, rather than every worker dying with
+    # a traceback of its own.
+    handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
+    try:
+        with dask.config.set(WORKER_CONFIG):
+            cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
+                                   dashboard_address=None, silence_logs=logging.ERROR)
+    finally:
+        if handler is not None:
+            signal.signal(signal.SIGINT, handler)
+    try:
+        client = Client(cluster, set_as_default=False)
+        try:
+            yield client
+        finally:
+            client.close()
+    finally:
+        cluster.close()
+
+
+def _main_thread() -> bool:
+    return threading.current_thread() is threading.main_thread()
+
+
+def run_tasks(client: Client, func: Callable[..., Any], tasks: Sequence[tuple],
+              failed: Callable[[int, str], Any],
+              done: Callable[[int, Any], None] | None = None) -> list[Any]:
+    """Run ``func(*args)`` for every ``args`` in ``tasks`` on the client's workers; returns
+    the results in the order of ``tasks``.
+
+    ``func`` must be importable by the workers (a module-level function of bistair) and
+    should catch its own errors; a task that raises anyway or whose worker dies gives
+    ``failed(index, one-line message)`` as its result. ``done(index, result)`` is called in
+    the order the tasks finish (for progress). On any exception here (Ctrl-C) the tasks
+    not yet finished are cancelled before it propagates.
+    """
+    futures = [client.submit(func, *args, pure=False) for args in tasks]
+    where = {future.key: i for i, future in enumerate(futures)}
+    results: list[Any] = [None] * len(futures)
+    try:
+        for future in as_completed(futures, loop=client.loop):
+            i = where[future.key]
+            try:
+                value = future.result()
+            except Exception as exc:  # a bug in the task, a worker lost: record, go on
+                value = failed(i, one_line(exc))
+            results[i] = value
+            if done is not None:
+                done(i, value)
+    except BaseException:
+        with contextlib.suppress(Exception):
+            client.cancel(futures, force=True)
+        raise
+    return results
+
+
+def one_line(exc: BaseException) -> str:
+    """An exception as one line: its message's first line, else its type's name.
+
+    Examples
+    --------
+    >>> one_line(ValueError("bad value\\nmore"))
+    'bad value'
+    >>> one_line(MemoryError())
+    'not enough memory (MemoryError)'
+    """
+    if isinstance(exc, MemoryError):
+        return "not enough memory (MemoryError)"
+    text = str(exc).strip()
+    name = type(exc).__name__
+    if name == "KilledWorker":
+        return "its worker died while running it (out of memory or killed?)"
+    return text.splitlines()[0] if text else name
+
+
+def run_prefix() -> str:
+    """The temporaries' prefix of a new run: ``.bistair-batch-<12 hex digits>-``."""
+    return f"{BATCH_PREFIX}{uuid.uuid4().hex[:12]}-"
+
+
+def remove_run_temporaries(folders: Iterable[str | Path], prefix: str = BATCH_PREFIX
+                           ) -> list[Path]:
+    """Delete the temporaries named ``prefix*`` directly in each of ``folders`` (default:
+    those of every batch run); returns what was deleted."""
+    removed: list[Path] = []
+    for folder in dict.fromkeys(Path(f) for f in folders):
+        removed += remove_temporaries(folder, prefix)
+    return removed
