@@ -329,7 +329,7 @@ def jump_problem(violations: int, links: int, limit: float = 0.1,
     Parameters
     ----------
     violations : int
-        Phase jumps across which the orders do not step by one (:func:`wrap_steps`).
+        Phase jumps across which the orders do not step by one (e.g. :func:`wrap_steps`).
     links : int
         Phase jumps judged; with fewer than 200, nothing is said.
     limit : float

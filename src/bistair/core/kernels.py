@@ -581,7 +581,7 @@ def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.
     Parameters
     ----------
     raw : (F, H, W) array
-        The capture stack, any numeric dtype (C-contiguous).
+        The capture stack, any numeric dtype.
     start : int
         Index of the set's first frame.
     steps : int

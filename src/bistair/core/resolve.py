@@ -305,8 +305,8 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     Returns
     -------
     labels : (H, W) array
-        The labels with the detached parts numbered from ``n + 1`` and the too small parts
-        set to 0 (the input array itself when nothing is detached).
+        The labels with the detached parts numbered from ``n + 1`` and the parts too small
+        set to 0 (a new array once a part is found, else the input itself).
     n : int
         The new number of regions.
     detached : int
