@@ -190,7 +190,26 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
 def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
     """Pixels clipped by the camera: a frame at full scale where the fitted sinusoid's peak
     ``A + B`` exceeds it. An exact capture of a full-range pattern touches full scale with a
-    peak of exactly 1 and is not saturated."""
+    peak of exactly 1 and is not saturated.
+
+    Parameters
+    ----------
+    clipped : (H, W) bool array
+        Pixels where some frame reaches full scale (:attr:`Prepared.clipped`).
+    avg, mod : (H, W) array
+        Fitted average ``A`` and modulation ``B`` (fractions of full scale).
+
+    Returns
+    -------
+    (H, W) bool array
+        ``clipped & (A + B > 1.02)``.
+
+    Examples
+    --------
+    >>> saturation(np.array([True, True, False]), np.array([0.5, 0.6, 0.6]),
+    ...            np.array([0.5, 0.5, 0.5])).tolist()
+    [False, True, False]
+    """
     return clipped & (avg + mod > 1.02)
 
 
@@ -199,6 +218,26 @@ def modulation_threshold(noise: float, min_modulation: float | None = None) -> f
     given (checked by :func:`check_min_modulation`), else ``max(0.01, 4 * noise)`` (pure
     noise exceeds four sigma in about one pixel in ten million).
 
+    Parameters
+    ----------
+    noise : float
+        Camera noise sigma, fraction of full scale.
+    min_modulation : float, optional
+        A threshold asked for, strictly between 0 and 1.
+
+    Returns
+    -------
+    float
+        The threshold, fraction of full scale.
+
+    Raises
+    ------
+    BistairError
+        If ``min_modulation`` is given and not strictly between 0 and 1
+        (:func:`check_min_modulation`).
+
+    Examples
+    --------
     >>> modulation_threshold(0.005), modulation_threshold(0.001), modulation_threshold(0.0, 0.2)
     (0.02, 0.01, 0.2)
     """
@@ -211,6 +250,11 @@ def modulation_threshold(noise: float, min_modulation: float | None = None) -> f
 def check_min_modulation(min_modulation: float | None) -> None:
     """Refuse a modulation threshold outside ``(0, 1)`` (a fraction of full scale; ``None``
     asks for the default from the noise).
+
+    Parameters
+    ----------
+    min_modulation : float or None
+        The threshold asked for, or ``None`` for the default.
 
     Raises
     ------
@@ -236,7 +280,27 @@ def check_min_modulation(min_modulation: float | None) -> None:
 
 
 def validity(mod: np.ndarray, saturated: np.ndarray, threshold: float) -> np.ndarray:
-    """Pixels with at least ``threshold`` modulation and no saturation."""
+    """Pixels with at least ``threshold`` modulation and no saturation.
+
+    Parameters
+    ----------
+    mod : (H, W) array
+        Modulation ``B`` (fraction of full scale).
+    saturated : (H, W) bool array
+        Saturated pixels (:func:`saturation`).
+    threshold : float
+        The modulation a valid pixel needs (:func:`modulation_threshold`).
+
+    Returns
+    -------
+    (H, W) bool array
+        ``(mod >= threshold) & ~saturated``.
+
+    Examples
+    --------
+    >>> validity(np.array([0.005, 0.2, 0.3]), np.array([False, False, True]), 0.01).tolist()
+    [False, True, False]
+    """
     return (mod >= threshold) & ~saturated
 
 
@@ -246,8 +310,28 @@ def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: floa
     (``clipped``: pixels with a frame at full scale) or, when a ``min_modulation`` was asked
     for, how much modulation the captures have (``mod``).
 
+    Captures pass when at least ``max(50, pixels / 10000)`` pixels are valid.
+
+    Parameters
+    ----------
+    valid : (H, W) bool array
+        The valid pixels.
+    clipped : (H, W) bool array
+        Pixels where some frame reaches full scale.
+    min_modulation : float, optional
+        The modulation threshold asked for, if any.
+    mod : (H, W) array, optional
+        Modulation ``B`` (fraction of full scale), reported with ``min_modulation``.
+
+    Raises
+    ------
+    BistairError
+        If too few pixels are valid: the message names the modulation asked for and the
+        most there is, or calls the captures saturated (over 25% of pixels clipped) or dark.
+
     Examples
     --------
+    >>> check_decodable(np.ones((20, 20), bool), np.zeros((20, 20), bool))
     >>> check_decodable(np.zeros((20, 20), bool), np.zeros((20, 20), bool), 0.6,
     ...                 np.full((20, 20), 0.3))
     Traceback (most recent call last):
@@ -273,6 +357,23 @@ def to_bit_depth(values: np.ndarray, bits: int, as_float: bool = False) -> np.nd
     """Values in [0, 1] (clipped) as the integer codes of a ``bits``-deep image: uint8 for 8
     bits, uint16 above; with ``as_float`` the codes divided by full scale, as float32.
 
+    Parameters
+    ----------
+    values : ndarray
+        Intensities as fractions of full scale; values outside [0, 1] are clipped.
+    bits : int
+        Bit depth of the image (at most 16).
+    as_float : bool
+        Return the quantised values as float32 fractions of full scale instead of codes.
+
+    Returns
+    -------
+    ndarray
+        Codes ``round(values * (2**bits - 1))`` (uint8 up to 8 bits, else uint16), or those
+        codes over ``2**bits - 1`` as float32; same shape as ``values``.
+
+    Examples
+    --------
     >>> to_bit_depth(np.array([0.0, 0.5, 1.2]), 8).tolist()
     [0, 128, 255]
     >>> to_bit_depth(np.array([0.5]), 2, as_float=True).tolist()

@@ -65,15 +65,35 @@ def edge_alignment(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray,
 
     Parameters
     ----------
-    phi : wrapped phase in ``[0, 2*pi)``.
-    edges : the code as read from its own patterns, -1 where not read.
-    valid : pixels whose phase counts.
-    edge_phase : the wrapped phase at which the code's edges should sit.
-    levels : the code's cycle, if it has one.
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    edges : (H, W) int array
+        The code as read from its own patterns, -1 where not read.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+    edge_phase : float
+        The wrapped phase (radians) at which the code's edges should sit.
+    levels : int, optional
+        The code's cycle, if it has one.
 
     Returns
     -------
     EdgeCheck
+        The number of steps judged, the circular mean of their phase relative to
+        ``edge_phase`` and its spread, and the share of steps where the phase falls as the
+        code grows (all zero when no step counts).
+
+    Examples
+    --------
+    >>> x = np.arange(120.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 20) % (2 * np.pi), (4, 1)).astype(np.float32)
+    >>> code = np.tile((x // 20).astype(np.int32), (4, 1))
+    >>> ok = np.ones(phi.shape, bool)
+    >>> check = edge_alignment(phi, code, ok)
+    >>> check.edges, abs(round(check.crossing, 3)), round(check.spread, 3), check.reversed
+    (20, 0.0, 1.0, 0.0)
+    >>> edge_alignment(np.float32(2 * np.pi) - phi, code, ok).reversed  # shifts run backwards
+    1.0
     """
     e = np.where(valid, edges, -1)
     a0, a, b, b1 = e[:, :-3], e[:, 1:-2], e[:, 2:-1], e[:, 3:]
@@ -101,11 +121,34 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     steps more than pi/3 off their expected phase (with the steps concentrated, spread
     >= 0.5) mean the phase offset is wrong; more than 0.25 rad is worth a warning.
 
+    Parameters
+    ----------
+    check : EdgeCheck
+        The result of :func:`edge_alignment` (at least ``MIN_EDGES`` steps to say anything).
+    phase_offset : float
+        The spec's phase offset in radians (to suggest the one that fits).
+    shift_sign : int
+        The spec's shift direction, +1 or -1 (to suggest the other).
+    edge_phase : float
+        The wrapped phase (radians) at which the code's edges should sit.
+
+    Returns
+    -------
+    tuple of (str, str) or None
+        ``("refuse", message)`` for reversed shifts or an offset more than pi/3 off,
+        ``("warn", message)`` for an offset between 0.25 rad and pi/3 off, else ``None``.
+
+    Examples
+    --------
     >>> kind, message = convention_problem(EdgeCheck(500, 3.1, 0.9, 20, 0.1), 0.0, 1)
     >>> kind, message.split(": ")[1]
     ('refuse', 'is phase_offset pi?')
     >>> convention_problem(EdgeCheck(500, 0.02, 0.9, 400, 0.97), 0.0, 1)[0]
     'refuse'
+    >>> convention_problem(EdgeCheck(500, 0.4, 0.9, 400, 0.0), 0.0, 1)[0]
+    'warn'
+    >>> convention_problem(EdgeCheck(20, 3.1, 0.9, 20, 0.0), 0.0, 1) is None  # too few steps
+    True
     """
     if check.edges < MIN_EDGES:
         return None
@@ -132,6 +175,27 @@ def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str,
     along the rows) changes more than ``factor`` times as fast down the columns as along
     the rows, i.e. the fringes run along the image's coded axis instead of across it.
 
+    The median absolute wrapped phase differences are taken on every fourth row and second
+    column; with fewer than 500 of either, nothing is said.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``, in the column layout.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+    orientation : str
+        The spec's orientation, ``"columns"`` or ``"rows"`` (for the message).
+    factor : float
+        How many times faster the phase must change across than along to refuse.
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None`` when the fringes run the expected way (or too few pixels).
+
+    Examples
+    --------
     >>> x = np.arange(128.0)
     >>> phi = np.tile((2 * np.pi * x / 16) % (2 * np.pi), (64, 1)).astype(np.float32)
     >>> ok = np.ones(phi.shape, bool)
@@ -157,6 +221,24 @@ def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str,
 def outside_problem(decoded: int, outside: int, length: int) -> str | None:
     """A one-line reason to refuse when many decoded pixels land outside the projector.
 
+    Many means at least 100 pixels and more than 10% of all decoded ones (inside and out).
+
+    Parameters
+    ----------
+    decoded : int
+        Pixels decoded inside the projector.
+    outside : int
+        Pixels whose coordinates fall outside ``[0, length)``.
+    length : int
+        Projector pixels along the coded axis.
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None`` when few pixels land outside.
+
+    Examples
+    --------
     >>> outside_problem(900, 5000, 1080)[:40]
     'the coordinates of 85% of the decoded pi'
     >>> outside_problem(90000, 40, 1080) is None
@@ -244,6 +326,26 @@ def jump_problem(violations: int, links: int, limit: float = 0.1,
     than ``limit`` of the phase jumps (the code does not fit the spec's levels), or are off
     by two or more orders at more than ``big_limit`` of them.
 
+    Parameters
+    ----------
+    violations : int
+        Phase jumps across which the orders do not step by one (e.g. :func:`wrap_steps`).
+    links : int
+        Phase jumps judged; with fewer than 200, nothing is said.
+    limit : float
+        Share of violations above which to refuse.
+    big : int
+        Violations by two or more orders.
+    big_limit : float
+        Share of big violations above which to refuse.
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None`` when the orders step as they should.
+
+    Examples
+    --------
     >>> jump_problem(600, 2000)[:36]
     'the fringe orders do not step by one'
     >>> jump_problem(150, 2000) is None, jump_problem(150, 2000, limit=0.05) is None
@@ -271,6 +373,24 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     """Median distance of the stair phases from the nearest level, in halves of that
     level's distance to its neighbour (0: on the levels, 1: halfway between two).
 
+    The median is taken over at most 20000 valid pixels on every fourth row and column.
+
+    Parameters
+    ----------
+    theta : (H, W) float array
+        Decoded stair phase in radians.
+    valid : (H, W) bool array
+        Pixels whose stair phase counts.
+    levels : (L,) float array
+        The stair levels' phases in radians.
+
+    Returns
+    -------
+    float
+        The median misfit; 0.0 when no pixel counts.
+
+    Examples
+    --------
     >>> lv = np.array([-2.0, 0.0, 2.0])
     >>> round(stair_misfit(np.array([[0.1, 1.0, -2.0]]), np.ones((1, 3), bool), lv), 2)
     0.1
@@ -288,6 +408,21 @@ def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:
     """Median RMS residual of the N-step sinusoid fit over its modulation, for
     ``samples`` of shape (N, pixels) (0 for N = 3, which has no redundancy).
 
+    Parameters
+    ----------
+    samples : (N, pixels) array
+        The N-step intensities of some pixels.
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+
+    Returns
+    -------
+    float
+        Median over the pixels of the RMS residual (``N - 3`` degrees of freedom) divided by
+        the fitted modulation; 0.0 for N <= 3 or no pixels.
+
+    Examples
+    --------
     >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
     >>> phi = np.linspace(0, 6, 50)[None]
     >>> round(fit_residual(0.5 + 0.3 * np.cos(phi + d)), 6)
@@ -311,6 +446,20 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
     ``None`` when the set fits or no exchange helps (an uncompensated gamma leaves a
     residual that no exchange removes).
 
+    Parameters
+    ----------
+    samples : (N, pixels) array
+        The N-step intensities of some pixels, in the captured frame order.
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+
+    Returns
+    -------
+    tuple of (int, int) or None
+        The 0-based indices ``(i, j)``, ``i < j``, of the frames that look swapped.
+
+    Examples
+    --------
     >>> d = 2 * np.pi * np.arange(5)[:, None] / 5
     >>> frames = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
     >>> swapped_frames(frames) is None, swapped_frames(frames[[0, 2, 1, 3, 4]])

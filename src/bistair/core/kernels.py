@@ -32,7 +32,31 @@ _COMPILED: dict[str, Any] = {}
 
 
 def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
-    """Compile the decorated function with ``numba.njit`` on its first call."""
+    """Compile the decorated function with ``numba.njit`` on its first call.
+
+    The compiled function is kept per function name and cached on disk (``cache=True``);
+    the plain Python function stays available as the wrapper's ``py_func``. Helpers marked
+    for inlining are compiled into the kernels when the first kernel compiles.
+
+    Parameters
+    ----------
+    parallel : bool
+        Compile with ``parallel=True``, so that loops over ``prange`` run on every core.
+
+    Returns
+    -------
+    callable
+        A decorator: it takes the kernel's Python function and returns a wrapper with the
+        same name and signature (positional arguments only).
+
+    Examples
+    --------
+    >>> def total(a):
+    ...     return a.sum()
+    >>> compiled = kernel()(total)  # nothing is compiled until the first call
+    >>> compiled.__name__, compiled.py_func is total
+    ('total', True)
+    """
 
     def wrap(fn: Callable) -> Callable:
         @wraps(fn)
@@ -59,7 +83,26 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
 
 
 def set_threads(count: int | None) -> int:
-    """Use ``count`` threads in the kernels (all cores when ``None``); returns the count."""
+    """Use ``count`` threads in the kernels (all cores when ``None``); returns the count.
+
+    Parameters
+    ----------
+    count : int or None
+        Threads for the parallel kernels, capped at numba's ``NUMBA_NUM_THREADS``; ``None``
+        (or 0) for every core.
+
+    Returns
+    -------
+    int
+        The number of threads numba now uses.
+
+    Examples
+    --------
+    >>> set_threads(1)
+    1
+    >>> set_threads(None) >= 1  # back to every core
+    True
+    """
     import numba
 
     count = count or os.cpu_count() or 1
@@ -120,6 +163,35 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
     (``y``), averaged over windows of columns: ``[x-half, x+half)`` around a pixel (for the
     vertical links), ``[x-half, x)`` and ``[x+1, x+1+half)`` either side of a horizontal
     link. Float32 throughout, in the order of the NumPy formulation.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+    noise : (H, W) float32 array
+        Per-pixel phase noise in radians.
+    half : int
+        Window length in pixels (each window also needs ``half`` valid gradients).
+    relative : float
+        Share of the larger mean gradient by which the two must differ.
+
+    Returns
+    -------
+    vert : (H-1, W) bool array
+        Links between each pixel and the one below it to cut.
+    horiz : (H, W-1) bool array
+        Links between each pixel and the one to its right to cut.
+
+    Examples
+    --------
+    >>> x = np.arange(40, dtype=np.float32)
+    >>> phi = np.tile(np.where(x < 20, 0.2 * x, 0.6 * x) % np.float32(2 * np.pi), (6, 1))
+    >>> vert, horiz = period_jump_links(phi, np.ones(phi.shape, bool),
+    ...                                 np.full(phi.shape, 0.01, np.float32), 3, 0.3)
+    >>> np.flatnonzero(horiz[0]).tolist(), bool(vert.any())
+    ([16, 17, 18, 19, 21, 22], False)
     """
     h, w = phi.shape
     rel = np.float32(relative)
@@ -192,6 +264,40 @@ def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
     along the rows, in a run of links against the phase's direction ``sign`` whose fall
     exceeds ``max(0.15, 4 sigma)`` (``sigma``: ``sqrt(2)`` times the larger per-pixel phase
     noise of a link, ``noise``; both ends dropped).
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels to link.
+    cut : float
+        Phase step (radians) above which a link is cut.
+    sign : int
+        +1 or -1, the phase's direction along the rows.
+    noise : (H, W) float32 array
+        Per-pixel phase noise in radians.
+    jump_v, jump_h : (H-1, W) and (H, W-1) bool arrays
+        Vertical and horizontal links to cut as well.
+
+    Returns
+    -------
+    vert : (H-1, W) bool array
+        Links between each pixel and the one below it that connect.
+    horiz : (H, W-1) bool array
+        Links between each pixel and the one to its right that connect.
+    keep : (H, W) bool array
+        Valid pixels that no cut link dropped.
+
+    Examples
+    --------
+    >>> x = np.arange(60.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (3, 1)).astype(np.float32)
+    >>> vert, horiz, keep = fringe_links(phi, np.ones(phi.shape, bool), 1.0, 1,
+    ...                                  np.full(phi.shape, 0.02, np.float32),
+    ...                                  np.zeros((2, 60), bool), np.zeros((3, 59), bool))
+    >>> keep[0, 28:32].tolist(), horiz[0, 27:31].tolist(), bool(vert.all())  # a wrap at 29|30
+    ([True, False, True, True], [True, True, False, True], True)
     """
     h, w = phi.shape
     cut32 = np.float32(cut)
@@ -280,7 +386,33 @@ def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.n
              horiz: np.ndarray, passes: int) -> None:
     """Give valid pixels that were dropped the label of a neighbour they are linked to
     (below, above, right, left: the first labelled one), ``passes`` times, in place; each
-    pass reads the labels the previous one left."""
+    pass reads the labels the previous one left.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Region labels (0: none), changed in place.
+    valid : (H, W) bool array
+        Valid pixels.
+    keep : (H, W) bool array
+        Pixels that kept their label (the others, if valid, are reattached).
+    vert : (H-1, W) bool array
+        Links between each pixel and the one below it that connect.
+    horiz : (H, W-1) bool array
+        Links between each pixel and the one to its right that connect.
+    passes : int
+        Rounds of reattachment.
+
+    Examples
+    --------
+    >>> labels = np.array([[1, 0, 2], [1, 1, 2]], np.int32)
+    >>> keep = np.array([[True, False, True], [True, True, True]])
+    >>> vert = np.array([[False, True, False]])
+    >>> horiz = np.array([[False, True], [True, True]])
+    >>> reattach(labels, np.ones((2, 3), bool), keep, vert, horiz, 1)
+    >>> labels.tolist()  # linked right and below: the one below wins
+    [[1, 1, 2], [1, 1, 2]]
+    """
     h, w = labels.shape
     ys = []
     xs = []
@@ -323,7 +455,33 @@ def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Sums of ``values`` (V, H, W) per (label, row) over the labelled pixels (label > 0):
     ``(keys, counts, sums (V, K))``, ``keys = label * H + row`` ascending. Float64 sums in
-    raster order, as ``np.bincount`` adds them."""
+    raster order, as ``np.bincount`` adds them.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Region labels, 0 outside any.
+    values : (V, H, W) float32 array
+        The V quantities to sum.
+    n_labels : int
+        Highest label.
+
+    Returns
+    -------
+    keys : (K,) int64 array
+        ``label * H + row`` of each (label, row) with pixels, ascending.
+    counts : (K,) int64 array
+        Pixels per key.
+    sums : (V, K) float64 array
+        Each quantity's sum per key.
+
+    Examples
+    --------
+    >>> labels = np.array([[1, 1, 2], [0, 2, 2]], np.int32)
+    >>> values = np.arange(6, dtype=np.float32).reshape(1, 2, 3)
+    >>> [a.tolist() for a in label_row_sums(labels, values, 2)]
+    [[2, 4, 5], [2, 1, 2], [[1.0, 2.0, 9.0]]]
+    """
     nv, h, w = values.shape
     n_bins = (n_labels + 1) * h
     count = np.zeros(n_bins, np.int64)
@@ -359,7 +517,33 @@ def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Neighbour pairs of different regions across a phase wrap, walking down the columns
     and along the rows (a wrap along a row against the phase's direction ``sign`` is left
-    out): ``(src, dst, step)``, step +1 where the phase falls from ``src`` to ``dst``."""
+    out): ``(src, dst, step)``, step +1 where the phase falls from ``src`` to ``dst``.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    labels : (H, W) int32 array
+        Region labels, 0 outside any.
+    sign : int
+        +1 or -1, the phase's direction along the rows.
+
+    Returns
+    -------
+    src, dst : int64 arrays
+        Labels of the first and second pixel of each pair (one entry per pixel pair).
+    step : int64 array
+        +1 where the phase falls across the wrap (from near 2*pi to near 0), else -1.
+
+    Examples
+    --------
+    >>> phi = np.float32([[5.0, 6.0, 0.5, 1.5]])
+    >>> labels = np.int32([[1, 1, 2, 2]])
+    >>> [a.tolist() for a in wrap_links(phi, labels, 1)]
+    [[1], [2], [1]]
+    >>> [a.tolist() for a in wrap_links(phi, labels, -1)]  # against the phase's direction
+    [[], [], []]
+    """
     h, w = phi.shape
     src = []
     dst = []
@@ -392,7 +576,38 @@ def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.
     """``(num, den, avg)`` of frames ``start .. start+steps-1`` of a raw capture stack (any
     dtype; each value times ``scale`` is its fraction of full scale): ``num = -sum
     sin_w[n] I_n``, ``den = sum cos_w[n] I_n`` and the mean, in one pass (float32, summed in
-    frame order as :func:`bistair.core.phase.wrapped_phase` sums them)."""
+    frame order as :func:`bistair.core.phase.wrapped_phase` sums them).
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The capture stack, any numeric dtype.
+    start : int
+        Index of the set's first frame.
+    steps : int
+        Number of frames ``N`` of the set.
+    scale : float
+        Factor that turns a raw value into a fraction of full scale.
+    sin_w, cos_w : (N,) float32 arrays
+        Sine and cosine of each frame's phase shift.
+
+    Returns
+    -------
+    num, den, avg : (H, W) float32 arrays
+        The two sums (for :func:`bistair.core.phase.phase_of_sums`) and the average
+        intensity ``A``, fraction of full scale.
+
+    Examples
+    --------
+    >>> from bistair.core.phase import phase_of_sums, shifts_of
+    >>> d = shifts_of(4)
+    >>> raw = np.round(127.5 + 102 * np.cos(np.array([0.5, 2.0, 4.0]) + d[:, None, None]))
+    >>> num, den, avg = nstep_sums(raw.astype(np.uint8), 0, 4, 1 / 255,
+    ...                            np.sin(d).astype(np.float32), np.cos(d).astype(np.float32))
+    >>> phi, mod = phase_of_sums(num, den, 4)
+    >>> [a.astype(float).round(2).tolist() for a in (phi, mod, avg)]
+    [[[0.5, 2.0, 4.0]], [[0.4, 0.4, 0.4]], [[0.5, 0.5, 0.5]]]
+    """
     _, h, w = raw.shape
     s32 = np.float32(scale)
     num = np.empty((h, w), np.float32)
@@ -421,7 +636,38 @@ def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np
     """Horizontal links (H, W-1) where the stair phase (given by its cosine and sine) turns
     by more than ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of
     the link, away from the phase jumps (see
-    :func:`bistair.codecs.bidirectional.stair_edges`)."""
+    :func:`bistair.codecs.bidirectional.stair_edges`).
+
+    Away from the phase jumps means the wrapped phase of the link's left pixel lies
+    between 15% and 85% of ``2*pi``; all four pixels must be valid.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    cos_t, sin_t : (H, W) float32 arrays
+        Cosine and sine of the stair phase.
+    valid : (H, W) bool array
+        Valid pixels.
+    noise : (H, W) float32 array
+        Per-pixel stair phase noise in radians (``spread`` combines those of the pairs).
+    step : float
+        The local stair step in radians (``2*pi / stairs``).
+
+    Returns
+    -------
+    (H, W-1) bool array
+        Links between each pixel and the one to its right where the stair phase turns.
+
+    Examples
+    --------
+    >>> theta = np.where(np.arange(12) < 6, -2.0, 1.0).astype(np.float32)[None].repeat(2, axis=0)
+    >>> phi = np.full((2, 12), np.pi, np.float32)
+    >>> edge = stair_turns(phi, np.cos(theta), np.sin(theta), np.ones((2, 12), bool),
+    ...                    np.full((2, 12), 0.01, np.float32), 2 * np.pi / 3)
+    >>> [np.flatnonzero(row).tolist() for row in edge]
+    [[5], [5]]
+    """
     h, w = phi.shape
     edge = np.zeros((h, w - 1), np.bool_)
     lo = np.float32(0.15 * 2.0 * math.pi)
@@ -455,7 +701,27 @@ def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np
 
 @kernel(parallel=True)
 def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
-    """:func:`bistair.core.stair.quantize` of a float32 phase map, -1 where not ``valid``."""
+    """:func:`bistair.core.stair.quantize` of a float32 phase map, -1 where not ``valid``.
+
+    Parameters
+    ----------
+    theta : (H, W) float32 array
+        Stair phase in radians.
+    levels : int
+        Number of steps of the stair.
+    valid : (H, W) bool array
+        Pixels to quantise.
+
+    Returns
+    -------
+    (H, W) int32 array
+        Level ``floor((theta + pi) * levels / (2*pi)) mod levels``, -1 where not valid.
+
+    Examples
+    --------
+    >>> quantize32(np.float32([[-3.0, 0.0, 3.0]]), 4, np.array([[True, True, False]])).tolist()
+    [[0, 2, -1]]
+    """
     h, w = theta.shape
     scale = np.float32(levels / (2.0 * math.pi))
     out = np.empty((h, w), np.int32)
@@ -472,7 +738,35 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
 def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
                   min_strong: int, min_size: int) -> np.ndarray:
     """``strong | (weak & region kept)``, a region kept when it holds ``min_strong`` strong
-    pixels or ``min_size`` pixels (see :func:`bistair.core.measure.coherent_pixels`)."""
+    pixels or ``min_size`` pixels (see :func:`bistair.core.measure.coherent_pixels`).
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Fringe regions of the weak mask, 0 outside any (never kept).
+    weak : (H, W) bool array
+        Pixels with at least the lower modulation threshold.
+    strong : (H, W) bool array
+        Pixels with at least the full modulation threshold.
+    n : int
+        Highest label.
+    min_strong : int
+        Strong pixels that keep a region.
+    min_size : int
+        Pixels in all that keep a region.
+
+    Returns
+    -------
+    (H, W) bool array
+        The pixels to count as valid.
+
+    Examples
+    --------
+    >>> labels = np.int32([[1, 1, 1, 2, 2, 0]])
+    >>> strong = np.array([[True, False, False, False, False, False]])
+    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10).tolist()
+    [[True, True, True, False, False, False]]
+    """
     h, w = labels.shape
     size = np.zeros(n + 1, np.int64)
     bright = np.zeros(n + 1, np.int64)

@@ -73,6 +73,32 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
     change) are used instead, ``sigma = median|d2| / (0.6745 * sqrt(6))``.
 
     Pixels that a frame clips (or that read exactly 0) are left out.
+
+    Parameters
+    ----------
+    frames : (N, H, W) array or ScaledStack
+        The N-step frames as fractions of full scale, in the column layout.
+    phi, avg, mod : (H, W) array
+        The set's fitted wrapped phase (radians), average and modulation.
+    shift_sign, phase_offset : int, float
+        The rig's phase convention (:func:`~bistair.core.phase.wrapped_phase`).
+
+    Returns
+    -------
+    float
+        The noise sigma, fraction of full scale.
+
+    Examples
+    --------
+    >>> from bistair.core.phase import phase_shift_patterns, wrapped_phase
+    >>> rng = np.random.default_rng(0)
+    >>> x = np.tile(np.arange(128.0), (64, 1))
+    >>> frames = phase_shift_patterns(x, 32, 4, amplitude=0.4) + rng.normal(0, 0.01, (4, 64, 128))
+    >>> round(noise_level(frames, *wrapped_phase(frames)), 3)
+    0.01
+    >>> frames = phase_shift_patterns(x, 32, 3, amplitude=0.4) + rng.normal(0, 0.01, (3, 64, 128))
+    >>> round(noise_level(frames, *wrapped_phase(frames)), 3)  # N = 3: along the fringes
+    0.01
     """
     steps = frames.shape[0]
     if steps <= 3:
@@ -126,6 +152,52 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
       whose phases do not join into regions (:func:`coherent_pixels`).
 
     With ``check``, captures with (almost) no valid pixel are refused as dark or saturated.
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The capture stack (:func:`~bistair.core.captures.prepare`).
+    start : int
+        Index of the set's first frame in ``prepared``.
+    steps : int
+        Number of frames ``N`` of the set (at least 3).
+    min_modulation : float, optional
+        The modulation a valid pixel needs (fraction of full scale, strictly between 0 and
+        1); from the noise when not given.
+    check : bool
+        Refuse captures with (almost) nothing to decode.
+    shift_sign, phase_offset : int, float
+        The rig's phase convention.
+    coherent : bool
+        Also accept dim pixels in coherent fringe regions (see above).
+
+    Returns
+    -------
+    FringeSet
+        Float32 (H, W) wrapped phase in ``[0, 2*pi)``, average and modulation (fractions of
+        full scale), the bool validity mask, the noise sigma, ``steps`` and the modulation
+        threshold.
+
+    Raises
+    ------
+    BistairError
+        With ``check``, if the captures are dark or saturated or no pixel has
+        ``min_modulation`` (:func:`~bistair.core.captures.check_decodable`); if
+        ``min_modulation`` is not strictly between 0 and 1.
+
+    Examples
+    --------
+    >>> from bistair.core.captures import prepare
+    >>> x = np.tile(np.arange(64.0), (16, 1))
+    >>> shifts = 2 * np.pi * np.arange(4)[:, None, None] / 4
+    >>> stack = np.round(255 * (0.5 + 0.3 * np.cos(2 * np.pi * x / 16 + shifts))).astype(np.uint8)
+    >>> fs = measure(prepare(stack, 4, "demo"), 0, 4)
+    >>> fs.phi.shape, fs.phi.dtype.name, bool(fs.valid.all()), round(float(fs.mod.mean()), 3)
+    ((16, 64), 'float32', True, 0.3)
+    >>> measure(prepare(np.full((4, 16, 64), 9, np.uint8), 4, "demo"), 0, 4)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: captures are dark: no pixel has enough fringe modulation to decode
     """
     shifts = shifts_of(steps, shift_sign)
     raw = prepared.raw if prepared.raw.flags.c_contiguous else np.ascontiguousarray(prepared.raw)
@@ -159,6 +231,38 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
 
     Noise has random phases: its pixels do not join into fringe regions, so a dim pixel
     whose phase runs on smoothly with a region's is part of a lit surface.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    weak : (H, W) bool array
+        Pixels with at least the lower modulation threshold (a superset of ``strong``).
+    strong : (H, W) bool array
+        Pixels with at least the full modulation threshold.
+    phase_noise : (H, W) float32 array
+        Per-pixel phase noise in radians (:func:`~bistair.core.regions.fringe_regions`).
+    min_strong : int
+        Strong pixels that keep a region.
+    min_size : int
+        Pixels in all that keep a region.
+
+    Returns
+    -------
+    (H, W) bool array
+        The pixels to count as valid.
+
+    Examples
+    --------
+    >>> rng = np.random.default_rng(0)
+    >>> phi = np.tile((2 * np.pi * (np.arange(60.0) + 0.5) / 30) % (2 * np.pi), (20, 1))
+    >>> phi[:, 35:] = rng.uniform(0, 2 * np.pi, (20, 25))  # noise on the right
+    >>> weak = np.ones(phi.shape, bool)
+    >>> weak[:, 30:35] = False
+    >>> keep = coherent_pixels(phi.astype(np.float32), weak, np.zeros(phi.shape, bool),
+    ...                        np.full(phi.shape, 0.02, np.float32))
+    >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any())
+    (True, False)
     """
     labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
     return keep_coherent(labels, weak, strong, n, min_strong, min_size)

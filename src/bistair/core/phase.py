@@ -28,6 +28,22 @@ TWO_PI = 2.0 * np.pi
 def shifts_of(steps: int, shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
     """The phase added to frame ``n``: ``phase_offset + shift_sign*2*pi*n/steps`` (float64).
 
+    Parameters
+    ----------
+    steps : int
+        Number of frames ``N`` of the set.
+    shift_sign : int
+        +1 or -1: the direction the shifts run (see the module docstring).
+    phase_offset : float
+        Phase added to every frame, in radians.
+
+    Returns
+    -------
+    ndarray
+        Float64 array of shape (steps,), in radians.
+
+    Examples
+    --------
     >>> shifts_of(4, -1).round(4).tolist()
     [0.0, -1.5708, -3.1416, -4.7124]
     """
@@ -41,7 +57,30 @@ def phase_shift_patterns(
     """Intensities ``offset + amplitude*cos(2*pi*x/period + phase_offset +
     shift_sign*2*pi*n/steps)``, n = 0..steps-1.
 
-    Returns an array of shape ``(steps, *x.shape)``.
+    Parameters
+    ----------
+    x : ndarray
+        Projector coordinate along the coded axis (projector pixels), any shape.
+    period : float
+        Fringe period in projector pixels.
+    steps : int
+        Number of frames ``N``.
+    offset, amplitude : float
+        Pattern offset ``a`` and amplitude ``b`` (fractions of full scale).
+    phase_offset : float
+        Phase added to every frame, in radians.
+    shift_sign : int
+        +1 or -1: the direction the shifts run.
+
+    Returns
+    -------
+    ndarray
+        Float64 array of shape ``(steps, *x.shape)``.
+
+    Examples
+    --------
+    >>> phase_shift_patterns(np.array([0.0, 1.0]), period=4, steps=4).round(3).tolist()
+    [[1.0, 0.5], [0.5, 0.0], [0.0, 0.5], [0.5, 1.0]]
     """
     shifts = shifts_of(steps, shift_sign, phase_offset)
     shifts = shifts.reshape((steps,) + (1,) * np.ndim(x))
@@ -58,12 +97,34 @@ def wrapped_phase(frames: np.ndarray, shift_sign: int = 1, phase_offset: float =
 
     Parameters
     ----------
-    frames : (N, H, W) array, any dtype.
-    shift_sign, phase_offset : the rig's phase convention (see the module docstring).
+    frames : (N, H, W) array
+        The N-step stack, any dtype (values as they are: fractions of full scale for a
+        prepared capture); N >= 3.
+    shift_sign, phase_offset : int, float
+        The rig's phase convention (see the module docstring).
 
     Returns
     -------
-    phi, A, B : float32 arrays of shape (H, W).
+    phi : ndarray
+        Float32 wrapped phase in ``[0, 2*pi)``, shape (H, W).
+    A : ndarray
+        Float32 average intensity, shape (H, W).
+    B : ndarray
+        Float32 modulation (amplitude of the fitted sinusoid), shape (H, W).
+
+    Raises
+    ------
+    ValueError
+        If the stack has fewer than 3 frames.
+
+    Examples
+    --------
+    >>> frames = phase_shift_patterns(np.array([[1.0, 2.0, 3.0]]), period=4, steps=4)
+    >>> phi, avg, mod = wrapped_phase(frames)
+    >>> phi.astype(float).round(4).tolist()
+    [[1.5708, 3.1416, 4.7124]]
+    >>> round(float(avg.mean()), 4), round(float(mod.mean()), 4)
+    (0.5, 0.5)
     """
     stack = np.asarray(frames, dtype=np.float32)
     steps = stack.shape[0]
@@ -80,7 +141,30 @@ def wrapped_phase(frames: np.ndarray, shift_sign: int = 1, phase_offset: float =
 def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: float = 0.0
                   ) -> tuple[np.ndarray, np.ndarray]:
     """The wrapped phase in ``[0, 2*pi)`` and the modulation of an N-step set from its sums
-    ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32)."""
+    ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32).
+
+    Parameters
+    ----------
+    num, den : ndarray
+        The sums over the frames, float32 arrays of the same shape (H, W).
+    steps : int
+        Number of frames ``N`` the sums are over.
+    phase_offset : float
+        The rig's phase offset in radians, subtracted from the phase.
+
+    Returns
+    -------
+    phi : ndarray
+        Float32 wrapped phase in ``[0, 2*pi)``.
+    mod : ndarray
+        Float32 modulation ``B = 2/N * hypot(num, den)``.
+
+    Examples
+    --------
+    >>> phi, mod = phase_of_sums(np.float32([0.0, 2.0, -2.0]), np.float32([2.0, 0.0, 0.0]), 4)
+    >>> phi.astype(float).round(4).tolist(), mod.tolist()
+    ([0.0, 1.5708, 4.7124], [1.0, 1.0, 1.0])
+    """
     phi = np.arctan2(num, den)
     if phase_offset:
         phi = (phi - np.float32(phase_offset)) % np.float32(TWO_PI)
@@ -93,7 +177,30 @@ def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: fl
 
 def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
               shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
-    """The N-step stack minus its fitted sinusoid, shape (N, ...)."""
+    """The N-step stack minus its fitted sinusoid, shape (N, ...).
+
+    Parameters
+    ----------
+    frames : (N, ...) array
+        The N-step stack, any dtype.
+    phi, avg, mod : ndarray
+        The fitted wrapped phase (radians), average and modulation (:func:`wrapped_phase`),
+        of the frames' pixel shape.
+    shift_sign, phase_offset : int, float
+        The rig's phase convention (see the module docstring).
+
+    Returns
+    -------
+    ndarray
+        Float32 ``frames - (avg + mod*cos(phi + shifts))``, shape (N, ...).
+
+    Examples
+    --------
+    >>> frames = phase_shift_patterns(np.arange(3.0), period=12, steps=4)
+    >>> res = residuals(frames, *wrapped_phase(frames))
+    >>> res.shape, bool(np.abs(res).max() < 1e-6)
+    ((4, 3), True)
+    """
     stack = np.asarray(frames, dtype=np.float32)
     steps = stack.shape[0]
     shifts = shifts_of(steps, shift_sign, phase_offset).astype(np.float32)
@@ -103,20 +210,76 @@ def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndar
 
 def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
                    shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
-    """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy)."""
+    """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy).
+
+    The squared residuals are summed over the frames and divided by the ``N - 3`` degrees of
+    freedom the fit leaves (1 for N = 3).
+
+    Parameters
+    ----------
+    frames : (N, ...) array
+        The N-step stack, any dtype.
+    phi, avg, mod : ndarray
+        The fitted wrapped phase (radians), average and modulation (:func:`wrapped_phase`).
+    shift_sign, phase_offset : int, float
+        The rig's phase convention (see the module docstring).
+
+    Returns
+    -------
+    ndarray
+        Float32 RMS residual per pixel, in the frames' units, shape (...).
+
+    Examples
+    --------
+    >>> frames = phase_shift_patterns(np.arange(3.0), period=12, steps=5)
+    >>> frames[0] += 0.01  # one frame off the sinusoid
+    >>> residual_noise(frames, *wrapped_phase(frames)).astype(float).round(4).tolist()
+    [0.0045, 0.0045, 0.0045]
+    """
     dof = max(np.shape(frames)[0] - 3, 1)
     res = residuals(frames, phi, avg, mod, shift_sign, phase_offset)
     return np.sqrt((res**2).sum(axis=0) / dof).astype(np.float32)
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:
-    """Wrap angles into ``[-pi, pi)``."""
+    """Wrap angles into ``[-pi, pi)``.
+
+    Parameters
+    ----------
+    angle : float or ndarray
+        Angles in radians.
+
+    Returns
+    -------
+    ndarray
+        ``(angle + pi) mod 2*pi - pi``, same shape (a NumPy scalar for a scalar input).
+
+    Examples
+    --------
+    >>> wrap(np.array([0.5, 4.0, -4.0, np.pi])).round(4).tolist()
+    [0.5, -2.2832, 2.2832, -3.1416]
+    """
     return (np.asarray(angle) + np.pi) % TWO_PI - np.pi
 
 
 def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
     """Fringe order that brings ``phi`` nearest an absolute ``reference`` phase (same period).
 
+    Parameters
+    ----------
+    phi : ndarray
+        Wrapped phase in radians, in ``[0, 2*pi)``.
+    reference : ndarray
+        Absolute phase in radians (same period), broadcastable to ``phi``.
+
+    Returns
+    -------
+    ndarray
+        ``rint((reference - phi) / (2*pi))``: whole numbers as floats (float64 for float64
+        inputs).
+
+    Examples
+    --------
     >>> order_from_reference(np.array([0.1, 6.2]), np.array([12.7, 12.5])).tolist()
     [2.0, 1.0]
     """

@@ -84,6 +84,36 @@ def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
     horizontal link, or around the two ends of a vertical link; a link is cut where the
     averages differ by more than ``relative`` of the larger gradient and by more than four
     times their noise (``sigma``: per-pixel phase noise, radians).
+
+    The NumPy formulation of :func:`~bistair.core.kernels.period_jump_links`.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+    sigma : (H, W) float array or float
+        Per-pixel phase noise in radians.
+    relative : float
+        Share of the larger mean gradient by which the two must differ.
+    half : int
+        Window length in pixels (each window also needs ``half`` valid gradients).
+
+    Returns
+    -------
+    vert : (H-1, W) bool array
+        Links between each pixel and the one below it to cut.
+    horiz : (H, W-1) bool array
+        Links between each pixel and the one to its right to cut.
+
+    Examples
+    --------
+    >>> x = np.arange(40.0)
+    >>> phi = np.tile(np.where(x < 20, 0.2 * x, 0.6 * x) % (2 * np.pi), (6, 1))
+    >>> vert, horiz = period_jumps(phi, np.ones(phi.shape, bool), 0.01)
+    >>> np.flatnonzero(horiz[0]).tolist(), bool(vert.any())
+    ([16, 17, 18, 19, 21, 22], False)
     """
     h, w = phi.shape
     noise = np.broadcast_to(np.asarray(sigma, np.float32), (h, w))
@@ -133,6 +163,26 @@ def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
 
     Along the coded axis the phase of one lit surface is monotonic (the projector and camera
     see its points in the same order); a reversal marks where two surfaces meet.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts (every eighth row is looked at).
+
+    Returns
+    -------
+    int
+        +1 or -1 (+1 when no pair of valid neighbours is found): the sign of the median
+        wrapped phase difference along the rows.
+
+    Examples
+    --------
+    >>> phi = np.tile(np.arange(40.0) * 0.3 % (2 * np.pi), (4, 1))
+    >>> ok = np.ones(phi.shape, bool)
+    >>> fringe_direction(phi, ok), fringe_direction(phi[:, ::-1], ok)
+    (1, -1)
     """
     a, b = phi[::8, :-1], phi[::8, 1:]
     ok = valid[::8, :-1] & valid[::8, 1:]
@@ -142,7 +192,29 @@ def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
 
 
 def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
-    """Cut threshold for phase steps: three times the median phase gradient, in [0.6, 2.2]."""
+    """Cut threshold for phase steps: three times the median phase gradient, in [0.6, 2.2].
+
+    The gradient is the hypotenuse of the median absolute wrapped neighbour differences
+    along the rows and down the columns, on every fourth row and column.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+
+    Returns
+    -------
+    float
+        The threshold in radians; 1.5 when no pair of valid neighbours is found.
+
+    Examples
+    --------
+    >>> phi = np.tile(2 * np.pi * np.arange(40.0) / 10 % (2 * np.pi), (8, 1))
+    >>> round(default_cut(phi, np.ones(phi.shape, bool)), 3), default_cut(phi, phi < 0)
+    (1.885, 1.5)
+    """
     # Neighbour differences on every fourth row and column: plenty for a median.
     a, va = phi[::4, ::4], valid[::4, ::4]
     gx = np.abs(phi[::4, 1::4][:, :a.shape[1]] - a[:, :phi[::4, 1::4].shape[1]])
@@ -170,6 +242,42 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
 
     Returns ``(labels, n)``: int32 labels 1..n, 0 outside any region. Regions smaller than
     ``min_size`` pixels are dropped (left 0) so that noise islands never vote.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels to label.
+    cut : float, optional
+        Phase step (radians) above which a link is cut; :func:`default_cut` when not given.
+    min_size : int
+        Smallest region kept, in pixels.
+    phase_noise : (H, W) float array, optional
+        Per-pixel phase noise in radians.
+    boundaries : tuple of (H-1, W) and (H, W-1) bool arrays, optional
+        Vertical and horizontal links to cut as well.
+
+    Returns
+    -------
+    labels : (H, W) int32 array
+        Region labels 1..n, 0 outside any region.
+    n : int
+        Number of regions.
+
+    Examples
+    --------
+    >>> x = np.arange(60.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (12, 1)).astype(np.float32)
+    >>> ok = np.ones(phi.shape, bool)
+    >>> labels, n = fringe_regions(phi, ok)
+    >>> n, labels[0, [0, 9, 10, 29, 30]].tolist()
+    (2, [1, 1, 1, 1, 2])
+    >>> horiz = np.zeros((12, 59), bool)
+    >>> horiz[:, 9] = True  # a boundary between columns 9 and 10
+    >>> labels, n = fringe_regions(phi, ok, boundaries=(np.zeros((11, 60), bool), horiz))
+    >>> n, labels[0, [0, 9, 10, 29, 30]].tolist()
+    (3, [1, 1, 2, 2, 3])
     """
     valid = np.asarray(valid, dtype=bool)
     if cut is None:
@@ -207,6 +315,21 @@ def core_weight(phi: np.ndarray) -> np.ndarray:
     Codes change at the fringe edges, where the wrapped phase jumps; blur and the half-pixel
     offset of a projector's stair edge put a neighbouring fringe's code on the first and last
     pixels of a fringe, so those vote least.
+
+    Parameters
+    ----------
+    phi : ndarray
+        Wrapped phase in ``[0, 2*pi)``.
+
+    Returns
+    -------
+    ndarray
+        ``min(phi, 2*pi - phi) / (pi/2)`` clipped to [0.1, 1], same shape.
+
+    Examples
+    --------
+    >>> core_weight(np.array([0.0, np.pi / 4, np.pi, 6.0])).round(3).tolist()
+    [0.1, 0.5, 1.0, 0.18]
     """
     return np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
 
@@ -233,6 +356,30 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     wrap against the phase's direction (:func:`fringe_direction`) joins two surfaces, not two
     fringes, and is left out. Each touching pair is reported once per direction of walk
     (``src`` before ``dst``). ``direction`` is :func:`fringe_direction`, computed if not given.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    labels : (H, W) int32 array
+        Fringe regions (:func:`fringe_regions`), 0 outside any.
+    direction : int, optional
+        +1 or -1, the phase's direction along the rows.
+
+    Returns
+    -------
+    RegionLinks
+        Int64 arrays ``src``, ``dst``, ``step`` (+1 or -1) and ``count`` (the pixel pairs
+        behind each link), sorted by ``(src, dst)``.
+
+    Examples
+    --------
+    >>> x = np.arange(60.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (5, 1)).astype(np.float32)
+    >>> labels = np.where(x < 30, 1, 2).astype(np.int32)[None].repeat(5, axis=0)
+    >>> links = region_links(phi, labels)
+    >>> links.src.tolist(), links.dst.tolist(), links.step.tolist(), links.count.tolist()
+    ([1], [2], [1], [5])
     """
     sign = fringe_direction(phi, labels > 0) if direction is None else direction
     s, d, st = wrap_links(phi, labels, sign)
@@ -250,6 +397,31 @@ def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
     pixel that has one: the order that brings the pixel's phase nearest that pixel's
     absolute phase, ``round((phi_near + 2 pi k_near - phi) / 2pi)``. Target pixels farther
     than ``max_distance`` from any order keep -1. Returns a new int32 array.
+
+    Only the orders given count as sources (a pixel filled here does not fill another).
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    order : (H, W) int array
+        Fringe orders, negative where unknown.
+    target : (H, W) bool array
+        Pixels to fill.
+    max_distance : float
+        Farthest source, in pixels (Euclidean).
+
+    Returns
+    -------
+    (H, W) int32 array
+        ``order`` with the target pixels filled where a source is near enough.
+
+    Examples
+    --------
+    >>> phi = np.array([[5.9, 6.2, 0.1, 0.4, 0.7, 1.0]])
+    >>> order = np.array([[3, -1, -1, 4, -1, -1]])
+    >>> fill_orders(phi, order, np.ones(phi.shape, bool), max_distance=1.5).tolist()
+    [[3, 3, 4, 4, 4, -1]]
     """
     out = np.array(order, dtype=np.int32)
     ty, tx = np.nonzero(target & (out < 0))

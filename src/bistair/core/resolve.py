@@ -31,6 +31,37 @@ def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_value
     """Most frequent value (0..n_values-1) per label 1..n_labels; label 0 and values < 0 ignored.
 
     Returns ``(mode, support)`` indexed by label (index 0 unused, mode -1 where no vote).
+
+    Parameters
+    ----------
+    labels : int array
+        Region label per pixel (0: none), any shape.
+    values : int array
+        Value per pixel, same shape; negative values abstain.
+    n_labels : int
+        Highest label.
+    n_values : int
+        Values run 0 .. n_values-1.
+    weights : float array, optional
+        Vote weight per pixel, same shape (1 each when not given).
+
+    Returns
+    -------
+    mode : (n_labels + 1,) int64 array
+        The most supported value per label (the smallest of ties), -1 where no vote.
+    support : (n_labels + 1,) array
+        Its vote count (or summed weight): int64 without ``weights``, float64 with them.
+
+    Examples
+    --------
+    >>> labels = np.array([1, 1, 1, 2, 2, 0])
+    >>> values = np.array([4, 4, 5, 7, -1, 9])
+    >>> mode, support = mode_by_label(labels, values, n_labels=2, n_values=10)
+    >>> mode.tolist(), support.tolist()
+    ([-1, 4, 7], [0, 2, 1])
+    >>> weights = np.array([0.1, 0.1, 1.0, 1.0, 1.0, 1.0])
+    >>> mode_by_label(labels, values, 2, 10, weights)[0].tolist()
+    [-1, 5, 7]
     """
     labels = np.asarray(labels).ravel()
     values = np.asarray(values).ravel()
@@ -56,6 +87,39 @@ def resolve_regions(evidence: np.ndarray, links: RegionLinks, link_weight: float
     a long chain of fringes backs a region without drowning what the region itself shows.
     Returns ``(order, belief, margin)`` per region: the chosen order (-1 where nothing
     supports one), its belief and how far it leads the runner-up.
+
+    Parameters
+    ----------
+    evidence : (n+1, K) float array
+        Each region's support for each of the K orders (e.g. :func:`code_evidence`).
+    links : RegionLinks
+        Wrap links between the regions (:func:`~bistair.core.regions.region_links`).
+    link_weight : float
+        Weight of a link's message (of one made by at least 10 pixel pairs).
+    iterations : int
+        Rounds of message passing.
+    cap : float
+        Largest belief a message carries over.
+
+    Returns
+    -------
+    order : (n+1,) int array
+        The chosen order per region, -1 where no order has a positive belief.
+    belief : (n+1,) float array
+        The chosen order's belief.
+    margin : (n+1,) float array
+        How far it leads the runner-up.
+
+    Examples
+    --------
+    >>> from bistair.core.regions import RegionLinks
+    >>> evidence = np.array([[0, 0, 0, 0], [0.6, 0.4, 0, 0], [0, 0.3, 0.35, 0],
+    ...                      [0, 0, 0.1, 0.9]])
+    >>> links = RegionLinks(np.array([1, 2]), np.array([2, 3]), np.array([1, 1]),
+    ...                     np.array([20, 20]))
+    >>> order, belief, margin = resolve_regions(evidence, links)
+    >>> order.tolist(), belief.round(3).tolist(), margin.round(3).tolist()
+    ([-1, 1, 2, 3], [0.0, 0.799, 1.0, 1.175], [0.0, 0.024, 0.35, 0.775])
     """
     n_reg, n_k = evidence.shape
     # Each touching pair is linked both ways: k_dst = k_src + step.
@@ -85,7 +149,33 @@ def resolve_regions(evidence: np.ndarray, links: RegionLinks, link_weight: float
 
 
 def jump_violations(links: RegionLinks, region_order: np.ndarray) -> tuple[int, int]:
-    """Count wrap links (in pixel pairs) whose orders do not step by the expected one."""
+    """Count wrap links (in pixel pairs) whose orders do not step by the expected one.
+
+    Parameters
+    ----------
+    links : RegionLinks
+        Wrap links between regions (:func:`~bistair.core.regions.region_links`).
+    region_order : (n+1,) int array
+        The order per region, -1 where undecided (links to such regions are not counted).
+
+    Returns
+    -------
+    violations : int
+        Pixel pairs of links between decided regions whose orders do not differ by the
+        link's step.
+    total : int
+        Pixel pairs of all links between decided regions.
+
+    Examples
+    --------
+    >>> from bistair.core.regions import RegionLinks
+    >>> links = RegionLinks(np.array([1, 2]), np.array([2, 3]), np.array([1, 1]),
+    ...                     np.array([20, 20]))
+    >>> jump_violations(links, np.array([-1, 0, 1, 3]))
+    (20, 40)
+    >>> jump_violations(links, np.array([-1, 0, 1, -1]))  # region 3 undecided
+    (0, 20)
+    """
     ks, kd = region_order[links.src], region_order[links.dst]
     both = (ks >= 0) & (kd >= 0)
     bad = both & (kd - ks != links.step)
@@ -112,6 +202,47 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     Valid pixels outside any region (cut off at a wrap, or in a noise island) take the order
     that makes their phase continuous with the nearest decoded pixel within 3 px. ``info``
     receives the counts and the wrap-consistency check.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Valid pixels.
+    labels : (H, W) int32 array
+        Fringe regions (:func:`~bistair.core.regions.fringe_regions`), 0 outside any.
+    evidence_of : callable
+        ``evidence_of(labels, n) -> (labels, n, evidence)``, ``evidence`` of shape (n+1, K).
+    agrees : callable, optional
+        ``agrees(order) -> bool array``: the pixels whose own codes fit a per-pixel order
+        (-1 where undecided).
+    info : dict, optional
+        Receives ``regions``, ``regions_decoded``, ``regions_detached``,
+        ``jump_violations`` and ``jump_links``.
+    min_score : float
+        Belief the best order of a region needs.
+    min_margin : float
+        Lead over the runner-up the best order needs.
+
+    Returns
+    -------
+    (H, W) int32 array
+        Fringe order per pixel, -1 where undecided.
+
+    Examples
+    --------
+    >>> from bistair.core.regions import fringe_regions
+    >>> x = np.arange(90.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (12, 1)).astype(np.float32)
+    >>> ok = np.ones(phi.shape, bool)
+    >>> code = np.tile((x // 30).astype(np.int64), (12, 1))
+    >>> code[:, 35:45] = 2  # a third of fringe 1 misread
+    >>> def evidence_of(labels, n):
+    ...     return labels, n, code_evidence(labels, n, code, 3)
+    >>> info = {}
+    >>> order = orders_from_regions(phi, ok, fringe_regions(phi, ok)[0], evidence_of, info=info)
+    >>> order[0, ::10].tolist(), info["regions_decoded"], info["jump_violations"]
+    ([0, 0, 0, 1, 1, 1, 2, 2, 2], 3, 0)
     """
     direction = fringe_direction(phi, valid)
     labels, n, evidence = evidence_of(labels, int(labels.max()))
@@ -152,6 +283,42 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     part, which grows over the region's other disagreeing pixels. Parts of at least
     ``min_size`` pixels become regions of their own; smaller ones are left undecided.
     Returns ``(labels, n, parts detached)``.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Fringe regions, 0 outside any.
+    n : int
+        Number of regions.
+    k_reg : (n+1,) int array
+        The order per region, -1 where undecided.
+    agrees : callable
+        ``agrees(order) -> bool array``: the pixels whose own codes fit a per-pixel order
+        (-1 where undecided).
+    window : int
+        Side of the neighbourhood, in pixels.
+    share : float
+        Share of a neighbourhood's decided pixels that must disagree to seed a part.
+    min_size : int
+        Smallest part made a region, in pixels.
+
+    Returns
+    -------
+    labels : (H, W) array
+        The labels with the detached parts numbered from ``n + 1`` and the parts too small
+        set to 0 (a new array once a part is found, else the input itself).
+    n : int
+        The new number of regions.
+    detached : int
+        Parts made regions.
+
+    Examples
+    --------
+    >>> labels = np.ones((20, 40), np.int32)
+    >>> truth = np.where(np.arange(40) < 30, 3, 5)[None].repeat(20, axis=0)
+    >>> new, n, detached = split_disagreeing(labels, 1, np.array([-1, 3]), lambda k: k == truth)
+    >>> n, detached, np.unique(new[:, :30]).tolist(), np.unique(new[:, 30:]).tolist()
+    (2, 1, [1], [2])
     """
     k_pix = np.where(labels > 0, k_reg[labels], -1)
     decided = k_pix >= 0
@@ -187,7 +354,34 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
 
 def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes: int,
                   weights: np.ndarray | None = None) -> np.ndarray:
-    """Each region's weighted share of pixels voting for each code (codes < 0 abstain)."""
+    """Each region's weighted share of pixels voting for each code (codes < 0 abstain).
+
+    Parameters
+    ----------
+    labels : (H, W) int array
+        Fringe regions, 0 outside any.
+    n_regions : int
+        Highest label.
+    codes : (H, W) int array
+        Code per pixel, 0 .. n_codes-1, negative to abstain.
+    n_codes : int
+        Number of codes.
+    weights : (H, W) float array, optional
+        Vote weight per pixel (e.g. :func:`~bistair.core.regions.core_weight`).
+
+    Returns
+    -------
+    (n_regions + 1, n_codes) float64 array
+        The share of each region's (weighted) votes per code; rows sum to 1 for regions
+        with votes, 0 otherwise (row 0 is unused).
+
+    Examples
+    --------
+    >>> labels = np.array([[1, 1, 1, 2, 2, 0]])
+    >>> codes = np.array([[0, 0, 1, 2, -1, 1]])
+    >>> code_evidence(labels, 2, codes, 3).round(3).tolist()
+    [[0.0, 0.0, 0.0], [0.667, 0.333, 0.0], [0.0, 0.0, 1.0]]
+    """
     flat = labels.ravel()
     c = codes.ravel()
     sel = (flat > 0) & (c >= 0)

@@ -56,6 +56,23 @@ class Response:
 def ramp_levels(count: int) -> np.ndarray:
     """``count`` pattern values evenly from 0 to 1 (at least 5).
 
+    Parameters
+    ----------
+    count : int
+        Number of grey levels of the ramp, at least 5.
+
+    Returns
+    -------
+    ndarray
+        Float64 array of shape (count,), from 0.0 to 1.0.
+
+    Raises
+    ------
+    BistairError
+        If ``count`` is below 5.
+
+    Examples
+    --------
     >>> ramp_levels(5).tolist()
     [0.0, 0.25, 0.5, 0.75, 1.0]
     """
@@ -70,21 +87,35 @@ def estimate_response(frames: np.ndarray, levels: np.ndarray, full_scale: float 
 
     Parameters
     ----------
-    frames : (N, H, W) captures, one per level, in the levels' order.
-    levels : (N,) pattern values in [0, 1], strictly increasing.
-    full_scale : the capture value of full scale (pixels reaching it are left out).
-    min_contrast : well-lit pixels differ between the brightest and darkest frame by at
-        least this share of full scale.
+    frames : (N, H, W) array
+        Captures, one per level, in the levels' order.
+    levels : (N,) array
+        Pattern values in [0, 1], strictly increasing (at least 5).
+    full_scale : float
+        The capture value of full scale (pixels reaching it are left out).
+    min_contrast : float
+        Well-lit pixels differ between the brightest and darkest frame by at least this
+        share of full scale.
 
     Returns
     -------
     Response
+        The fitted gamma, the median relative response per level, the fit's RMS misfit and
+        the number of well-lit pixels (at least 100) it was measured on.
 
     Raises
     ------
     BistairError
         Frames and levels that do not match, levels that do not increase, or too few
         well-lit pixels.
+
+    Examples
+    --------
+    >>> levels = ramp_levels(6)
+    >>> frames = 0.1 + 0.7 * np.ones((1, 12, 12)) * levels[:, None, None] ** 1.8
+    >>> fit = estimate_response(frames, levels)
+    >>> round(fit.gamma, 3), fit.pixels, [round(r, 3) for r in fit.response]
+    (1.8, 144, [0.0, 0.055, 0.192, 0.399, 0.669, 1.0])
     """
     stack = np.asarray(frames, dtype=np.float64) / full_scale
     levels = np.asarray(levels, dtype=np.float64)

@@ -123,6 +123,46 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
     ``phi`` must lie in ``[0, 2*pi)``, so ``order`` is ``floor(Phi / 2pi)`` exactly. With
     ``length`` (projector pixels along the coded axis), coordinates outside ``[0, length)``
     are invalid: they cannot come from the projector.
+
+    Parameters
+    ----------
+    method : str
+        The codec's name.
+    phi : (H, W) array
+        Wrapped phase in radians, in ``[0, 2*pi)`` (NaN where unknown).
+    order : (H, W) int array
+        Fringe order per pixel, negative where invalid.
+    period : float
+        Projector pixels per fringe.
+    modulation : (H, W) array
+        Fringe modulation ``B`` (fraction of full scale).
+    average : (H, W) array, optional
+        Average intensity ``A`` (fraction of full scale); zeros when not given.
+    code : (H, W) int32 array, optional
+        The method's decoded code word per pixel; -1 everywhere when not given.
+    wrapped : (H, W) array, optional
+        The wrapped phase to report (NaN where the modulation is too low); ``phi`` when not
+        given.
+    info : dict, optional
+        Figures about the decode; ``outside_projector`` (a count) is added when ``length``
+        invalidates pixels.
+    length : float, optional
+        Projector pixels along the coded axis.
+
+    Returns
+    -------
+    DecodeResult
+        Absolute phase ``phi + 2*pi*order`` and projector coordinate ``phase * period /
+        (2*pi)`` (float32, NaN where invalid), order (int32, -1 where invalid) and the mask
+        of valid pixels.
+
+    Examples
+    --------
+    >>> phi = np.full((1, 3), np.pi, np.float32)
+    >>> res = make_result("demo", phi, np.array([[0, 2, -1]]), period=10.0,
+    ...                   modulation=np.ones((1, 3)), length=25)
+    >>> res.coord.astype(float).round(3).tolist(), res.order.tolist(), res.info
+    ([[5.0, nan, nan]], [[0, -1, -1]], {'outside_projector': 1})
     """
     phi = np.asarray(phi, dtype=np.float32)
     out_order = np.asarray(order).astype(np.int32)
@@ -155,7 +195,40 @@ def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: fl
                        code: np.ndarray | None = None, info: dict[str, Any] | None = None,
                        length: float | None = None) -> DecodeResult:
     """A result from a measured fringe set and its fringe orders (-1 = invalid); with
-    ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`)."""
+    ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`).
+
+    The wrapped phase reported is the set's, NaN where the set's pixels are not valid; the
+    modulation and average are the set's.
+
+    Parameters
+    ----------
+    method : str
+        The codec's name.
+    fs : FringeSet
+        The measured N-step set whose wrapped phase the orders complete.
+    order : (H, W) int array
+        Fringe order per pixel, -1 where invalid.
+    period : float
+        Projector pixels per fringe.
+    code : (H, W) int32 array, optional
+        The method's decoded code word per pixel (-1 where not decoded).
+    info : dict, optional
+        Figures about the decode.
+    length : float, optional
+        Projector pixels along the coded axis.
+
+    Returns
+    -------
+    DecodeResult
+
+    Examples
+    --------
+    >>> ones = np.ones((1, 3), np.float32)
+    >>> fs = FringeSet(ones, 0.5 * ones, 0.4 * ones, np.array([[True, True, False]]), 0.001)
+    >>> res = result_from_orders("demo", fs, np.array([[0, 1, -1]]), period=2 * np.pi)
+    >>> res.coord.astype(float).round(3).tolist(), res.wrapped.tolist(), res.mask.tolist()
+    ([[1.0, 7.283, nan]], [[1.0, 1.0, nan]], [[True, True, False]])
+    """
     return make_result(method, fs.phi, order, period, fs.mod, fs.avg,
                        code=code, wrapped=np.where(fs.valid, fs.phi, np.float32(np.nan)),
                        info=info, length=length)
