@@ -334,15 +334,37 @@ def load_spec(path: str | Path) -> BaseSpec:
 
 def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
               files: Sequence[Path] | None = None) -> BaseSpec:
-    """The spec of a capture set, read as its file says (frames marked ``ignore`` kept):
-    ``spec`` itself, the file it names, or by default ``spec.json`` in the captures' folder
-    (the folder given, or the folder of the first file). ``files``: the captures' files if
-    already listed (:func:`capture_files`).
+    """The spec of a capture set, read as its file says (frames marked ``ignore`` kept).
+
+    Parameters
+    ----------
+    captures : str, Path or sequence of them
+        A folder, image files or glob patterns, or a ``.npy`` stack.
+    spec : BaseSpec, str, Path or None
+        The spec itself, the file it names, or by default ``spec.json`` in the captures'
+        folder (the folder given, or the folder of the first file).
+    files : sequence of Path, optional
+        The captures' files if already listed (:func:`capture_files`).
+
+    Returns
+    -------
+    BaseSpec
 
     Raises
     ------
     BistairError
         Captures or a spec file that cannot be read.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.codecs import make_spec
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (tmp / "spec.json").write_text(make_spec("graycode", width=64, height=48,
+    ...                                              period=16).to_json())
+    >>> find_spec(tmp, tmp / "spec.json").method
+    'graycode'
+    >>> shutil.rmtree(tmp)
     """
     if isinstance(spec, BaseSpec):
         return spec
@@ -694,6 +716,7 @@ def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Pa
     return found
 
 
+@contextlib.contextmanager
 def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
     """Yield a temporary file path beside ``path``; it replaces ``path`` only on success.
 
