@@ -216,8 +216,10 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     if prepared.white is not None and prepared.black is not None:
         valid &= (prepared.white - prepared.black) >= 2.0 * lowest
     if lowest < threshold:
-        sigma = noise / (np.maximum(mod, 1e-6) * np.sqrt(steps / 2.0))
-        valid = coherent_pixels(phi, valid, valid & (mod >= threshold), sigma)
+        strong = valid & (mod >= threshold)
+        if not np.array_equal(strong, valid):  # dim pixels to judge by their regions
+            sigma = noise / (np.maximum(mod, 1e-6) * np.sqrt(steps / 2.0))
+            valid = coherent_pixels(phi, valid, strong, sigma)
     if check:
         check_decodable(valid, prepared.clipped, min_modulation, mod)
     return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
