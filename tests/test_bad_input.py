@@ -3,13 +3,15 @@
 Each row runs ``bistair`` in-process and must exit with code 2, print exactly one non-empty
 line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
 uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
-patterns with their spec (they decode) and ``{poses}`` for calibration captures of two poses
-that show no board.
+patterns with their spec (they decode), ``{zero}`` and ``{corrupt}`` for copies whose frame
+03.png is empty or not an image, and ``{poses}`` for calibration captures of two poses that
+show no board.
 """
 
 from __future__ import annotations
 
 import json
+import shutil
 
 import numpy as np
 import pytest
@@ -53,6 +55,12 @@ ROWS = [
     # demo
     (["demo", "--camera", "0x0", "--out", "{out}"], "camera size 0x0 must be 8 to 8192 whole"),
     (["demo", "--seed", "-1", "--out", "{out}"], "seed must be a whole number of at least 0"),
+    # decode: output paths that would break the next run, unreadable frames named
+    (["decode", "{pats}", "--out", "{pats}"], "is the captures' own folder: choose another"),
+    (["decode", "{pats}", "--out", ""], "the output path is empty"),
+    (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
+    (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "
+                                                 "another format)"),
     (DECODE + ["--threads", "0"], "Invalid value for '--threads': 0 is not in the range x>=1"),
     (DECODE + ["--threads", "many"], "Invalid value for '--threads': 'many' is not a valid"),
     # decode --min-modulation: a fraction of full scale, strictly between 0 and 1
@@ -133,6 +141,9 @@ def inputs(tmp_path_factory):
     """A decodable folder of graycode patterns and two calibration poses without a board."""
     root = tmp_path_factory.mktemp("inputs")
     save_patterns(bistair.make_spec("graycode", width=64, height=48, period=16), root / "pats")
+    for name, content in (("zero", b""), ("corrupt", b"not a png at all")):
+        shutil.copytree(root / "pats", root / name)
+        (root / name / "03.png").write_bytes(content)
     (root / "poses").mkdir()
     (root / "poses" / "board.json").write_text(json.dumps(
         {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20.0}))
@@ -161,7 +172,7 @@ def row_id(args: list[str]) -> str:
 @pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
 def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
-    paths = {"out": out, "pats": inputs / "pats", "poses": inputs / "poses"}
+    paths = {"out": out, **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt")}}
     code, _, err = cli_run(monkeypatch, capsys, *(a.format(**paths) for a in args))
     lines = [line for line in err.splitlines() if line.strip()]
     assert code == 2, err
