@@ -44,6 +44,20 @@ CONNECT_TIMEOUT = 20  # seconds to reach a scheduler
 # glibc's growing mmap threshold: every large NumPy temporary is then a fresh mmap with its
 # pages faulted in, some 15% more time for a decode. Unset for the local cluster's workers.
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
+ENVIRON = "distributed.nanny.pre-spawn-environ."
+
+
+def worker_config(count: int) -> dict[str, Any]:
+    """The local cluster's worker settings: glibc's mmap threshold left alone (above) and
+    the cores shared out, so that ``count`` workers whose compiled kernels would each run on
+    every core do not oversubscribe the machine (numba reads ``NUMBA_NUM_THREADS`` when a
+    worker imports it; Dask already sets the BLAS and OpenMP pools to one thread).
+
+    >>> worker_config(2)[ENVIRON + "NUMBA_NUM_THREADS"] == str(max(1, (os.cpu_count() or 1) // 2))
+    True
+    """
+    threads = max(1, (os.cpu_count() or 1) // max(1, count))
+    return {**WORKER_CONFIG, ENVIRON + "NUMBA_NUM_THREADS": str(threads)}
 WORKER_TIMEOUT = 60  # seconds to wait for a scheduler's first worker
 
 
@@ -122,7 +136,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     # a traceback of its own.
     handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
     try:
-        with dask.config.set(WORKER_CONFIG):
+        with dask.config.set(worker_config(count)):
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                                    dashboard_address=None, silence_logs=logging.ERROR)
     finally:
