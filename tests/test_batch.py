@@ -340,3 +340,44 @@ def test_a_set_that_breaks_the_decoder_is_an_error_row(scans, tmp_path, monkeypa
     assert row["status"] == "error"
     assert row["error"] == "RuntimeError: something unforeseen"
     assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
+
+
+@pytest.mark.parametrize("cell", ["../victim", "{abs}", ".", "a/../.."])
+def test_a_manifest_out_cell_must_stay_inside_out(cell, tmp_path):
+    """An out cell that leaves OUT would replace (delete) a folder the batch does not own."""
+    victim = tmp_path / "victim"
+    victim.mkdir()
+    (victim / "thesis.txt").write_text("important")
+    (tmp_path / "caps").mkdir()
+    manifest = tmp_path / "sets.csv"
+    manifest.write_text(f"captures,out\ncaps,{cell.format(abs=victim)}\n")
+    with pytest.raises(BistairError, match="must name a folder inside the output folder"):
+        find_sets(manifest, tmp_path / "out")
+    assert (victim / "thesis.txt").read_text() == "important"
+
+
+def test_an_output_folder_inside_a_capture_set_is_refused(tmp_path):
+    root = tmp_path / "scans"
+    for name in ("s0", "s1"):
+        (root / name).mkdir(parents=True)
+        (root / name / "00.png").write_bytes(b"")
+    with pytest.raises(BistairError, match="is one of the capture sets"):
+        find_sets(root, root / "s0")
+    with pytest.raises(BistairError, match="is inside the capture set s1"):
+        find_sets(root, root / "s1" / "results")
+    assert [job.name for job in find_sets(root, root / "results")] == ["s0", "s1"]
+
+
+def test_resume_redoes_a_set_whose_captures_or_spec_changed(scans, tmp_path):
+    root = tmp_path / "root"
+    for name in ("a", "b"):
+        shutil.copytree(scans / "plane", root / name)
+    options, out = Options(previews=False), tmp_path / "out"
+    jobs = find_sets(root, out)
+    for job in jobs:
+        assert run_set(job, options)["status"] == "ok"
+    assert all(batch_module.complete_row(job, options) is not None for job in jobs)
+    shutil.copy(scans / "sphere" / "01.png", root / "a" / "01.png")  # other captures
+    spec = root / "b" / "spec.json"
+    spec.write_text(spec.read_text() + "\n")  # the set's own spec file rewritten
+    assert [batch_module.complete_row(job, options) for job in jobs] == [None, None]

@@ -243,3 +243,16 @@ def test_installed_console_script(tmp_path):
                           capture_output=True, text=True)
     assert done.returncode == 2
     assert done.stderr.strip() == f"Error: captures {tmp_path / 'none'} not found"
+
+
+def test_a_decode_into_a_folder_of_an_earlier_one_leaves_none_of_its_files(pats, tmp_path,
+                                                                           monkeypatch, capsys):
+    out = tmp_path / "res"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine")  # not a decode's file: kept
+    assert run(monkeypatch, capsys, "decode", pats, "--out", out)[0] == 0
+    assert (out / "ks.png").exists()
+    assert run(monkeypatch, capsys, "decode", pats, "--out", out, "--no-previews")[0] == 0
+    assert sorted(p.name for p in out.iterdir()) == [
+        "coord.npy", "info.json", "mask.npy", "modulation.npy", "notes.txt", "order.npy",
+        "phase.npy", "wrapped.npy"]

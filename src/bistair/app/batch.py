@@ -39,6 +39,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import math
@@ -56,7 +57,15 @@ from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.calibration import load_calibration
 from ..geometry.triangulate import check_depth_range
-from ..io.files import check_output, load_spec, natural_key, output_file, replace_folder
+from ..io.files import (
+    IMAGE_SUFFIXES,
+    capture_files,
+    check_output,
+    load_spec,
+    natural_key,
+    output_file,
+    replace_folder,
+)
 from ..io.jsonfile import read_json, write_json
 from .engine import (
     BATCH_PREFIX,
@@ -167,12 +176,24 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
         if root.resolve() == out.resolve():
             raise BistairError(f"the output folder {out} is the folder of the capture sets: "
                                "choose another (its set folders would be read as sets)")
+        if out.parent.resolve() == root.resolve() and out.is_dir() and any(
+                p.suffix.lower() in IMAGE_SUFFIXES or p.name == "spec.json"
+                for p in out.iterdir()):
+            raise BistairError(f"the output folder {out} is one of the capture sets in {root} "
+                               "(it holds images or a spec.json): choose another")
         subs = sorted((p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")
                        and p.resolve() != out.resolve()), key=lambda p: natural_key(p.name))
         jobs = [SetJob(p.name, str(p.absolute()), spec, calibration, str(out / p.name))
                 for p in subs]
         if not jobs:
             raise BistairError(f"no capture sets in {root}: each set is a sub-folder")
+    resolved = out.resolve()
+    for job in jobs:
+        folder = Path(job.captures)
+        folder = folder if folder.is_dir() else folder.parent
+        if folder.resolve() == resolved or folder.resolve() in resolved.parents:
+            raise BistairError(f"the output folder {out} is inside the capture set {job.name} "
+                               f"({folder}): choose another")
     seen: dict[str, str] = {}
     for job in jobs:
         key = str(Path(job.out).resolve())
@@ -238,11 +259,15 @@ def read_manifest(path: str | Path, out: str | Path, spec: str | None = None,
             raise BistairError(f"manifest {path} line {number}: no captures")
         captures = _under(base, cells["captures"])
         name = cells.get("out") or _default_name(cells["captures"])
+        target = (out / name).resolve()
+        if target == out.resolve() or out.resolve() not in target.parents:
+            raise BistairError(f"manifest {path} line {number}: the out cell {name!r} must name "
+                               f"a folder inside the output folder {out}")
         jobs.append(SetJob(
             name, captures,
             _under(base, cells["spec"]) if cells.get("spec") else spec,
             _under(base, cells["calibration"]) if cells.get("calibration") else calibration,
-            str(out / name) if not Path(name).is_absolute() else name))
+            str(out / name)))
     if not jobs:
         raise BistairError(f"manifest {path} lists no capture sets")
     return jobs
@@ -323,9 +348,31 @@ def _warnings(result: DecodeResult | AxesResult) -> list[str]:
 
 
 def _inputs(job: SetJob, options: Options) -> dict[str, Any]:
-    """What a set's outputs were made from (compared by :func:`complete_row`)."""
+    """What a set's outputs were made from (compared by :func:`complete_row`): the paths,
+    the options and each input file's size and modification time, so that captures, a
+    spec or a calibration changed since are decoded again."""
     return {"name": job.name, "captures": job.captures, "spec": job.spec,
-            "calibration": job.calibration, "options": options.to_dict()}
+            "calibration": job.calibration, "options": options.to_dict(),
+            "files_stamp": _stamp(job)}
+
+
+def _stamp(job: SetJob) -> list[list[Any]]:
+    """(path, size, mtime in ns) of a set's capture files, its spec file (the given one or
+    the captures' ``spec.json``) and its calibration; an unreadable set gives []."""
+    try:
+        files = capture_files(job.captures)
+    except BistairError:
+        return []
+    if not files:
+        return []
+    spec = Path(job.spec) if job.spec else (
+        Path(job.captures) if Path(job.captures).is_dir() else files[0].parent) / "spec.json"
+    stamp = []
+    for path in [*files, spec, *([Path(job.calibration)] if job.calibration else [])]:
+        with contextlib.suppress(OSError):
+            info = path.stat()
+            stamp.append([str(path), info.st_size, info.st_mtime_ns])
+    return stamp
 
 
 def complete_row(job: SetJob, options: Options, run: str | None = None

@@ -19,6 +19,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -132,8 +133,18 @@ def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Pa
     say("writing " + ("outputs and previews" if previews else "outputs"))
     with output_folder(out) as tmp:
         write_result(result, tmp, previews=previews)
+        written = {p.name for p in tmp.iterdir()}
+    for name in DECODE_FILES - written:  # an earlier decode's files there: not this one's
+        with contextlib.suppress(OSError):
+            (Path(out) / name).unlink()
     return result
 
+
+# every file a decode may write (arrays, previews, per axis), so that a decode into a folder
+# holding an earlier one's result leaves no file of that one behind
+DECODE_FILES = {f"{stem}{axis}{ext}"
+                for stem in ("phase", "coord", "order", "wrapped", "modulation", "mask", "ks")
+                for axis in ("", "_x", "_y") for ext in (".npy", ".png")} | {"info.json"}
 
 Say = Callable[[str], None]
 

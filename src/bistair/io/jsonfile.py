@@ -46,7 +46,7 @@ def read_json(path: str | Path, what: str) -> Any:
     >>> read_json(tmp / "bad.json", "board description")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    bistair.errors.BistairError: board description .../bad.json is not valid JSON (...line 1)
+    bistair.errors.BistairError: board description .../bad.json is not valid JSON (...column 15)
     >>> shutil.rmtree(tmp)
     >>> read_json("/nonexistent.json", "spec file")
     Traceback (most recent call last):
@@ -63,7 +63,8 @@ def read_json(path: str | Path, what: str) -> Any:
         raise BistairError(f"cannot read {what} {path}: {reason}") from None
     except json.JSONDecodeError as exc:
         raise BistairError(
-            f"{what} {path} is not valid JSON ({exc.msg}, line {exc.lineno})"
+            f"{what} {path} is not valid JSON ({exc.msg.removesuffix(' at')} at line "
+            f"{exc.lineno} column {exc.colno})"
         ) from None
 
 

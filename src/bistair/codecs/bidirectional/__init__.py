@@ -298,7 +298,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
         raise BistairError(
             f"the captures do not fit the spec: at {100 * misfit:.0f}% of the decoded pixels "
             "the stair phase is nearer a level other than the local or partition level of the "
-            "decoded order: are partitions, stairs and period right?")
+            "decoded order: are partitions, stairs and period right, and stair-cos and "
+            "stair-sin in the spec's order?")
     return Orders(order, info)
 
 
