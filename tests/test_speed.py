@@ -27,7 +27,12 @@ def test_same_orders_and_phases_as_before(name, images, spec, options):
             decode(images, spec, **options)
         return
     res = decode(images, spec, **options)
-    assert np.array_equal(res.order, RECORDED[name].astype(np.int32))
+    recorded = RECORDED[name].astype(np.int32)
+    # since the recording, regions whose orders their neighbours contradict are undecided
+    # (resolve.drop_contradicted): those pixels may turn -1, nothing else may change
+    dropped = (res.order != recorded) & (res.order == -1)
+    assert np.array_equal(res.order[~dropped], recorded[~dropped])
+    assert dropped.sum() <= 0.001 * (recorded >= 0).sum()
     frames = prepare(images, spec.frame_count, spec.method).frames
     if spec.method == "multifreq":  # the shortest period's set
         i = spec.periods.index(min(spec.periods))

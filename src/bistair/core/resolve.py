@@ -259,8 +259,65 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
         bad, total = jump_violations(links, k_reg)
         info.update(regions=n, regions_decoded=int((k_reg[1:] >= 0).sum()),
                     regions_detached=detached, jump_violations=bad, jump_links=total)
+    k_reg, dropped = drop_contradicted(links, k_reg)
+    if info is not None:
+        info["regions_contradicted"] = dropped
     return fill_orders(phi, k_reg.astype(np.int32)[labels], valid & (labels == 0),
                        max_distance=3.0)
+
+
+def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
+                      min_pairs: int = 3) -> tuple[np.ndarray, int]:
+    """Undecide the regions whose orders contradict their neighbours' more than they agree.
+
+    A decided region whose wrap links to decided neighbours do not step as the links say
+    for more pixel pairs than they do (and for at least ``min_pairs``) holds an order its
+    surroundings deny: it is made undecided (-1) rather than kept as a guess. The most
+    contradicted region goes first and the others are judged again without it, so the
+    right neighbours of one wrong region stay.
+
+    Parameters
+    ----------
+    links : RegionLinks
+        Wrap links between regions (:func:`~bistair.core.regions.region_links`).
+    region_order : (n+1,) int array
+        Order per region label, -1 where undecided (label 0: outside any region).
+    min_pairs : int
+        Contradicting pixel pairs below which a region is kept.
+
+    Returns
+    -------
+    (orders, dropped) : ((n+1,) int array, int)
+        The orders with the contradicted regions at -1, and how many there were.
+
+    Examples
+    --------
+    >>> from bistair.core.regions import RegionLinks
+    >>> links = RegionLinks(np.array([1, 2]), np.array([2, 3]), np.array([1, 1]),
+    ...                     np.array([20, 20]))
+    >>> k, dropped = drop_contradicted(links, np.array([-1, 0, 9, 2]))  # region 2 is off
+    >>> k.tolist(), dropped
+    ([-1, 0, -1, 2], 1)
+    """
+    k = np.array(region_order, copy=True)
+    count = links.count.astype(np.float64)
+    dropped = 0
+    while True:  # the most contradicted region first: its neighbours may be right
+        ks, kd = k[links.src], k[links.dst]
+        both = (ks >= 0) & (kd >= 0)
+        good = both & (kd - ks == links.step)
+        bad = both & ~good
+        agree = (np.bincount(links.src[good], count[good], k.size)
+                 + np.bincount(links.dst[good], count[good], k.size))
+        deny = (np.bincount(links.src[bad], count[bad], k.size)
+                + np.bincount(links.dst[bad], count[bad], k.size))
+        worse = np.where((deny > agree) & (deny >= min_pairs) & (k >= 0), deny - agree, 0.0)
+        worse[0] = 0.0
+        worst = int(np.argmax(worse))
+        if worse[worst] <= 0:
+            return k, dropped
+        k[worst] = -1
+        dropped += 1
 
 
 def _decide(evidence: np.ndarray, links: RegionLinks, min_score: float,
