@@ -35,6 +35,7 @@ from typing import Any
 import dask
 from distributed import Client, LocalCluster, as_completed
 
+from ..core.kernels import set_threads
 from ..errors import BistairError
 from ..io.files import TEMP_PREFIX, remove_temporaries
 
@@ -44,21 +45,29 @@ CONNECT_TIMEOUT = 20  # seconds to reach a scheduler
 # glibc's growing mmap threshold: every large NumPy temporary is then a fresh mmap with its
 # pages faulted in, some 15% more time for a decode. Unset for the local cluster's workers.
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
-ENVIRON = "distributed.nanny.pre-spawn-environ."
-
-
-def worker_config(count: int) -> dict[str, Any]:
-    """The local cluster's worker settings: glibc's mmap threshold left alone (above) and
-    the cores shared out, so that ``count`` workers whose compiled kernels would each run on
-    every core do not oversubscribe the machine (numba reads ``NUMBA_NUM_THREADS`` when a
-    worker imports it; Dask already sets the BLAS and OpenMP pools to one thread).
-
-    >>> worker_config(2)[ENVIRON + "NUMBA_NUM_THREADS"] == str(max(1, (os.cpu_count() or 1) // 2))
-    True
-    """
-    threads = max(1, (os.cpu_count() or 1) // max(1, count))
-    return {**WORKER_CONFIG, ENVIRON + "NUMBA_NUM_THREADS": str(threads)}
 WORKER_TIMEOUT = 60  # seconds to wait for a scheduler's first worker
+
+
+def in_threads(threads: int | None, func: Callable[..., Any], *args: Any) -> Any:
+    """``func(*args)`` with the compiled kernels on ``threads`` threads (numba's setting is
+    per thread, so it is made in the task's own thread); ``None`` leaves them as they are.
+
+    >>> in_threads(1, max, 3, 4)
+    4
+    """
+    if threads is not None:
+        set_threads(threads)
+    return func(*args)
+
+
+def task_threads(client: Client) -> int | None:
+    """Threads per task on a local cluster: the cores shared out among its workers, so that
+    workers whose kernels would each run on every core do not fight over them (Dask sets
+    the BLAS and OpenMP pools to one thread already). ``None`` on a remote cluster, whose
+    machines are unknown here."""
+    if not isinstance(getattr(client, "cluster", None), LocalCluster):
+        return None
+    return max(1, (os.cpu_count() or 1) // max(1, len(client.nthreads())))
 
 
 def default_workers() -> int:
@@ -136,7 +145,7 @@ def dask_client(workers: int | None = None, scheduler: str | None = None,
     # a traceback of its own.
     handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
     try:
-        with dask.config.set(worker_config(count)):
+        with dask.config.set(WORKER_CONFIG):
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                                    dashboard_address=None, silence_logs=logging.ERROR)
     finally:
@@ -168,7 +177,8 @@ def run_tasks(client: Client, func: Callable[..., Any], tasks: Sequence[tuple],
     the order the tasks finish (for progress). On any exception here (Ctrl-C) the tasks
     not yet finished are cancelled before it propagates.
     """
-    futures = [client.submit(func, *args, pure=False) for args in tasks]
+    threads = task_threads(client)
+    futures = [client.submit(in_threads, threads, func, *args, pure=False) for args in tasks]
     where = {future.key: i for i, future in enumerate(futures)}
     results: list[Any] = [None] * len(futures)
     try:
