@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .phase import TWO_PI, shifts_of, wrap
+from .phase import TWO_PI, residuals, wrap, wrapped_phase
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 
@@ -431,12 +431,10 @@ def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:
     steps = samples.shape[0]
     if steps <= 3 or samples.shape[1] == 0:
         return 0.0
-    d = shifts_of(steps, shift_sign)[:, None]
-    c = 2.0 / steps * (samples * np.cos(d)).sum(axis=0)
-    s = 2.0 / steps * (samples * np.sin(d)).sum(axis=0)
-    fit = samples.mean(axis=0) + c * np.cos(d) + s * np.sin(d)
-    rms = np.sqrt(((samples - fit) ** 2).sum(axis=0) / (steps - 3))
-    return float(np.median(rms / np.maximum(np.hypot(c, s), 1e-6)))
+    phi, avg, mod = wrapped_phase(samples, shift_sign)
+    rest = residuals(samples, phi, avg, mod, shift_sign).astype(np.float64)
+    rms = np.sqrt((rest ** 2).sum(axis=0) / (steps - 3))
+    return float(np.median(rms / np.maximum(mod, 1e-6)))
 
 
 def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] | None:
