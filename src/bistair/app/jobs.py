@@ -52,7 +52,7 @@ from ..io.files import (
 )
 from ..io.jsonfile import read_json, write_json
 from ..io.previews import colorize
-from ..io.writers import write_depth, write_ply, write_result
+from ..io.writers import RESULT_FILES, write_depth, write_ply, write_result
 from ..spec import BaseSpec
 
 
@@ -134,17 +134,11 @@ def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Pa
     with output_folder(out) as tmp:
         write_result(result, tmp, previews=previews)
         written = {p.name for p in tmp.iterdir()}
-    for name in DECODE_FILES - written:  # an earlier decode's files there: not this one's
+    for name in RESULT_FILES - written:  # an earlier decode's files there: not this one's
         with contextlib.suppress(OSError):
             (Path(out) / name).unlink()
     return result
 
-
-# every file a decode may write (arrays, previews, per axis), so that a decode into a folder
-# holding an earlier one's result leaves no file of that one behind
-DECODE_FILES = {f"{stem}{axis}{ext}"
-                for stem in ("phase", "coord", "order", "wrapped", "modulation", "mask", "ks")
-                for axis in ("", "_x", "_y") for ext in (".npy", ".png")} | {"info.json"}
 
 Say = Callable[[str], None]
 

@@ -20,6 +20,9 @@ import numpy as np
 from .measure import FringeSet
 from .phase import TWO_PI
 
+# the arrays a decode writes as NAME.npy (DecodeResult.arrays)
+ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")
+
 
 @dataclass
 class DecodeResult:
@@ -56,9 +59,8 @@ class DecodeResult:
     texture: np.ndarray | None = None  # the white frame if the spec has one (camera axes)
 
     def arrays(self) -> dict[str, np.ndarray]:
-        """The arrays written as ``NAME.npy``."""
-        return {"phase": self.phase, "coord": self.coord, "order": self.order,
-                "wrapped": self.wrapped, "modulation": self.modulation, "mask": self.mask}
+        """The arrays written as ``NAME.npy`` (:data:`ARRAY_NAMES`)."""
+        return {name: getattr(self, name) for name in ARRAY_NAMES}
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""

@@ -15,6 +15,9 @@ from matplotlib import colormaps
 
 from ..core.result import DecodeResult
 
+# the file stems of preview_images, in its order
+PREVIEW_NAMES = ("wrapped", "ks", "order", "phase", "modulation")
+
 
 def colorize(values: np.ndarray, cmap: str = "jet", vmin: float | None = None,
              vmax: float | None = None) -> np.ndarray:
@@ -79,8 +82,8 @@ def preview_images(result: DecodeResult) -> dict[str, np.ndarray]:
     >>> res = make_result("demo", phi, np.array([[0, 1, 2], [0, -1, 2]]), 30.0,
     ...                   modulation=np.full((2, 3), 0.4))
     >>> images = preview_images(res)
-    >>> list(images), images["order"].shape, images["order"].dtype
-    (['wrapped', 'ks', 'order', 'phase', 'modulation'], (2, 3, 3), dtype('uint8'))
+    >>> tuple(images) == PREVIEW_NAMES, images["order"].shape, images["order"].dtype
+    (True, (2, 3, 3), dtype('uint8'))
     >>> images["phase"][1, 1].tolist(), images["wrapped"][1, 1].tolist()  # order -1
     ([0, 0, 0], [128, 128, 128])
     """

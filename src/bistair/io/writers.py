@@ -23,10 +23,17 @@ import imageio.v3 as iio
 import numpy as np
 from plyfile import PlyData, PlyElement
 
-from ..core.result import AxesResult, DecodeResult
+from ..core.result import ARRAY_NAMES, AxesResult, DecodeResult
 from .files import output_file
 from .jsonfile import write_json
-from .previews import colorize, write_previews
+from .previews import PREVIEW_NAMES, colorize, write_previews
+
+# every file write_result may write, for one axis or both: what an earlier decode left in
+# a folder that a new one writes into
+RESULT_FILES = frozenset(
+    [f"{name}{axis}.npy" for name in ARRAY_NAMES for axis in ("", "_x", "_y")]
+    + [f"{name}{axis}.png" for name in PREVIEW_NAMES for axis in ("", "_x", "_y")]
+    + ["info.json"])
 
 
 def write_result(result: DecodeResult | AxesResult, folder: str | Path,
