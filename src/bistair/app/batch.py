@@ -61,6 +61,7 @@ from ..io.files import (
     IMAGE_SUFFIXES,
     capture_files,
     check_output,
+    default_spec_path,
     load_spec,
     natural_key,
     output_file,
@@ -365,8 +366,7 @@ def _stamp(job: SetJob) -> list[list[Any]]:
         return []
     if not files:
         return []
-    spec = Path(job.spec) if job.spec else (
-        Path(job.captures) if Path(job.captures).is_dir() else files[0].parent) / "spec.json"
+    spec = Path(job.spec) if job.spec else default_spec_path(job.captures, files)
     stamp = []
     for path in [*files, spec, *([Path(job.calibration)] if job.calibration else [])]:
         with contextlib.suppress(OSError):

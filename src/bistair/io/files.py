@@ -369,11 +369,38 @@ def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
     if isinstance(spec, BaseSpec):
         return spec
     if spec is None:
-        files = capture_files(captures) if files is None else files
-        first = captures if isinstance(captures, str | Path) else next(iter(captures))
-        first = Path(first)
-        spec = first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
+        spec = default_spec_path(captures, files)
     return load_spec(spec)
+
+
+def default_spec_path(captures: Captures, files: Sequence[Path] | None = None) -> Path:
+    """Where a capture set's spec is when none is named: ``spec.json`` in the folder given,
+    or in the folder of the first file.
+
+    Parameters
+    ----------
+    captures : str, Path or sequence of them
+        A folder, image files or glob patterns, or a ``.npy`` stack.
+    files : sequence of Path, optional
+        The captures' files if already listed (:func:`capture_files`).
+
+    Returns
+    -------
+    Path
+
+    Raises
+    ------
+    BistairError
+        Captures that cannot be listed (:func:`capture_files`).
+
+    Examples
+    --------
+    >>> default_spec_path("/data/scan-1/pat*.png", [Path("/data/scan-1/pat0.png")]).as_posix()
+    '/data/scan-1/spec.json'
+    """
+    files = capture_files(captures) if files is None else files
+    first = Path(captures if isinstance(captures, str | Path) else next(iter(captures)))
+    return first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
 
 
 def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
