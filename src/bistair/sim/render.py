@@ -29,8 +29,10 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -278,9 +280,8 @@ def trace(rig: Rig, scene: Scene, imaging: Imaging | None = None,
                normals=np.empty((n, 3)), which=np.empty(n, np.int32), lit=np.empty(n, bool))
     blocks = [slice(i, min(i + _BLOCK, n)) for i in range(0, n, _BLOCK)]
     if (workers or os.cpu_count() or 1) > 1 and len(blocks) > 1:
-        with ThreadPoolExecutor(workers or os.cpu_count()) as pool:
-            for job in [pool.submit(_trace_block, rig, scene, imaging, b, out) for b in blocks]:
-                job.result()
+        _in_threads(workers or os.cpu_count() or 1,
+                    lambda b: _trace_block(rig, scene, imaging, b, out), blocks)
     else:
         for b in blocks:
             _trace_block(rig, scene, imaging, b, out)
@@ -363,12 +364,26 @@ def expose(trace: Trace, patterns: np.ndarray, imaging: Imaging | None = None,
     jobs = [(pattern, seed) for pattern, seed in zip(pats, seeds, strict=True)]
     count = min(workers or os.cpu_count() or 1, len(jobs))
     if count > 1:
-        with ThreadPoolExecutor(count) as pool:
-            frames = list(pool.map(lambda job: _frame(trace, imaging, where, ambient, *job),
-                                   jobs))
+        frames = _in_threads(count, lambda job: _frame(trace, imaging, where, ambient, *job),
+                             jobs)
     else:
         frames = [_frame(trace, imaging, where, ambient, *job) for job in jobs]
     return np.stack(frames)
+
+
+def _in_threads(count: int, func: Callable[[Any], Any], items: list) -> list:
+    """``[func(item) for item in items]`` on ``count`` threads. On an exception (Ctrl-C
+    included) the items not started are cancelled, so it propagates once the running ones
+    end rather than after all of them."""
+    pool = ThreadPoolExecutor(count)
+    try:
+        futures = [pool.submit(func, item) for item in items]
+        return [future.result() for future in futures]
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        raise
+    finally:
+        pool.shutdown(wait=True)
 
 
 def _frame(trace: Trace, imaging: Imaging, where: list, ambient: np.ndarray,
