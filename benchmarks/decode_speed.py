@@ -9,6 +9,12 @@ in a fresh process with an empty numba cache. ``numpy.show_runtime()`` says whic
 units NumPy's ``arctan2`` uses. If comimag's ``fringes`` package is installed, its
 three-frequency decode is timed too.
 
+The decodes are timed as the command line runs them, with freed memory kept for the next
+arrays (:func:`bistair.core.memory.keep_freed_memory`); the default decoder is also timed
+with glibc's default allocator settings (``system malloc``), which is what
+``bistair.decode`` from Python gets unless asked. The memory figure is always measured
+with the default settings.
+
     python benchmarks/decode_speed.py [--runs 5] [--sizes 1.3,12] [--threads N]
 """
 
@@ -28,6 +34,7 @@ import numpy as np
 
 import bistair
 from bistair.core.kernels import set_threads
+from bistair.core.memory import keep_freed_memory
 from bistair.sim.warp import Blob, WarpScene, render_warp
 
 SIZES = {"1.3": (1024, 1280), "12": (3000, 4000)}
@@ -152,7 +159,9 @@ def main() -> None:
     args = parser.parse_args()
     threads = set_threads(args.threads)
     np.show_runtime()
-    print(f"\nnumba threads: {threads}; cores: {os.cpu_count()}")
+    kept = keep_freed_memory()
+    print(f"\nnumba threads: {threads}; cores: {os.cpu_count()}; freed memory kept for the "
+          f"next arrays: {'yes' if kept else 'no (not glibc)'}")
     for key in args.sizes.split(","):
         size = SIZES[key]
         mpix = size[0] * size[1] / 1e6
@@ -178,6 +187,14 @@ def main() -> None:
             print(f"{label:<30} {1e3 * t_dec:7.0f}ms {mpix / t_dec:6.1f} "
                   f"{1e3 * t_atan:7.1f}ms {t_atan / t_dec:6.3f} {mem:>6} {first:>11} "
                   f"{compile_s:>9}", flush=True)
+            if not options and params["method"] == "bidirectional" and kept:
+                keep_freed_memory(False)
+                t_sys = timed(lambda f=frames, s=spec: bistair.decode(f, s), runs)
+                t_atan = timed(lambda f=frames: bare_arctan2(f), runs)
+                keep_freed_memory(True)
+                print(f"{'  the same, system malloc':<30} {1e3 * t_sys:7.0f}ms "
+                      f"{mpix / t_sys:6.1f} {1e3 * t_atan:7.1f}ms {t_atan / t_sys:6.3f}",
+                      flush=True)
         print(fringes_three_frequency(size, args.runs))
 
 

@@ -18,6 +18,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..core.memory import keep_freed_memory
 from ..errors import BistairError
 from ..spec import BaseSpec, coerce_field, field_kind
 
@@ -541,6 +542,7 @@ def _terminated(signum: int, frame: Any) -> None:
 
 def main() -> None:
     signal.signal(signal.SIGTERM, _terminated)
+    keep_freed_memory()  # a short-lived process: freed arrays serve the next ones
     try:
         cli(standalone_mode=False)
     except click.exceptions.Abort:

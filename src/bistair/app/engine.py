@@ -36,6 +36,7 @@ import dask
 from distributed import Client, LocalCluster, as_completed
 
 from ..core.kernels import set_threads
+from ..core.memory import keep_freed_memory
 from ..errors import BistairError
 from ..io.files import TEMP_PREFIX, remove_temporaries
 
@@ -43,7 +44,8 @@ BATCH_PREFIX = TEMP_PREFIX + "batch-"  # the temporaries of every batch run
 CONNECT_TIMEOUT = 20  # seconds to reach a scheduler
 # Dask starts its worker processes with MALLOC_TRIM_THRESHOLD_=65536, which turns off
 # glibc's growing mmap threshold: every large NumPy temporary is then a fresh mmap with its
-# pages faulted in, some 15% more time for a decode. Unset for the local cluster's workers.
+# pages faulted in, some 15% more time for a decode. Unset for the local cluster's workers;
+# each task then keeps freed memory for the next (bistair.core.memory).
 WORKER_CONFIG = {"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}
 WORKER_TIMEOUT = 60  # seconds to wait for a scheduler's first worker
 
@@ -57,6 +59,7 @@ def in_threads(threads: int | None, func: Callable[..., Any], *args: Any) -> Any
     """
     if threads is not None:
         set_threads(threads)
+    keep_freed_memory()  # a worker decodes scan after scan: its freed arrays serve the next
     return func(*args)
 
 
