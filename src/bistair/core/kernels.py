@@ -72,8 +72,9 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
                 if module.get("prange") is range:  # its first kernel: helpers compiled once
                     module["prange"] = numba.prange
                     for name, value in list(module.items()):
-                        if getattr(value, "_inline", False):
-                            module[name] = numba.njit(cache=True, inline="always")(value)
+                        how = getattr(value, "_inline", None)
+                        if how is not None:
+                            module[name] = numba.njit(cache=True, inline=how)(value)
                 compiled = numba.njit(cache=True, parallel=parallel, fastmath=False,
                                       error_model="numpy")(fn)
                 _COMPILED[key] = compiled
@@ -119,7 +120,14 @@ PI32 = np.float32(math.pi)
 
 def _numba_inline(fn: Callable) -> Callable:
     """Mark a helper that the kernels call: compiled into them with ``numba.njit``."""
-    fn._inline = True  # type: ignore[attr-defined]
+    fn._inline = "always"  # type: ignore[attr-defined]
+    return fn
+
+
+def _numba_called(fn: Callable) -> Callable:
+    """Mark a helper that the kernels call: compiled with ``numba.njit`` on its own (not
+    inlined: numba's parallel loops miscompile some inlined bodies that write arrays)."""
+    fn._inline = "never"  # type: ignore[attr-defined]
     return fn
 
 
@@ -142,18 +150,61 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
     their noise (float32, as :func:`bistair.core.regions.period_jumps` computes it)."""
     if pn < half or qn < half:
         return False
+    dx, dy = px - qx, py - qy
+    d2 = dx * dx + dy * dy
+    # clearly below ``rel`` of the larger gradient (most links): no root, no division
+    if d2 < rel * rel * max(px * px + py * py, qx * qx + qy * qy) * np.float32(0.9999):
+        return False
     one = np.float32(1.0)
     spread = np.float32(2.0) * max(noise_p / np.float32(math.sqrt(max(pn, one))),
                                    noise_q / np.float32(math.sqrt(max(qn, one))))
-    dx, dy = px - qx, py - qy
     limit = np.float32(4.0) * spread
-    if dx * dx + dy * dy < limit * limit * np.float32(0.9999):
+    if d2 < limit * limit * np.float32(0.9999):
         return False  # clearly below the noise: no square root needed
     step = np.float32(math.hypot(dx, dy))
     if not step > np.float32(4.0) * spread:
         return False
     size = max(np.float32(math.hypot(px, py)), np.float32(math.hypot(qx, qy)))
     return step > rel * size
+
+
+@_numba_inline
+def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
+                      sums: np.ndarray, around: np.ndarray, ahead: np.ndarray) -> None:
+    """Row ``y``'s mean wrapped gradients (x, y) and their sample counts over the columns
+    ``[x-half, x+half)`` (``around``, for the vertical links) and ``[x, x+half)``
+    (``ahead``, for the horizontal ones), each (3, W) and clipped to the image; ``sums``
+    (4, W+1) is scratch for the running sums."""
+    h, w = phi.shape
+    one = np.float32(1.0)
+    for x in range(w):
+        gx = np.float32(0.0)
+        nx = np.float32(0.0)
+        if x < w - 1 and valid[y, x] and valid[y, x + 1]:
+            gx = _wrapped(phi[y, x + 1] - phi[y, x])
+            nx = one
+        gy = np.float32(0.0)
+        ny = np.float32(0.0)
+        if y < h - 1 and valid[y, x] and valid[y + 1, x]:
+            gy = _wrapped(phi[y + 1, x] - phi[y, x])
+            ny = one
+        sums[0, x + 1] = sums[0, x] + gx
+        sums[1, x + 1] = sums[1, x] + nx
+        sums[2, x + 1] = sums[2, x] + gy
+        sums[3, x + 1] = sums[3, x] + ny
+    for x in range(w):
+        hi = min(x + half, w)
+        lo = max(x - half, 0)
+        nxs = sums[1, hi] - sums[1, lo]
+        nys = sums[3, hi] - sums[3, lo]
+        around[0, x] = (sums[0, hi] - sums[0, lo]) / max(nxs, one)
+        around[1, x] = (sums[2, hi] - sums[2, lo]) / max(nys, one)
+        around[2, x] = min(nxs, nys)
+        nxs = sums[1, hi] - sums[1, x]
+        nys = sums[3, hi] - sums[3, x]
+        ahead[0, x] = (sums[0, hi] - sums[0, x]) / max(nxs, one)
+        ahead[1, x] = (sums[2, hi] - sums[2, x]) / max(nys, one)
+        ahead[2, x] = min(nxs, nys)
 
 
 @kernel(parallel=True)
@@ -165,7 +216,9 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
     Gradients are wrapped phase differences along the row (``x``) and down the column
     (``y``), averaged over windows of columns: ``[x-half, x+half)`` around a pixel (for the
     vertical links), ``[x-half, x)`` and ``[x+1, x+1+half)`` either side of a horizontal
-    link. Float32 throughout, in the order of the NumPy formulation.
+    link. Float32 throughout, in the order of the NumPy formulation. Rows are taken in
+    blocks of 32 (on every core), each row's windows kept only until the next row's links
+    are made.
 
     Parameters
     ----------
@@ -197,62 +250,44 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
     ([16, 17, 18, 19, 21, 22], False)
     """
     h, w = phi.shape
-    rel = np.float32(relative)
-    fhalf = np.float32(half)
-    one = np.float32(1.0)
-    ax = np.zeros((h, w), np.float32)
-    ay = np.zeros((h, w), np.float32)
-    an = np.zeros((h, w), np.float32)
     horiz = np.zeros((h, w - 1), np.bool_)
     vert = np.zeros((h - 1, w), np.bool_)
-    for y in prange(h):
-        sx = np.zeros(w + 1, np.float32)
-        cx = np.zeros(w + 1, np.float32)
-        sy = np.zeros(w + 1, np.float32)
-        cy = np.zeros(w + 1, np.float32)
-        for x in range(w):
-            gx = np.float32(0.0)
-            nx = np.float32(0.0)
-            if x < w - 1 and valid[y, x] and valid[y, x + 1]:
-                gx = _wrapped(phi[y, x + 1] - phi[y, x])
-                nx = one
-            gy = np.float32(0.0)
-            ny = np.float32(0.0)
-            if y < h - 1 and valid[y, x] and valid[y + 1, x]:
-                gy = _wrapped(phi[y + 1, x] - phi[y, x])
-                ny = one
-            sx[x + 1] = sx[x] + gx
-            cx[x + 1] = cx[x] + nx
-            sy[x + 1] = sy[x] + gy
-            cy[x + 1] = cy[x] + ny
-        for x in range(w):
-            lo = max(x - half, 0)
-            hi = min(x + half, w)
-            nxs = cx[hi] - cx[lo]
-            nys = cy[hi] - cy[lo]
-            ax[y, x] = (sx[hi] - sx[lo]) / max(nxs, one)
-            ay[y, x] = (sy[hi] - sy[lo]) / max(nys, one)
-            an[y, x] = min(nxs, nys)
-        for x in range(w - 1):
-            lo, hi = max(x - half, 0), x
-            n1 = cx[hi] - cx[lo]
-            m1 = cy[hi] - cy[lo]
-            px = (sx[hi] - sx[lo]) / max(n1, one)
-            py = (sy[hi] - sy[lo]) / max(m1, one)
-            pn = min(n1, m1)
-            lo, hi = x + 1, min(x + 1 + half, w)
-            n2 = cx[hi] - cx[lo]
-            m2 = cy[hi] - cy[lo]
-            qx = (sx[hi] - sx[lo]) / max(n2, one)
-            qy = (sy[hi] - sy[lo]) / max(m2, one)
-            qn = min(n2, m2)
-            horiz[y, x] = _jump(px, py, pn, qx, qy, qn, noise[y, x], noise[y, x + 1], rel,
-                                fhalf)
-    for y in prange(h - 1):
-        for x in range(w):
-            vert[y, x] = _jump(ax[y, x], ay[y, x], an[y, x], ax[y + 1, x], ay[y + 1, x],
-                               an[y + 1, x], noise[y, x], noise[y + 1, x], rel, fhalf)
+    block = 32
+    for b in prange((h + block - 1) // block):
+        _jump_rows(phi, valid, noise, half, relative, b * block, min(b * block + block, h),
+                   vert, horiz)
     return vert, horiz
+
+
+@_numba_called
+def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
+               relative: float, y0: int, y1: int, vert: np.ndarray, horiz: np.ndarray
+               ) -> None:
+    """:func:`period_jump_links` for rows ``y0 .. y1-1`` (and the links from row ``y0-1``)."""
+    h, w = phi.shape
+    rel = np.float32(relative)
+    fhalf = np.float32(half)
+    sums = np.zeros((4, w + 1), np.float32)
+    ahead = np.zeros((3, w), np.float32)
+    rows = np.zeros((2, 3, w), np.float32)  # ``around`` of rows y-1 and y (at y % 2)
+    if y0 > 0:
+        _gradient_windows(phi, valid, y0 - 1, half, sums, rows[(y0 - 1) % 2], ahead)
+    for y in range(y0, y1):
+        around = rows[y % 2]
+        _gradient_windows(phi, valid, y, half, sums, around, ahead)
+        # left of link x the window [x-half, x) is ``ahead`` of x-half; nearer the image's
+        # left edge it holds under ``half`` samples and no link is cut
+        for x in range(half, w - 1):
+            lo = x - half
+            horiz[y, x] = _jump(ahead[0, lo], ahead[1, lo], ahead[2, lo],
+                                ahead[0, x + 1], ahead[1, x + 1], ahead[2, x + 1],
+                                noise[y, x], noise[y, x + 1], rel, fhalf)
+        if y > 0:
+            above = rows[(y - 1) % 2]
+            for x in range(w):
+                vert[y - 1, x] = _jump(above[0, x], above[1, x], above[2, x],
+                                       around[0, x], around[1, x], around[2, x],
+                                       noise[y - 1, x], noise[y, x], rel, fhalf)
 
 
 @kernel(parallel=True)
