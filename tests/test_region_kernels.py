@@ -271,3 +271,44 @@ def test_resolve_regions_messages():
         for got, want in zip(resolve_regions(evidence, links), before(evidence, links),
                              strict=True):
             assert np.array_equal(got, want)
+
+
+def test_label_stair_sums_and_stair_noise_match_the_stored_values():
+    from bistair.core.label_rows import label_row_sums
+    from bistair.core.region_maps import label_stair_sums, stair_noise, stair_weights
+
+    rng = np.random.default_rng(11)
+    for shape in [(1, 1), (1, 7), (9, 1), (40, 50), (33, 64), (150, 20)]:
+        phi = rng.uniform(0, 2 * np.pi, shape).astype(np.float32)
+        theta = rng.uniform(-np.pi, np.pi, shape).astype(np.float32)
+        stair_mod = rng.uniform(0, 0.5, shape).astype(np.float32)
+        mod = rng.uniform(0, 0.5, shape).astype(np.float32)
+        stair_mod.flat[:3], mod.flat[-2:] = 0.0, 1e-7
+        labels = rng.integers(0, 5, shape).astype(np.int32)
+        maps = (phi, np.cos(theta), np.sin(theta), stair_mod, mod)
+        values, noise = stair_weights(*maps, 0.017)
+        want = label_row_sums(labels, values, int(labels.max()))
+        got = label_stair_sums(labels, phi, theta, stair_mod, mod, int(labels.max()))
+        assert all(np.array_equal(a, b) for a, b in zip(want, got, strict=True))
+        assert np.array_equal(stair_noise(stair_mod, 0.017), noise)
+
+
+def test_label_row_sums_match_bincount():
+    from bistair.core.label_rows import label_row_sums
+
+    rng = np.random.default_rng(12)
+    for shape, n in [((1, 1), 1), ((5, 1), 3), ((1, 9), 4), ((70, 40), 3), ((64, 33), 900)]:
+        labels = rng.integers(0, n + 1, shape).astype(np.int32)
+        labels[rng.random(shape) < 0.3] = 0
+        if shape[0] > 3:
+            labels[2] = 0  # a row without labels
+        values = rng.normal(size=(3, *shape)).astype(np.float32)
+        h = shape[0]
+        key = (labels.astype(np.int64) * h + np.arange(h)[:, None])[labels > 0]
+        want_keys, inv = np.unique(key, return_inverse=True)
+        keys, counts, sums = label_row_sums(labels, values, int(labels.max()))
+        assert np.array_equal(keys, want_keys)
+        assert np.array_equal(counts, np.bincount(inv, minlength=want_keys.size))
+        for v in range(3):
+            want = np.bincount(inv, values[v][labels > 0].astype(np.float64), want_keys.size)
+            assert np.array_equal(sums[v], want)

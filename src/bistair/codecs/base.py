@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -252,6 +252,10 @@ class Codec:
         if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
             _refuse(turned)
         code = self.code_columns(cols, spec, fs, min_modulation)
+        # every set is measured: saturation is in the validity, the clipped masks (one byte
+        # a pixel, twice for the rows orientation) need not stay in memory
+        prepared = replace(prepared, clipped=np.broadcast_to(False, prepared.clipped.shape))
+        del cols
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
         if warnings:
@@ -262,11 +266,14 @@ class Codec:
             _refuse(jump_problem(bad, links, limit=0.05, big=big, big_limit=0.02))
         _refuse(jump_problem(orders.info.get("jump_violations", 0),
                              orders.info.get("jump_links", 0)))
+        words, beyond = code.code, code.beyond
+        del code  # its maps are done with: the result is made without them in memory
+        vars(fs).pop("phase_noise", None)  # the same for the set's cached phase noise
         result = result_from_orders(self.name, fs, orders.order, spec.period,
-                                   code=code.code, info=orders.info, length=spec.coded_length)
-        if code.beyond:
+                                   code=words, info=orders.info, length=spec.coded_length)
+        if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
-                                                + code.beyond)
+                                                + beyond)
         _refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
                                 spec.coded_length))
         result.info["valid_pixels"] = int(result.mask.sum())

@@ -488,68 +488,6 @@ def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.n
         n = m
 
 
-@kernel(parallel=True)
-def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Sums of ``values`` (V, H, W) per (label, row) over the labelled pixels (label > 0):
-    ``(keys, counts, sums (V, K))``, ``keys = label * H + row`` ascending. Float64 sums in
-    raster order, as ``np.bincount`` adds them (rows in parallel: each has its own keys).
-
-    Parameters
-    ----------
-    labels : (H, W) int32 array
-        Region labels, 0 outside any.
-    values : (V, H, W) float32 array
-        The V quantities to sum.
-    n_labels : int
-        Highest label.
-
-    Returns
-    -------
-    keys : (K,) int64 array
-        ``label * H + row`` of each (label, row) with pixels, ascending.
-    counts : (K,) int64 array
-        Pixels per key.
-    sums : (V, K) float64 array
-        Each quantity's sum per key.
-
-    Examples
-    --------
-    >>> labels = np.array([[1, 1, 2], [0, 2, 2]], np.int32)
-    >>> values = np.arange(6, dtype=np.float32).reshape(1, 2, 3)
-    >>> [a.tolist() for a in label_row_sums(labels, values, 2)]
-    [[2, 4, 5], [2, 1, 2], [[1.0, 2.0, 9.0]]]
-    """
-    nv, h, w = values.shape
-    n_bins = (n_labels + 1) * h
-    count = np.zeros(n_bins, np.int64)
-    acc = np.zeros((nv, n_bins), np.float64)
-    for y in prange(h):  # rows never share a key
-        for x in range(w):
-            lab = labels[y, x]
-            if lab > 0:
-                k = lab * h + y
-                count[k] += 1
-                for v in range(nv):
-                    acc[v, k] += np.float64(values[v, y, x])
-    used = 0
-    for k in range(n_bins):
-        if count[k] > 0:
-            used += 1
-    keys = np.empty(used, np.int64)
-    counts = np.empty(used, np.int64)
-    sums = np.empty((nv, used), np.float64)
-    i = 0
-    for k in range(n_bins):
-        if count[k] > 0:
-            keys[i] = k
-            counts[i] = count[k]
-            for v in range(nv):
-                sums[v, i] = acc[v, k]
-            i += 1
-    return keys, counts, sums
-
-
 @kernel()
 def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -18,6 +18,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -40,10 +41,10 @@ class FringeSet:
     steps: int | None = None  # N
     threshold: float | None = None  # the modulation a valid pixel needs
 
-    @property
+    @cached_property
     def phase_noise(self) -> np.ndarray:
         """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``
-        (float32, :func:`~bistair.core.fused.phase_noise`)."""
+        (float32, :func:`~bistair.core.fused.phase_noise`; computed once)."""
         return phase_noise(self.mod, self.noise, 4 if self.steps is None else self.steps)
 
     def transposed(self) -> FringeSet:
@@ -208,12 +209,17 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     # saturation, validity and the white/black contrast of captures.py, in one pass
     valid, strong, weak = pixel_validity(mod, avg, prepared.clipped, lowest, threshold,
                                          prepared.white, prepared.black)
+    sigma = None
     if lowest < threshold and weak:  # dim pixels to judge by their regions
-        valid = coherent_pixels(phi, valid, strong, phase_noise(mod, noise, steps))
+        sigma = phase_noise(mod, noise, steps)
+        valid = coherent_pixels(phi, valid, strong, sigma)
     del strong
     if check:
         check_decodable(valid, prepared.clipped, min_modulation, mod)
-    return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
+    fs = FringeSet(phi, avg, mod, valid, noise, steps, threshold)
+    if sigma is not None:  # the same per-pixel phase noise: kept as the set's
+        vars(fs)["phase_noise"] = sigma
+    return fs
 
 
 def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,

@@ -17,10 +17,12 @@ import math
 
 import numpy as np
 
-from .kernels import _numba_inline, kernel
+from .kernels import _numba_called, _numba_inline, kernel
+from .label_rows import BLOCK, label_major, row_entries
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
+TRIG_ROWS = 64  # rows whose stair phase cosine and sine are made at a time
 
 
 @kernel(parallel=True)
@@ -36,7 +38,7 @@ def pixel_orders(labels: np.ndarray, region_order: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    (H, W) int64 array
+    (H, W) int32 array
         ``region_order[labels]`` where ``labels > 0``, else -1.
 
     Examples
@@ -45,11 +47,11 @@ def pixel_orders(labels: np.ndarray, region_order: np.ndarray) -> np.ndarray:
     [[-1, 3, -1]]
     """
     h, w = labels.shape
-    out = np.empty((h, w), np.int64)
+    out = np.empty((h, w), np.int32)
     for y in prange(h):
         for x in range(w):
             lab = labels[y, x]
-            out[y, x] = region_order[lab] if lab > 0 else -1
+            out[y, x] = np.int32(region_order[lab]) if lab > 0 else np.int32(-1)
     return out
 
 
@@ -187,6 +189,20 @@ def _fmin(a: float, b: float) -> float:
     return a if a <= b else b
 
 
+@_numba_inline
+def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.float32,
+                  m: np.float32) -> tuple:
+    """One pixel's ``weight * cos``, ``weight * sin``, ``weight`` and ``ratio`` (float32,
+    as :func:`stair_weights` documents them)."""
+    tiny = np.float32(1e-6)
+    zero, one, two = np.float32(0.0), np.float32(1.0), np.float32(2.0)
+    ratio = _fmin(_fmax(sm / _fmax(m, tiny), zero), two)
+    core = _fmin(_fmax(_fmin(p, np.float32(TWO_PI) - p) / np.float32(math.pi / 2),
+                       np.float32(0.1)), one)
+    weight = core * _fmin(ratio, one)
+    return weight * cos_t, weight * sin_t, weight, ratio
+
+
 @kernel(parallel=True)
 def stair_weights(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
                   stair_mod: np.ndarray, mod: np.ndarray, noise_scale: float
@@ -196,7 +212,8 @@ def stair_weights(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
 
     ``ratio = clip(stair_mod / max(mod, 1e-6), 0, 2)``, ``weight = core_weight(phi) *
     min(ratio, 1)`` (:func:`bistair.core.regions.core_weight`) and ``noise = noise_scale /
-    max(stair_mod, 1e-6)`` (computed in float64, stored as float32).
+    max(stair_mod, 1e-6)`` (computed in float64, stored as float32). The decoder itself
+    sums the values without storing them (:func:`label_stair_sums`, :func:`stair_noise`).
 
     Parameters
     ----------
@@ -228,25 +245,159 @@ def stair_weights(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
     h, w = phi.shape
     values = np.empty((5, h, w), np.float32)
     noise = np.empty((h, w), np.float32)
-    two_pi = np.float32(TWO_PI)
-    quarter = np.float32(math.pi / 2)
     tiny = np.float32(1e-6)
-    zero, one, two = np.float32(0.0), np.float32(1.0), np.float32(2.0)
-    low = np.float32(0.1)
     for y in prange(h):
         for x in range(w):
-            sm = stair_mod[y, x]
-            ratio = _fmin(_fmax(sm / _fmax(mod[y, x], tiny), zero), two)
-            p = phi[y, x]
-            core = _fmin(_fmax(_fmin(p, two_pi - p) / quarter, low), one)
-            weight = core * _fmin(ratio, one)
-            values[0, y, x] = weight * cos_t[y, x]
-            values[1, y, x] = weight * sin_t[y, x]
+            c, s, weight, ratio = _stair_values(phi[y, x], cos_t[y, x], sin_t[y, x],
+                                                stair_mod[y, x], mod[y, x])
+            values[0, y, x] = c
+            values[1, y, x] = s
             values[2, y, x] = weight
             values[3, y, x] = ratio
             values[4, y, x] = np.float32(x)
-            noise[y, x] = np.float32(noise_scale / np.float64(_fmax(sm, tiny)))
+            noise[y, x] = np.float32(noise_scale / np.float64(_fmax(stair_mod[y, x], tiny)))
     return values, noise
+
+
+@kernel(parallel=True)
+def stair_noise(stair_mod: np.ndarray, noise_scale: float) -> np.ndarray:
+    """Stair phase noise per pixel, ``noise_scale / max(stair_mod, 1e-6)`` (float64
+    arithmetic, float32 result), as :func:`stair_weights` gives it.
+
+    Parameters
+    ----------
+    stair_mod : (H, W) float32 array
+        Modulation of the stair pair.
+    noise_scale : float
+        Camera noise times ``sqrt(2)``.
+
+    Returns
+    -------
+    (H, W) float32 array
+        Radians.
+
+    Examples
+    --------
+    >>> stair_noise(np.float32([[0.5, 0.0]]), 0.01).tolist()
+    [[0.019999999552965164, 10000.0]]
+    """
+    h, w = stair_mod.shape
+    noise = np.empty((h, w), np.float32)
+    tiny = np.float32(1e-6)
+    for y in prange(h):
+        for x in range(w):
+            noise[y, x] = np.float32(noise_scale / np.float64(_fmax(stair_mod[y, x], tiny)))
+    return noise
+
+
+@_numba_called
+def _stair_sum_rows(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
+                    sin_t: np.ndarray, stair_mod: np.ndarray, mod: np.ndarray, n_labels: int,
+                    start: np.ndarray, entry: np.ndarray, y0: int, y1: int,
+                    count: np.ndarray, acc: np.ndarray) -> None:
+    """:func:`stair_sums` of rows ``y0 .. y1-1``."""
+    w = labels.shape[1]
+    slot = np.empty(n_labels + 1, np.int64)
+    for y in range(y0, y1):
+        for i in range(start[y], start[y + 1]):
+            slot[entry[i]] = i
+        for x in range(w):
+            lab = labels[y, x]
+            if lab > 0:
+                i = slot[lab]
+                count[i] += 1
+                c, s, weight, ratio = _stair_values(phi[y, x], cos_t[y, x], sin_t[y, x],
+                                                    stair_mod[y, x], mod[y, x])
+                acc[0, i] += np.float64(c)
+                acc[1, i] += np.float64(s)
+                acc[2, i] += np.float64(weight)
+                acc[3, i] += np.float64(ratio)
+                acc[4, i] += np.float64(np.float32(x))
+
+
+@kernel(parallel=True)
+def stair_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
+               stair_mod: np.ndarray, mod: np.ndarray, n_labels: int, start: np.ndarray,
+               entry: np.ndarray, count: np.ndarray, acc: np.ndarray) -> None:
+    """Add :func:`stair_weights`' five values, computed per pixel as they are summed, to
+    the pixel ``count`` (K,) and sums ``acc`` (5, K) of the entries of
+    :func:`bistair.core.label_rows.row_entries` (of these rows: ``start`` has one more
+    element than the maps have rows; ``entry`` is the whole image's).
+
+    Parameters
+    ----------
+    labels : (R, W) int32 array
+        Region labels, 0 outside any.
+    phi, cos_t, sin_t, stair_mod, mod : (R, W) float32 arrays
+        As for :func:`stair_weights`.
+    n_labels : int
+        Highest label.
+    start, entry : numpy.ndarray
+        From :func:`bistair.core.label_rows.row_entries` (``start`` of these rows).
+    count : (K,) int64 array
+        Pixels per entry, added to.
+    acc : (5, K) float64 array
+        Sums per entry, added to.
+
+    Examples
+    --------
+    >>> one = np.ones((1, 3), np.float32)
+    >>> count, acc = np.zeros(1, np.int64), np.zeros((5, 1))
+    >>> stair_sums(np.int32([[1, 1, 0]]), np.pi * one, one, 0 * one, one, one, 1,
+    ...            np.array([0, 1]), np.int32([1]), count, acc)
+    >>> count.tolist(), acc[:, 0].tolist()
+    ([2], [2.0, 0.0, 2.0, 2.0, 1.0])
+    """
+    h = labels.shape[0]
+    for b in prange((h + BLOCK - 1) // BLOCK):
+        _stair_sum_rows(labels, phi, cos_t, sin_t, stair_mod, mod, n_labels, start, entry,
+                        b * BLOCK, min(b * BLOCK + BLOCK, h), count, acc)
+
+
+def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
+                     stair_mod: np.ndarray, mod: np.ndarray, n_labels: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`bistair.core.label_rows.label_row_sums` of :func:`stair_weights`' five values
+    (from ``np.cos(theta)`` and ``np.sin(theta)``), computed per pixel as they are summed:
+    no (5, H, W) array, the cosine and sine made for a band of rows at a time. Returns
+    ``(keys, counts, sums (5, K))``, ``keys = label * H + row`` ascending, float64 sums in
+    raster order.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Region labels, 0 outside any.
+    phi, theta, stair_mod, mod : (H, W) float32 arrays
+        Wrapped phase, stair phase and the modulations of the stair pair and the fringes.
+    n_labels : int
+        Highest label.
+
+    Returns
+    -------
+    keys : (K,) int64 array
+        ``label * H + row`` of each (label, row) with pixels, ascending.
+    counts : (K,) int64 array
+        Pixels per key.
+    sums : (5, K) float64 array
+        The sums of ``weight * cos``, ``weight * sin``, ``weight``, ``ratio`` and the column.
+
+    Examples
+    --------
+    >>> one = np.ones((1, 3), np.float32)
+    >>> keys, counts, sums = label_stair_sums(np.int32([[1, 1, 0]]), np.pi * one, 0 * one,
+    ...                                       one, one, 1)
+    >>> keys.tolist(), counts.tolist(), sums[:, 0].tolist()
+    ([1], [2], [2.0, 0.0, 2.0, 2.0, 1.0])
+    """
+    start, entry = row_entries(labels, n_labels)
+    count = np.zeros(entry.size, np.int64)
+    acc = np.zeros((5, entry.size), np.float64)
+    for y0 in range(0, labels.shape[0], TRIG_ROWS):
+        rows = slice(y0, y0 + TRIG_ROWS)
+        t = theta[rows]
+        stair_sums(labels[rows], phi[rows], np.cos(t), np.sin(t), stair_mod[rows], mod[rows],
+                   n_labels, start[y0:y0 + TRIG_ROWS + 1], entry, count, acc)
+    return label_major(start, entry, count, acc, n_labels)
 
 
 @kernel(parallel=True)

@@ -301,10 +301,12 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
              else np.ascontiguousarray(phase_noise, dtype=np.float32))
     sign = fringe_direction(phi, valid)
     jump_v, jump_h = period_jump_links(phi, valid, noise, 3, 0.3)
-    if boundaries is not None:
-        jump_v, jump_h = jump_v | boundaries[0], jump_h | boundaries[1]
+    if boundaries is not None:  # the links are this call's own arrays: marked in place
+        jump_v |= boundaries[0]
+        jump_h |= boundaries[1]
     vert, horiz, keep = fringe_links(phi, valid, float(np.float32(cut)), sign, noise,
                                      jump_v, jump_h)
+    del jump_v, jump_h
     n, labels = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
                                         ltype=cv2.CV_32S)
     n -= 1
@@ -398,11 +400,12 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
 
 
 def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
-                max_distance: float = 3.0) -> np.ndarray:
+                max_distance: float = 3.0, in_place: bool = False) -> np.ndarray:
     """Fringe orders for ``target`` pixels without one (``order < 0``) from the nearest
     pixel that has one: the order that brings the pixel's phase nearest that pixel's
     absolute phase, ``round((phi_near + 2 pi k_near - phi) / 2pi)``. Target pixels farther
-    than ``max_distance`` from any order keep -1. Returns a new int32 array.
+    than ``max_distance`` from any order keep -1. Returns a new int32 array, or, with
+    ``in_place`` and an int32 ``order``, ``order`` itself filled.
 
     Only the orders given count as sources (a pixel filled here does not fill another).
 
@@ -416,6 +419,8 @@ def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
         Pixels to fill.
     max_distance : float
         Farthest source, in pixels (Euclidean).
+    in_place : bool
+        Fill an int32 ``order`` itself (every source is read before a pixel is filled).
 
     Returns
     -------
@@ -429,7 +434,7 @@ def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
     >>> fill_orders(phi, order, np.ones(phi.shape, bool), max_distance=1.5).tolist()
     [[3, 3, 4, 4, 4, -1]]
     """
-    out = np.array(order, dtype=np.int32)
+    out = np.asarray(order, np.int32) if in_place else np.array(order, dtype=np.int32)
     ty, tx = np.nonzero(target & (out < 0))
     if ty.size == 0:
         return out

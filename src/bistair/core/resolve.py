@@ -280,7 +280,7 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     if info is not None:
         info.update(regions_adopted=adopted, regions_contradicted=dropped)
     order, outside = label_orders(labels, k_reg.astype(np.int32), valid)
-    return fill_orders(phi, order, outside, max_distance=3.0)
+    return fill_orders(phi, order, outside, max_distance=3.0, in_place=True)
 
 
 def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
@@ -396,7 +396,10 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     """
     k_pix = pixel_orders(labels, np.asarray(k_reg))
     decided = k_pix >= 0
-    bad = decided & ~agrees(k_pix)
+    bad = np.asarray(agrees(k_pix), bool)
+    del k_pix
+    bad = np.logical_not(bad, out=bad if bad.flags.writeable else None)
+    bad &= decided
     if not dense_tile(bad, decided, share, 8):  # a cheap test: no part anywhere
         return labels, n, 0
     # the window shares only matter at bad pixels: count them in their bounding box, with a

@@ -52,7 +52,7 @@ from ...core.fused_codes import stair_agreement
 from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI, wrap
-from ...core.region_maps import stair_weights
+from ...core.region_maps import TRIG_ROWS, stair_noise
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair
@@ -60,11 +60,13 @@ from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
 from .bands import (
+    RowProfiles,
     nearest_level,
     observed_levels,
     profile_centroids,
     row_profiles,
     row_runs,
+    stair_row_profiles,
     stair_values,
     union_levels,
 )
@@ -438,8 +440,12 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     (64, [108, 109, 110])
     """
     h, w = phi.shape
-    edge = stair_turns(phi, np.cos(theta), np.sin(theta), valid,
-                       np.ascontiguousarray(noise, dtype=np.float32), TWO_PI / stairs)
+    noise = np.ascontiguousarray(noise, dtype=np.float32)
+    edge = np.empty((h, w - 1), bool)
+    for y0 in range(0, h, TRIG_ROWS):  # the cosine and sine for a band of rows at a time
+        rows = slice(y0, y0 + TRIG_ROWS)
+        edge[rows] = stair_turns(phi[rows], np.cos(theta[rows]), np.sin(theta[rows]),
+                                 valid[rows], noise[rows], TWO_PI / stairs)
     ys, xs = np.flatnonzero(edge.any(axis=1)), np.flatnonzero(edge.any(axis=0))
     if ys.size == 0:
         return np.zeros((h - 1, w), bool), edge
@@ -499,26 +505,37 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
     noise_scale = fs.noise * np.sqrt(2.0)
     maps = (fs.phi, theta, stair_mod, fs.mod)
     if np.ndim(noise_scale) == 0 and all(m.dtype == np.float32 for m in maps):
-        values, noise = stair_weights(fs.phi, np.cos(theta), np.sin(theta), stair_mod, fs.mod,
-                                      float(noise_scale))
+        def profiles(labels: np.ndarray) -> RowProfiles:  # values summed, never stored
+            return stair_row_profiles(labels, fs.phi, theta, stair_mod, fs.mod)
+
+        def stair_noise_map() -> np.ndarray:
+            return stair_noise(stair_mod, float(noise_scale))
     else:  # the same in NumPy
-        noise = noise_scale / np.maximum(stair_mod, 1e-6)
         ratio = np.clip(stair_mod / np.maximum(fs.mod, 1e-6), 0.0, 2.0)
         values = stair_values(theta, core_weight(fs.phi) * np.minimum(ratio, 1.0), ratio)
-    edges = stair_edges(fs.phi, theta, fs.valid, noise, spec.stairs, 12)
-    del noise
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise, boundaries=edges)
-    del edges
+
+        def profiles(labels: np.ndarray) -> RowProfiles:
+            return row_profiles(labels, values)
+
+        def stair_noise_map() -> np.ndarray:
+            return noise_scale / np.maximum(stair_mod, 1e-6)
+
+    def regions() -> np.ndarray:
+        """Fringe regions, cut where the stair code says two surfaces meet."""
+        edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
+        return fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise,
+                              boundaries=edges)[0]
+
     levels = union_levels(spec.partitions, spec.stairs)
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        prof = row_profiles(labels, values)
+        prof = profiles(labels)
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = edge_rows(runs, band_splits(runs, heights, spec.local_rows / spec.group_rows))
         if splits:  # surfaces stacked in one fringe region: decode them apart
             prof = split_profiles(prof, n, splits)
-            labels, n = split_regions(labels, n, splits)
+            labels, n = split_regions(labels, n, splits, in_place=True)  # the decode's own
             runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         default = float(np.nanmedian(heights)) if np.isfinite(heights).any() else spec.group_rows
@@ -532,7 +549,8 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         """A pixel reads its order's local or partition level (its row decides which)."""
         return stair_agreement(ks, theta, k, spec.stairs, spec.partitions)
 
-    return orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info,
+    # the labels are passed on, not kept here: the decode replaces them as it splits regions
+    return orders_from_regions(fs.phi, fs.valid, regions(), evidence_of, agrees, info,
                                phase_noise=fs.phase_noise)
 
 

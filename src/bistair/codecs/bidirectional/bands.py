@@ -17,13 +17,14 @@ from functools import lru_cache
 
 import numpy as np
 
-from ...core.kernels import label_row_sums
+from ...core.label_rows import label_row_sums
 from ...core.phase import TWO_PI, wrap
 from ...core.region_kernels import (
     group_percentiles,
     nearest_levels,
     region_quantile,
 )
+from ...core.region_maps import label_stair_sums
 from ...core.stair import stair_level_phase
 
 
@@ -193,8 +194,47 @@ def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
     >>> prof.region.size, prof.region[:2].tolist(), prof.row[:2].tolist(), prof.count[:2].tolist()
     (96, [1, 1], [0, 1], [8, 8])
     """
-    h = labels.shape[0]
-    keys, count, sums = label_row_sums(labels, values, int(labels.max()))
+    return _profiles(labels.shape[0], *label_row_sums(labels, values, int(labels.max())))
+
+
+def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
+                       stair_mod: np.ndarray, mod: np.ndarray) -> RowProfiles:
+    """:func:`row_profiles` of the values :func:`stair_values` would make from float32 maps
+    (:func:`~bistair.core.region_maps.stair_weights`), summed as they are computed
+    (:func:`~bistair.core.region_maps.label_stair_sums`).
+
+    Parameters
+    ----------
+    labels : numpy.ndarray
+        (H, W) int32 fringe region labels, 0 for no region.
+    phi, theta, stair_mod, mod : numpy.ndarray
+        (H, W) float32 wrapped phase, stair phase, modulation of the stair pair and of the
+        fringes.
+
+    Returns
+    -------
+    RowProfiles
+        The same as :func:`row_profiles` of the stored values.
+
+    Examples
+    --------
+    >>> from dataclasses import astuple
+    >>> from bistair.core.region_maps import stair_weights
+    >>> rng = np.random.default_rng(0)
+    >>> phi, theta, stair_mod, mod = (rng.uniform(0.1, 1, (6, 5)).astype(np.float32)
+    ...                               for _ in range(4))
+    >>> labels = rng.integers(0, 3, (6, 5)).astype(np.int32)
+    >>> a = stair_row_profiles(labels, phi, theta, stair_mod, mod)
+    >>> values = stair_weights(phi, np.cos(theta), np.sin(theta), stair_mod, mod, 0.01)[0]
+    >>> b = row_profiles(labels, values)
+    >>> all(np.array_equal(u, v) for u, v in zip(astuple(a), astuple(b)))
+    True
+    """
+    return _profiles(labels.shape[0], *label_stair_sums(labels, phi, theta, stair_mod, mod,
+                                                        int(labels.max())))
+
+
+def _profiles(h: int, keys: np.ndarray, count: np.ndarray, sums: np.ndarray) -> RowProfiles:
     c, s, wsum, rsum, cols = sums
     return RowProfiles(keys // h, keys % h, c, s, wsum, rsum / np.maximum(count, 1), count,
                        cols)

@@ -81,23 +81,26 @@ def band_splits(runs: Runs, heights: np.ndarray, local_share: float
     return splits
 
 
-def split_regions(labels: np.ndarray, n_regions: int,
-                  splits: list[tuple[int, int]]) -> tuple[np.ndarray, int]:
+def split_regions(labels: np.ndarray, n_regions: int, splits: list[tuple[int, int]],
+                  in_place: bool = False) -> tuple[np.ndarray, int]:
     """Give the rows of a region from each split row down a new label.
 
     Parameters
     ----------
     labels : numpy.ndarray
-        (H, W) int fringe region labels (not changed).
+        (H, W) int fringe region labels (changed only ``in_place``).
     n_regions : int
         The highest label in use.
     splits : list of tuple of int
         ``(region, row)`` pairs, as from :func:`band_splits`.
+    in_place : bool
+        Relabel ``labels`` itself rather than a copy.
 
     Returns
     -------
     labels : numpy.ndarray
-        A relabelled copy: each split's lower part gets a new label above ``n_regions``.
+        A relabelled copy (or ``labels``): each split's lower part gets a new label above
+        ``n_regions``.
     n_regions : int
         The highest label now in use.
 
@@ -108,7 +111,7 @@ def split_regions(labels: np.ndarray, n_regions: int,
     >>> n, new[:, 0].tolist()
     (2, [1, 1, 1, 1, 2, 2])
     """
-    labels = labels.copy()
+    labels = labels if in_place else labels.copy()
     for region, row in sorted(splits, key=lambda s: (s[0], -s[1])):
         n_regions += 1
         lower = labels[row:] == region
