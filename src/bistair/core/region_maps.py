@@ -22,7 +22,17 @@ from .label_rows import BLOCK, label_major, row_entries
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
-TRIG_ROWS = 64  # rows whose stair phase cosine and sine are made at a time
+
+
+def trig_bands(height: int) -> range:
+    """First rows of the bands whose stair phase cosine and sine are made at a time: an
+    eighth of the image (at least 64 rows), so that the two float32 maps take a byte per
+    pixel rather than eight, in few kernel calls.
+
+    >>> list(trig_bands(1000)), list(trig_bands(100))
+    ([0, 125, 250, 375, 500, 625, 750, 875], [0, 64])
+    """
+    return range(0, height, max(64, -(-height // 8)))
 
 
 @kernel(parallel=True)
@@ -392,11 +402,12 @@ def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     start, entry = row_entries(labels, n_labels)
     count = np.zeros(entry.size, np.int64)
     acc = np.zeros((5, entry.size), np.float64)
-    for y0 in range(0, labels.shape[0], TRIG_ROWS):
-        rows = slice(y0, y0 + TRIG_ROWS)
+    bands = trig_bands(labels.shape[0])
+    for y0 in bands:
+        rows = slice(y0, y0 + bands.step)
         t = theta[rows]
         stair_sums(labels[rows], phi[rows], np.cos(t), np.sin(t), stair_mod[rows], mod[rows],
-                   n_labels, start[y0:y0 + TRIG_ROWS + 1], entry, count, acc)
+                   n_labels, start[y0:y0 + bands.step + 1], entry, count, acc)
     return label_major(start, entry, count, acc, n_labels)
 
 
