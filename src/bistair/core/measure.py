@@ -209,17 +209,12 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     # saturation, validity and the white/black contrast of captures.py, in one pass
     valid, strong, weak = pixel_validity(mod, avg, prepared.clipped, lowest, threshold,
                                          prepared.white, prepared.black)
-    sigma = None
     if lowest < threshold and weak:  # dim pixels to judge by their regions
-        sigma = phase_noise(mod, noise, steps)
-        valid = coherent_pixels(phi, valid, strong, sigma)
+        valid = coherent_pixels(phi, valid, strong, phase_noise(mod, noise, steps))
     del strong
     if check:
         check_decodable(valid, prepared.clipped, min_modulation, mod)
-    fs = FringeSet(phi, avg, mod, valid, noise, steps, threshold)
-    if sigma is not None:  # the same per-pixel phase noise: kept as the set's
-        vars(fs)["phase_noise"] = sigma
-    return fs
+    return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
 
 
 def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
