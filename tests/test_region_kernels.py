@@ -312,3 +312,22 @@ def test_label_row_sums_match_bincount():
         for v in range(3):
             want = np.bincount(inv, values[v][labels > 0].astype(np.float64), want_keys.size)
             assert np.array_equal(sums[v], want)
+
+
+def test_code_evidence_matches_bincount():
+    from bistair.core.resolve import code_evidence
+
+    rng = np.random.default_rng(13)
+    for shape, n, c in [((1, 1), 1, 1), ((6, 1), 3, 4), ((40, 30), 20, 7), ((25, 64), 300, 64)]:
+        labels = rng.integers(0, n + 1, shape).astype(np.int32)
+        codes = rng.integers(-1, c, shape).astype(np.int32)
+        weights = rng.uniform(0.1, 1, shape).astype(np.float32)
+        for w in (None, weights):
+            flat, cc = labels.ravel(), codes.ravel()
+            sel = (flat > 0) & (cc >= 0)
+            ww = None if w is None else w.ravel()[sel]
+            votes = np.bincount(flat[sel].astype(np.int64) * c + cc[sel], ww,
+                                (n + 1) * c).reshape(n + 1, c)
+            total = np.bincount(flat[sel], ww, n + 1)
+            want = votes / np.maximum(total, 1e-12)[:, None]
+            assert np.array_equal(code_evidence(labels, n, codes, c, w), want)

@@ -268,7 +268,6 @@ class Codec:
                              orders.info.get("jump_links", 0)))
         words, beyond = code.code, code.beyond
         del code  # its maps are done with: the result is made without them in memory
-        vars(fs).pop("phase_noise", None)  # the same for the set's cached phase noise
         result = result_from_orders(self.name, fs, orders.order, spec.period,
                                    code=words, info=orders.info, length=spec.coded_length)
         if beyond:

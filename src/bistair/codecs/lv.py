@@ -34,6 +34,7 @@ from ..core.checks import stair_misfit
 from ..core.fused import pair_phase
 from ..core.kernels import quantize32
 from ..core.measure import FringeSet
+from ..core.region_maps import row_bands
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..core.resolve import code_evidence, orders_from_regions
 from ..core.stair import stair_level_phase, stair_pair
@@ -391,11 +392,19 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
         succ = _successors(region_links(fs.phi, labels), n)
         return labels, n, window_evidence(region_code, shares.max(axis=1), succ, spec, info)
 
-    sequence = np.asarray(spec.sequence)
+    sequence = np.asarray(spec.sequence, np.int32)
+
+    def agrees(k: np.ndarray) -> np.ndarray:
+        ok = np.empty(k.shape, bool)
+        bands = row_bands(k.shape[0])
+        for y0 in bands:  # a band at a time: the lookup's indices are 8 bytes a pixel
+            rows = slice(y0, y0 + bands.step)
+            np.equal(codes[rows], np.take(sequence, k[rows], mode="clip"), out=ok[rows])
+        ok |= codes < 0  # (undecided orders, -1, are not judged)
+        return ok
+
     info: dict = {"noise": fs.noise, "fringes": spec.fringes}
-    order = orders_from_regions(
-        fs.phi, fs.valid, labels, evidence_of, info=info,
-        agrees=lambda k: (codes == sequence[np.clip(k, 0, None)]) | (codes < 0))
+    order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
     windows, unknown = info.get("code_windows", 0), info.get("unknown_windows", 0)
     if windows >= 20 and unknown > 0.15 * windows:
         raise BistairError(

@@ -217,8 +217,14 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """Noise moves a code a level or so; another surface's fringe moves it more."""
-        off = np.abs(codes - k) % spec.levels
-        return (np.minimum(off, spec.levels - off) <= 1) | (codes < 0)
+        off = np.subtract(codes, k, dtype=np.int32)  # in place from here: few temporaries
+        np.abs(off, out=off)
+        off %= spec.levels
+        ok = off <= 1  # min(off, levels - off) <= 1
+        ok |= off >= spec.levels - 1
+        del off
+        ok |= codes < 0
+        return ok
 
     return Orders(orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info),
                   info)

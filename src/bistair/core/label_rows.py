@@ -232,3 +232,49 @@ def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
     start, entry = row_entries(labels, n_labels)
     count, acc = row_sums(labels, values, n_labels, start, entry)
     return label_major(start, entry, count, acc, n_labels)
+
+
+@kernel()
+def label_code_votes(labels: np.ndarray, codes: np.ndarray, weights: np.ndarray,
+                     n_labels: int, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each label's (weighted) votes per code and in all: ``(votes (n+1, C), total
+    (n+1,))``, float64, over the pixels with a label (1 .. n) and a code (0 .. C-1; others
+    abstain), added in raster order as ``np.bincount`` adds them (one thread: a label
+    spans rows).
+
+    Parameters
+    ----------
+    labels : (H, W) int array
+        Region labels, 0 outside any.
+    codes : (H, W) int array
+        Code per pixel, 0 .. n_codes-1, negative to abstain.
+    weights : (H, W) float array or (0, 0) array
+        Vote weight per pixel; an empty array for one vote each.
+    n_labels, n_codes : int
+        Highest label and number of codes.
+
+    Returns
+    -------
+    votes : (n_labels + 1, n_codes) float64 array
+    total : (n_labels + 1,) float64 array
+
+    Examples
+    --------
+    >>> votes, total = label_code_votes(np.array([[1, 1, 2]]), np.array([[0, 1, -1]]),
+    ...                                 np.empty((0, 0)), 2, 2)
+    >>> votes.tolist(), total.tolist()
+    ([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]], [0.0, 2.0, 0.0])
+    """
+    h, w = labels.shape
+    votes = np.zeros((n_labels + 1, n_codes), np.float64)
+    total = np.zeros(n_labels + 1, np.float64)
+    weighted = weights.size > 0
+    for y in range(h):
+        for x in range(w):
+            lab = labels[y, x]
+            c = codes[y, x]
+            if lab > 0 and c >= 0 and lab <= n_labels and c < n_codes:
+                v = np.float64(weights[y, x]) if weighted else 1.0
+                votes[lab, c] += v
+                total[lab] += v
+    return votes, total

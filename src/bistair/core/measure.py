@@ -18,7 +18,6 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
 
@@ -41,10 +40,11 @@ class FringeSet:
     steps: int | None = None  # N
     threshold: float | None = None  # the modulation a valid pixel needs
 
-    @cached_property
+    @property
     def phase_noise(self) -> np.ndarray:
         """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``
-        (float32, :func:`~bistair.core.fused.phase_noise`; computed once)."""
+        (float32, :func:`~bistair.core.fused.phase_noise`; computed when asked for, not
+        kept: a map of 4 bytes a pixel that most stages need only for a moment)."""
         return phase_noise(self.mod, self.noise, 4 if self.steps is None else self.steps)
 
     def transposed(self) -> FringeSet:

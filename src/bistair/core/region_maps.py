@@ -24,12 +24,13 @@ prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
 
 
-def trig_bands(height: int) -> range:
-    """First rows of the bands whose stair phase cosine and sine are made at a time: an
-    eighth of the image (at least 64 rows), so that the two float32 maps take a byte per
-    pixel rather than eight, in few kernel calls.
+def row_bands(height: int) -> range:
+    """First rows of the bands of an image worked a band at a time: an eighth of the image
+    (at least 64 rows), so that a band's temporaries take an eighth of a whole image's, in
+    few kernel calls (the stair phase's cosine and sine here, for example: a byte per pixel
+    rather than eight).
 
-    >>> list(trig_bands(1000)), list(trig_bands(100))
+    >>> list(row_bands(1000)), list(row_bands(100))
     ([0, 125, 250, 375, 500, 625, 750, 875], [0, 64])
     """
     return range(0, height, max(64, -(-height // 8)))
@@ -402,7 +403,7 @@ def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     start, entry = row_entries(labels, n_labels)
     count = np.zeros(entry.size, np.int64)
     acc = np.zeros((5, entry.size), np.float64)
-    bands = trig_bands(labels.shape[0])
+    bands = row_bands(labels.shape[0])
     for y0 in bands:
         rows = slice(y0, y0 + bands.step)
         t = theta[rows]

@@ -339,7 +339,9 @@ def core_weight(phi: np.ndarray) -> np.ndarray:
     >>> core_weight(np.array([0.0, np.pi / 4, np.pi, 6.0])).round(3).tolist()
     [0.1, 0.5, 1.0, 0.18]
     """
-    return np.clip(np.minimum(phi, TWO_PI - phi) / (np.pi / 2), 0.1, 1.0)
+    weight = np.minimum(phi, TWO_PI - phi)  # in place from here: one temporary
+    weight /= np.pi / 2
+    return np.clip(weight, 0.1, 1.0, out=weight)
 
 
 @dataclass(frozen=True)

@@ -23,6 +23,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from .label_rows import label_code_votes
 from .region_kernels import pass_messages
 from .region_maps import dense_tile, label_orders, pixel_orders, window_seeds
 from .regions import RegionLinks, fill_orders, fringe_direction, region_links
@@ -395,8 +396,8 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
     (2, 1, [1], [2])
     """
     k_pix = pixel_orders(labels, np.asarray(k_reg))
+    bad = np.asarray(agrees(k_pix), bool)  # a new array (changed in place below)
     decided = k_pix >= 0
-    bad = np.asarray(agrees(k_pix), bool)
     del k_pix
     bad = np.logical_not(bad, out=bad if bad.flags.writeable else None)
     bad &= decided
@@ -462,11 +463,9 @@ def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes
     >>> code_evidence(labels, 2, codes, 3).round(3).tolist()
     [[0.0, 0.0, 0.0], [0.667, 0.333, 0.0], [0.0, 0.0, 1.0]]
     """
-    flat = labels.ravel()
-    c = codes.ravel()
-    sel = (flat > 0) & (c >= 0)
-    w = None if weights is None else weights.ravel()[sel]
-    votes = np.bincount(flat[sel].astype(np.int64) * n_codes + c[sel], w,
-                        (n_regions + 1) * n_codes).reshape(n_regions + 1, n_codes)
-    total = np.bincount(flat[sel], w, n_regions + 1)
+    shape = labels.shape if labels.ndim == 2 else (1, labels.size)
+    votes, total = label_code_votes(
+        np.ascontiguousarray(labels).reshape(shape), np.ascontiguousarray(codes).reshape(shape),
+        np.empty((0, 0)) if weights is None else np.ascontiguousarray(weights).reshape(shape),
+        int(n_regions), int(n_codes))
     return votes / np.maximum(total, 1e-12)[:, None]

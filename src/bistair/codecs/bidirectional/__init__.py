@@ -52,7 +52,7 @@ from ...core.fused_codes import stair_agreement
 from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI, wrap
-from ...core.region_maps import stair_noise, trig_bands
+from ...core.region_maps import row_bands, stair_noise
 from ...core.regions import core_weight, fringe_regions
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair
@@ -442,7 +442,7 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     h, w = phi.shape
     noise = np.ascontiguousarray(noise, dtype=np.float32)
     edge = np.empty((h, w - 1), bool)
-    bands = trig_bands(h)
+    bands = row_bands(h)
     for y0 in bands:  # the cosine and sine for a band of rows at a time
         rows = slice(y0, y0 + bands.step)
         edge[rows] = stair_turns(phi[rows], np.cos(theta[rows]), np.sin(theta[rows]),
