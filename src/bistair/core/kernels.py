@@ -66,8 +66,7 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
         def call(*args: Any) -> Any:
             compiled = _COMPILED.get(key)
             if compiled is None:
-                import numba  # heavy: imported when the first kernel runs
-
+                numba = _numba()  # heavy: imported when the first kernel runs
                 module = fn.__globals__  # the kernel's own module (kernels, region_kernels)
                 if module.get("prange") is range:  # its first kernel: helpers compiled once
                     module["prange"] = numba.prange
@@ -107,11 +106,26 @@ def set_threads(count: int | None) -> int:
     >>> set_threads(None) >= 1  # back to every core
     True
     """
-    import numba
-
+    numba = _numba()
     count = count or os.cpu_count() or 1
     numba.set_num_threads(max(1, min(int(count), numba.config.NUMBA_NUM_THREADS)))
     return numba.get_num_threads()
+
+
+def _numba() -> Any:
+    """Import numba, its OpenMP threads told to sleep rather than spin between loops.
+
+    OpenMP's default (``OMP_WAIT_POLICY=active``) keeps a finished loop's threads spinning:
+    on a machine whose cores other work also wants, each of a decode's few dozen parallel
+    loops then waits a scheduler slice for a thread to come back (a 2-core machine with one
+    busy core decoded three times slower on two threads than on one). Passive threads cost
+    some microseconds a loop on an idle machine. A policy set by the user is kept; it acts
+    only if the OpenMP runtime is not loaded yet.
+    """
+    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+    import numba
+
+    return numba
 
 
 TWO_PI32 = np.float32(2.0 * math.pi)
