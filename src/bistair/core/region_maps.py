@@ -30,6 +30,18 @@ def row_bands(height: int) -> range:
     few kernel calls (the stair phase's cosine and sine here, for example: a byte per pixel
     rather than eight).
 
+    Parameters
+    ----------
+    height : int
+        Rows of the image.
+
+    Returns
+    -------
+    range
+        The bands' first rows; its ``step`` is the band height.
+
+    Examples
+    --------
     >>> list(row_bands(1000)), list(row_bands(100))
     ([0, 125, 250, 375, 500, 625, 750, 875], [0, 64])
     """
