@@ -331,3 +331,26 @@ def test_code_evidence_matches_bincount():
             total = np.bincount(flat[sel], ww, n + 1)
             want = votes / np.maximum(total, 1e-12)[:, None]
             assert np.array_equal(code_evidence(labels, n, codes, c, w), want)
+
+
+def test_in_place_fills_and_splits_equal_the_copies():
+    from bistair.codecs.bidirectional.evidence import split_regions
+    from bistair.core.regions import fill_orders
+
+    rng = np.random.default_rng(14)
+    phi = rng.uniform(0, 2 * np.pi, (30, 40)).astype(np.float32)
+    order = rng.integers(-1, 5, (30, 40)).astype(np.int32)
+    target = rng.random((30, 40)) < 0.5
+    want = fill_orders(phi, order, target)
+    given = order.copy()
+    got = fill_orders(phi, given, target, in_place=True)
+    assert got is given and np.array_equal(got, want)
+    assert not np.array_equal(want, order)  # the copy left the input alone
+
+    labels = rng.integers(0, 4, (30, 40)).astype(np.int32)
+    splits = [(1, 10), (2, 5), (1, 20)]
+    want, n = split_regions(labels, 3, splits)
+    given = labels.copy()
+    got, m = split_regions(given, 3, splits, in_place=True)
+    assert got is given and m == n and np.array_equal(got, want)
+    assert not np.array_equal(want, labels)
