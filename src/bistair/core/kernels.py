@@ -230,9 +230,9 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
     Gradients are wrapped phase differences along the row (``x``) and down the column
     (``y``), averaged over windows of columns: ``[x-half, x+half)`` around a pixel (for the
     vertical links), ``[x-half, x)`` and ``[x+1, x+1+half)`` either side of a horizontal
-    link. Float32 throughout, in the order of the NumPy formulation. Rows are taken in
-    blocks of 32 (on every core), each row's windows kept only until the next row's links
-    are made.
+    link. Float32 throughout, in the order of the NumPy formulation. Only links between
+    two valid pixels are judged (no other link joins a region). Rows are taken in blocks of
+    32 (on every core), each row's windows kept only until the next row's links are made.
 
     Parameters
     ----------
@@ -287,21 +287,28 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
     if y0 > 0:
         _gradient_windows(phi, valid, y0 - 1, half, sums, rows[(y0 - 1) % 2], ahead)
     for y in range(y0, y1):
+        lit = False
+        for x in range(w):
+            lit = lit or valid[y, x]
+        if not lit:  # no link of this row joins two valid pixels
+            continue
         around = rows[y % 2]
         _gradient_windows(phi, valid, y, half, sums, around, ahead)
         # left of link x the window [x-half, x) is ``ahead`` of x-half; nearer the image's
         # left edge it holds under ``half`` samples and no link is cut
         for x in range(half, w - 1):
-            lo = x - half
-            horiz[y, x] = _jump(ahead[0, lo], ahead[1, lo], ahead[2, lo],
-                                ahead[0, x + 1], ahead[1, x + 1], ahead[2, x + 1],
-                                noise[y, x], noise[y, x + 1], rel, fhalf)
+            if valid[y, x] and valid[y, x + 1]:
+                lo = x - half
+                horiz[y, x] = _jump(ahead[0, lo], ahead[1, lo], ahead[2, lo],
+                                    ahead[0, x + 1], ahead[1, x + 1], ahead[2, x + 1],
+                                    noise[y, x], noise[y, x + 1], rel, fhalf)
         if y > 0:
             above = rows[(y - 1) % 2]
             for x in range(w):
-                vert[y - 1, x] = _jump(above[0, x], above[1, x], above[2, x],
-                                       around[0, x], around[1, x], around[2, x],
-                                       noise[y - 1, x], noise[y, x], rel, fhalf)
+                if valid[y - 1, x] and valid[y, x]:
+                    vert[y - 1, x] = _jump(above[0, x], above[1, x], above[2, x],
+                                           around[0, x], around[1, x], around[2, x],
+                                           noise[y - 1, x], noise[y, x], rel, fhalf)
 
 
 @kernel(parallel=True)

@@ -84,7 +84,8 @@ def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
     components are averaged over windows of ``half`` pixels along the row on each side of a
     horizontal link, or around the two ends of a vertical link; a link is cut where the
     averages differ by more than ``relative`` of the larger gradient and by more than four
-    times their noise (``sigma``: per-pixel phase noise, radians).
+    times their noise (``sigma``: per-pixel phase noise, radians). Only links between two
+    valid pixels are cut (no other link joins a region).
 
     The NumPy formulation of :func:`~bistair.core.kernels.period_jump_links`.
 
@@ -152,10 +153,10 @@ def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
     x = np.arange(w)
     around = window(x - half, x + half)  # gradients around each pixel
     vert = cut(tuple(v[:-1] for v in around), tuple(v[1:] for v in around),
-               noise[:-1], noise[1:])
+               noise[:-1], noise[1:]) & (ok_y > 0)
     xl = np.arange(w - 1)
     left, right = window(xl - half, xl), window(xl + 1, xl + 1 + half)
-    horiz = cut(left, right, noise[:, :-1], noise[:, 1:])
+    horiz = cut(left, right, noise[:, :-1], noise[:, 1:]) & (ok_x > 0)
     return vert, horiz
 
 
