@@ -231,7 +231,7 @@ def gray_orders(gray: np.ndarray, phi: np.ndarray, valid: np.ndarray, mode: int,
                         int(fringes))
 
 
-@kernel()
+@kernel(parallel=True)
 def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold: float,
                   phi: np.ndarray, valid: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -241,26 +241,30 @@ def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold:
     inv = 1.0 / two_pi
     code = np.empty((h, w), np.int32)
     worst = np.empty((h, w), np.float64)
-    last = np.empty((h, w), np.float64)
-    for y in range(h):
+    last = np.zeros((h, w), np.float64)
+    for y in prange(h):  # step by step along the row (vector loops), the phase in `a`
+        a = np.empty(w, np.float64)
+        top = phases[0]
         for x in range(w):
-            p = np.float64(phases[0][y, x])
-            a = p - two_pi if p * top_scale >= top_fold else p
-            most = 0.0
-            miss = 0.0
-            for i in range(n):
-                f = np.float64(phases[i + 1][y, x])
-                ref = a * ratios[i]
+            p = np.float64(top[y, x])
+            a[x] = p - two_pi if p * top_scale >= top_fold else p
+            worst[y, x] = 0.0
+        for i in range(n):
+            fine = phases[i + 1]
+            ratio = ratios[i]
+            for x in range(w):
+                f = np.float64(fine[y, x])
+                ref = a[x] * ratio
                 k = np.rint((ref - f) * inv)
                 miss = (ref - f) / two_pi - k
                 m = abs(miss)
-                if most == most and (m != m or m > most):  # np.maximum: NaN wins
-                    most = m
-                a = f + two_pi * k
-            order = np.rint((a - np.float64(phi[y, x])) * inv)
+                most = worst[y, x]
+                worst[y, x] = m if most == most and (m != m or m > most) else most  # NaN wins
+                last[y, x] = miss
+                a[x] = f + two_pi * k
+        for x in range(w):
+            order = np.rint((a[x] - np.float64(phi[y, x])) * inv)
             code[y, x] = np.int32(order) if valid[y, x] and np.isfinite(order) else -1
-            worst[y, x] = most
-            last[y, x] = miss
     return code, worst, last
 
 
