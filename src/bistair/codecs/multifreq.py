@@ -274,18 +274,21 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     """
     n = spec.steps
     shortest = float(spec.period)
-    sets = {float(t): fs if float(t) == shortest else
-            measure(prepared, i * n, n, min_modulation, check=False,
-                    shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
-            for i, t in enumerate(spec.periods)}
-    valid = np.logical_and.reduce([s.valid for s in sets.values()])
+    sets = {}  # period: (phase, valid); the other maps of a set are let go at once
+    for i, t in enumerate(spec.periods):
+        s = fs if float(t) == shortest else measure(
+            prepared, i * n, n, min_modulation, check=False, shift_sign=spec.shift_sign,
+            phase_offset=spec.phase_offset)
+        sets[float(t)] = (s.phi, s.valid)
+        del s
+    valid = np.logical_and.reduce([v for _, v in sets.values()])
     if spec.unwrap == "hierarchical" and len(sets) > 1:  # per pixel in one pass
         chain = sorted(sets, reverse=True)
-        code, worst, last = unwrap_chain(tuple(sets[t].phi for t in chain), tuple(chain),
+        code, worst, last = unwrap_chain(tuple(sets[t][0] for t in chain), tuple(chain),
                                          spec.coded_length, fs.phi, valid)
         return CodeMap(code, {"worst": np.broadcast_to(worst, valid.shape), "valid": valid,
                               "residual": np.broadcast_to(last, valid.shape)})
-    phase_of = {t: s.phi.astype(np.float64) for t, s in sets.items()}
+    phase_of = {t: phi.astype(np.float64) for t, (phi, _) in sets.items()}
     unwrap = _Unwrapper()
     if spec.unwrap == "hierarchical":
         chain = sorted(phase_of, reverse=True)
