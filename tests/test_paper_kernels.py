@@ -89,7 +89,7 @@ def test_median_of_five_every_order():
 
 
 @pytest.mark.parametrize("shape", SHAPES)
-@pytest.mark.parametrize("min_run", [1, 2, 3, 5])
+@pytest.mark.parametrize("min_run", [0, 1, 2, 3, 5])
 @pytest.mark.parametrize("invalid", [0.0, 0.1, 1.0])
 def test_column_runs_are_the_numpy_scan(shape, min_run, invalid):
     rng = np.random.default_rng(min_run * 7 + shape[1])

@@ -77,6 +77,11 @@ def column_median(code: np.ndarray, valid: np.ndarray, size: int) -> np.ndarray:
     (H, W) array
         The filtered values, ``code``'s dtype.
 
+    Raises
+    ------
+    TypeError
+        ``code`` is not of an integer dtype.
+
     Examples
     --------
     >>> code = np.int32([[3], [1], [4], [1], [5], [9]])
@@ -87,6 +92,33 @@ def column_median(code: np.ndarray, valid: np.ndarray, size: int) -> np.ndarray:
     if not np.issubdtype(code.dtype, np.integer):
         raise TypeError(f"column_median takes integers, not {code.dtype}")
     return _median_rows(code, np.ascontiguousarray(valid, np.bool_), int(max(size, 1)))
+
+
+@kernel(parallel=True)
+def _count_runs(code: np.ndarray, min_run: int) -> np.ndarray:
+    h, w = code.shape
+    count = np.zeros(w, np.int64)
+    for b in prange((w + _BLOCK - 1) // _BLOCK):
+        x0, x1 = b * _BLOCK, min((b + 1) * _BLOCK, w)
+        runs = np.zeros(_BLOCK, np.int64)
+        for y in range(h):
+            for x in range(x0, x1):
+                c = code[y, x]
+                p = code[y - 1, x] if y > 0 else -1
+                if c < 0 or c == p:
+                    continue
+                if p < 0:  # a stretch starts: its first run is kept
+                    runs[x - x0] += 1
+                    continue
+                kept = y + min_run <= h  # another run: kept if min_run pixels long
+                k = 1
+                while kept and k < min_run:
+                    kept = code[y + k, x] == c
+                    k += 1
+                runs[x - x0] += kept
+        for x in range(x0, x1):
+            count[x] = runs[x - x0]
+    return count
 
 
 @_numba_called
@@ -100,15 +132,15 @@ def _store(i: int, start: np.ndarray, length: np.ndarray, first: np.ndarray,
 
 @kernel(parallel=True)
 def _scan(code: np.ndarray, sin: np.ndarray, cos: np.ndarray, min_run: int,
-          offsets: np.ndarray, emit: bool, start: np.ndarray, length: np.ndarray,
-          first: np.ndarray, sum_sin: np.ndarray, sum_cos: np.ndarray) -> np.ndarray:
+          offsets: np.ndarray, start: np.ndarray, length: np.ndarray, first: np.ndarray,
+          sum_sin: np.ndarray, sum_cos: np.ndarray) -> None:
     h, w = code.shape
-    count = np.zeros(w, np.int64)
     for b in prange((w + _BLOCK - 1) // _BLOCK):
         x0, x1 = b * _BLOCK, min((b + 1) * _BLOCK, w)
+        at = offsets[x0:x1].copy()  # the next run's index, per column
         prev = np.full(_BLOCK, -1, np.int64)  # code of the pixel above (-1: none)
         m_start = np.zeros(_BLOCK, np.int64)  # the run being built (short runs joined)
-        m_len = np.zeros(_BLOCK, np.int64)
+        m_len = np.zeros(_BLOCK, np.int64)  # 0: none yet in the stretch
         m_first = np.zeros(_BLOCK, np.bool_)
         m_sin = np.zeros(_BLOCK, np.float64)
         m_cos = np.zeros(_BLOCK, np.float64)
@@ -116,7 +148,6 @@ def _scan(code: np.ndarray, sin: np.ndarray, cos: np.ndarray, min_run: int,
         r_len = np.zeros(_BLOCK, np.int64)
         r_sin = np.zeros(_BLOCK, np.float64)
         r_cos = np.zeros(_BLOCK, np.float64)
-        r_own = np.zeros(_BLOCK, np.bool_)  # the raw run opens its stretch (it is m's)
         for y in range(h + 1):  # row h: past the end, every stretch ends
             for x in range(x0, x1):
                 j = x - x0
@@ -124,47 +155,32 @@ def _scan(code: np.ndarray, sin: np.ndarray, cos: np.ndarray, min_run: int,
                 p = prev[j]
                 if c >= 0 and c == p:  # the raw run goes on
                     r_len[j] += 1
-                    if r_own[j]:
-                        m_len[j] += 1
-                        if emit:
-                            m_sin[j] += sin[y, x]
-                            m_cos[j] += cos[y, x]
-                    elif emit:
-                        r_sin[j] += sin[y, x]
-                        r_cos[j] += cos[y, x]
+                    r_sin[j] += sin[y, x]
+                    r_cos[j] += cos[y, x]
                     continue
                 if p >= 0:  # a raw run ends
-                    if not r_own[j]:
-                        if r_len[j] >= min_run:  # kept: the run above is done
-                            if emit:
-                                _store(offsets[x] + count[x], start, length, first, sum_sin,
-                                       sum_cos, m_start[j], m_len[j], m_first[j], m_sin[j],
-                                       m_cos[j])
-                            count[x] += 1
-                            m_start[j], m_len[j], m_first[j] = r_start[j], r_len[j], False
-                            m_sin[j], m_cos[j] = r_sin[j], r_cos[j]
-                        else:  # short: its pixels join the run above, one by one
-                            if emit:
-                                for yy in range(r_start[j], r_start[j] + r_len[j]):
-                                    m_sin[j] += sin[yy, x]
-                                    m_cos[j] += cos[yy, x]
-                            m_len[j] += r_len[j]
+                    if m_len[j] == 0 or r_len[j] >= min_run:  # kept: a stretch's first too
+                        if m_len[j] > 0:  # the run above is done
+                            _store(at[j], start, length, first, sum_sin, sum_cos,
+                                   m_start[j], m_len[j], m_first[j], m_sin[j], m_cos[j])
+                            at[j] += 1
+                        m_first[j] = m_len[j] == 0
+                        m_start[j], m_len[j] = r_start[j], r_len[j]
+                        m_sin[j], m_cos[j] = r_sin[j], r_cos[j]
+                    else:  # short: its pixels join the run above, one by one, in order
+                        for yy in range(r_start[j], r_start[j] + r_len[j]):
+                            m_sin[j] += sin[yy, x]
+                            m_cos[j] += cos[yy, x]
+                        m_len[j] += r_len[j]
                     if c < 0:  # the stretch ends
-                        if emit:
-                            _store(offsets[x] + count[x], start, length, first, sum_sin,
-                                   sum_cos, m_start[j], m_len[j], m_first[j], m_sin[j],
-                                   m_cos[j])
-                        count[x] += 1
+                        _store(at[j], start, length, first, sum_sin, sum_cos, m_start[j],
+                               m_len[j], m_first[j], m_sin[j], m_cos[j])
+                        at[j] += 1
+                        m_len[j] = 0
                 prev[j] = c
-                if c < 0:
-                    continue
-                r_start[j], r_len[j], r_own[j] = y, 1, p < 0
-                r_sin[j] = sin[y, x] if emit else 0.0
-                r_cos[j] = cos[y, x] if emit else 0.0
-                if p < 0:  # a stretch starts: its first run is kept
-                    m_start[j], m_len[j], m_first[j] = y, 1, True
-                    m_sin[j], m_cos[j] = r_sin[j], r_cos[j]
-    return count
+                if c >= 0:
+                    r_start[j], r_len[j] = y, 1
+                    r_sin[j], r_cos[j] = sin[y, x], cos[y, x]
 
 
 class ColumnRuns(NamedTuple):
@@ -207,6 +223,11 @@ def column_runs(code: np.ndarray, sin: np.ndarray, cos: np.ndarray,
     ColumnRuns
         The runs: column offsets, first row, length, stretch start, sums.
 
+    Raises
+    ------
+    ValueError
+        ``code`` is not 2-D or ``sin`` and ``cos`` are not of its shape.
+
     Examples
     --------
     >>> code = np.int32([[1, -1], [1, 2], [0, 2], [1, 2]])
@@ -222,16 +243,14 @@ def column_runs(code: np.ndarray, sin: np.ndarray, cos: np.ndarray,
     if code.ndim != 2 or sin.shape != code.shape or cos.shape != code.shape:
         raise ValueError("column_runs takes 2-D code, sin and cos of one shape")
     h, w = code.shape
-    none_i, none_b, none_f = np.empty(0, np.int64), np.empty(0, np.bool_), np.empty(0)
-    min_run = int(min_run)
-    count = _scan(code, sin, cos, min_run, np.zeros(w, np.int64), False, none_i, none_i,
-                  none_b, none_f, none_f)
+    min_run = max(int(min_run), 1)
     offsets = np.zeros(w + 1, np.int64)
-    np.cumsum(count, out=offsets[1:])
+    np.cumsum(_count_runs(code, min_run), out=offsets[1:])  # where each column's runs go
     n = int(offsets[-1])
     runs = ColumnRuns(offsets, np.empty(n, np.int64), np.empty(n, np.int64),
                       np.empty(n, np.bool_), np.empty(n), np.empty(n))
-    _scan(code, sin, cos, min_run, offsets, True, *runs[1:])
+    if n:
+        _scan(code, sin, cos, min_run, offsets, *runs[1:])
     return runs
 
 
@@ -240,18 +259,15 @@ def _vote(labels: np.ndarray, offsets: np.ndarray, start: np.ndarray, length: np
           value: np.ndarray, n_values: int, counts: np.ndarray) -> None:
     h, w = labels.shape
     chunks = counts.shape[0]
-    for k in prange(chunks):
-        x0, x1 = k * w // chunks, (k + 1) * w // chunks
-        at = offsets[x0:x1].copy()  # each column's run at or below the row
-        for y in range(h):
-            for x in range(x0, x1):
-                p, end = at[x - x0], offsets[x + 1]
-                while p < end and start[p] + length[p] <= y:
-                    p += 1
-                at[x - x0] = p
-                if p < end and start[p] <= y:
-                    lab, v = np.int64(labels[y, x]), np.int64(value[p])
-                    if lab > 0 and v >= 0 and v < n_values:
+    for k in prange(chunks):  # run by run down the columns (a block's rows stay cached)
+        for x in range(k * w // chunks, (k + 1) * w // chunks):
+            for p in range(offsets[x], offsets[x + 1]):
+                v = np.int64(value[p])
+                if v < 0 or v >= n_values:
+                    continue
+                for y in range(start[p], start[p] + length[p]):
+                    lab = np.int64(labels[y, x])
+                    if lab > 0:
                         counts[k, lab * n_values + v] += 1
 
 
@@ -328,6 +344,11 @@ def paint_labels(labels: np.ndarray, table: np.ndarray) -> np.ndarray:
     -------
     (H, W) int32 array
         Each labelled pixel's value, -1 elsewhere.
+
+    Raises
+    ------
+    ValueError
+        ``labels`` is not 2-D.
 
     Examples
     --------
