@@ -14,6 +14,7 @@ from bistair.codecs.bidirectional import code_columns
 from bistair.codecs.bidirectional.bands import nearest_level, union_levels
 from bistair.codecs.bidirectional.paper import _pixel_median, paper_orders
 from bistair.core.captures import prepare
+from bistair.core.kernels import set_threads
 from bistair.core.paper_kernels import column_median, column_runs, paint_labels, run_label_modes
 from bistair.core.regions import fringe_regions
 from bistair.core.resolve import mode_by_label
@@ -183,3 +184,27 @@ def test_paper_orders_as_before_on_a_noisy_code(partitions, stairs, median):
     mode, _ = mode_by_label(fringes, order, n, S * P)
     assert np.array_equal(got, np.where(fringes > 0, mode[fringes], -1))
     assert (got >= 0).mean() > 0.5
+
+
+def test_one_thread_gives_the_same_runs_and_modes():
+    """The passes split columns over threads; the result must not depend on how many."""
+    rng = np.random.default_rng(8)
+    code = _codes(rng, (300, 517), levels=6)
+    valid = rng.random(code.shape) > 0.1
+    t = rng.uniform(-np.pi, np.pi, code.shape).astype(np.float32)
+    labels = rng.integers(0, 30, code.shape).astype(np.int32)
+
+    def everything():
+        med = column_median(code, valid, 5)
+        runs = column_runs(med, np.sin(t), np.cos(t), 3)
+        value = np.arange(runs.length.size) % 7
+        mode, support = run_label_modes(labels, runs, value, 29, 7)
+        return (med, *runs, mode, support, paint_labels(labels, mode))
+
+    many = everything()
+    try:
+        assert set_threads(1) == 1
+        one = everything()
+    finally:
+        set_threads(None)
+    assert all(np.array_equal(a, b) for a, b in zip(one, many, strict=True))
