@@ -149,15 +149,18 @@ def _scan(code: np.ndarray, sin: np.ndarray, cos: np.ndarray, min_run: int,
         r_sin = np.zeros(_BLOCK, np.float64)
         r_cos = np.zeros(_BLOCK, np.float64)
         for y in range(h + 1):  # row h: past the end, every stretch ends
-            for x in range(x0, x1):
-                j = x - x0
-                c = np.int64(code[y, x]) if y < h else np.int64(-1)
+            beyond = y == h
+            row = min(y, h - 1)
+            c_row, s_row, k_row = code[row, x0:x1], sin[row, x0:x1], cos[row, x0:x1]
+            for j in range(x1 - x0):
+                c = np.int64(-1) if beyond else np.int64(c_row[j])
                 p = prev[j]
                 if c >= 0 and c == p:  # the raw run goes on
                     r_len[j] += 1
-                    r_sin[j] += sin[y, x]
-                    r_cos[j] += cos[y, x]
+                    r_sin[j] += s_row[j]
+                    r_cos[j] += k_row[j]
                     continue
+                x = x0 + j
                 if p >= 0:  # a raw run ends
                     if m_len[j] == 0 or r_len[j] >= min_run:  # kept: a stretch's first too
                         if m_len[j] > 0:  # the run above is done
@@ -180,7 +183,7 @@ def _scan(code: np.ndarray, sin: np.ndarray, cos: np.ndarray, min_run: int,
                 prev[j] = c
                 if c >= 0:
                     r_start[j], r_len[j] = y, 1
-                    r_sin[j], r_cos[j] = sin[y, x], cos[y, x]
+                    r_sin[j], r_cos[j] = s_row[j], k_row[j]
 
 
 class ColumnRuns(NamedTuple):
