@@ -38,7 +38,7 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.fused_codes import unwrap_chain
+from ..core.fused_codes import agreed_orders, unwrap_chain
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, order_from_reference
 from ..errors import BistairError
@@ -274,18 +274,21 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     """
     n = spec.steps
     shortest = float(spec.period)
-    sets = {float(t): fs if float(t) == shortest else
-            measure(prepared, i * n, n, min_modulation, check=False,
-                    shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
-            for i, t in enumerate(spec.periods)}
-    valid = np.logical_and.reduce([s.valid for s in sets.values()])
+    sets = {}  # period: (phase, valid); the other maps of a set are let go at once
+    for i, t in enumerate(spec.periods):
+        s = fs if float(t) == shortest else measure(
+            prepared, i * n, n, min_modulation, check=False, shift_sign=spec.shift_sign,
+            phase_offset=spec.phase_offset)
+        sets[float(t)] = (s.phi, s.valid)
+        del s
+    valid = np.logical_and.reduce([v for _, v in sets.values()])
     if spec.unwrap == "hierarchical" and len(sets) > 1:  # per pixel in one pass
         chain = sorted(sets, reverse=True)
-        code, worst, last = unwrap_chain(tuple(sets[t].phi for t in chain), tuple(chain),
+        code, worst, last = unwrap_chain(tuple(sets[t][0] for t in chain), tuple(chain),
                                          spec.coded_length, fs.phi, valid)
         return CodeMap(code, {"worst": np.broadcast_to(worst, valid.shape), "valid": valid,
                               "residual": np.broadcast_to(last, valid.shape)})
-    phase_of = {t: s.phi.astype(np.float64) for t, s in sets.items()}
+    phase_of = {t: phi.astype(np.float64) for t, (phi, _) in sets.items()}
     unwrap = _Unwrapper()
     if spec.unwrap == "hierarchical":
         chain = sorted(phase_of, reverse=True)
@@ -359,9 +362,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
     bistair.errors.BistairError: the captures do not fit the spec: the periods agree on 13% ...
     """
     valid = code.maps["valid"]
-    agree = code.maps["worst"] < 0.25
-    lit = valid.sum()
-    share = float((agree & valid).sum() / max(lit, 1))
+    # the kept orders, the counts and the sign of the phase's slope along the rows at once
+    order, lit, agreeing, falling = agreed_orders(code.code, code.maps["worst"], valid,
+                                                  fs.phi, 0.25, 4)
+    share = float(np.int64(agreeing) / max(lit, 1))
     info = {"unwrap": spec.unwrap, "noise": fs.noise,
             "valid_modulation": int(lit), "period_agreement": share}
     if lit >= 500 and share < 0.5:
@@ -375,11 +379,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
             f"the captures do not fit the spec: the periods agree on {100 * share:.0f}% of "
             f"the modulated pixels (check the periods, the frame order, phase_offset and "
             f"shift_sign{hint})")
-    ok = valid & agree & (code.code >= 0)
-    order = np.where(ok, code.code, -1).astype(np.int32)
-    sub = np.where(ok[::4], fs.phi[::4] + TWO_PI * code.code[::4], np.nan)
-    slope = np.nanmedian(np.diff(sub, axis=1)) if ok.sum() > 100 else 0.0
-    if slope < 0:
+    if falling:
         info["warnings"] = ["the projector coordinate falls along the image's coded axis: "
                             "if the projector is not mirrored, is shift_sign "
                             f"{-spec.shift_sign:+d}?"]

@@ -231,7 +231,7 @@ def gray_orders(gray: np.ndarray, phi: np.ndarray, valid: np.ndarray, mode: int,
                         int(fringes))
 
 
-@kernel()
+@kernel(parallel=True)
 def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold: float,
                   phi: np.ndarray, valid: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -241,26 +241,30 @@ def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold:
     inv = 1.0 / two_pi
     code = np.empty((h, w), np.int32)
     worst = np.empty((h, w), np.float64)
-    last = np.empty((h, w), np.float64)
-    for y in range(h):
+    last = np.zeros((h, w), np.float64)
+    for y in prange(h):  # step by step along the row (vector loops), the phase in `a`
+        a = np.empty(w, np.float64)
+        top = phases[0]
         for x in range(w):
-            p = np.float64(phases[0][y, x])
-            a = p - two_pi if p * top_scale >= top_fold else p
-            most = 0.0
-            miss = 0.0
-            for i in range(n):
-                f = np.float64(phases[i + 1][y, x])
-                ref = a * ratios[i]
+            p = np.float64(top[y, x])
+            a[x] = p - two_pi if p * top_scale >= top_fold else p
+            worst[y, x] = 0.0
+        for i in range(n):
+            fine = phases[i + 1]
+            ratio = ratios[i]
+            for x in range(w):
+                f = np.float64(fine[y, x])
+                ref = a[x] * ratio
                 k = np.rint((ref - f) * inv)
                 miss = (ref - f) / two_pi - k
                 m = abs(miss)
-                if most == most and (m != m or m > most):  # np.maximum: NaN wins
-                    most = m
-                a = f + two_pi * k
-            order = np.rint((a - np.float64(phi[y, x])) * inv)
+                most = worst[y, x]
+                worst[y, x] = m if most == most and (m != m or m > most) else most  # NaN wins
+                last[y, x] = miss
+                a[x] = f + two_pi * k
+        for x in range(w):
+            order = np.rint((a[x] - np.float64(phi[y, x])) * inv)
             code[y, x] = np.int32(order) if valid[y, x] and np.isfinite(order) else -1
-            worst[y, x] = most
-            last[y, x] = miss
     return code, worst, last
 
 
@@ -309,3 +313,107 @@ def unwrap_chain(phases: tuple[np.ndarray, ...], periods: tuple[float, ...], len
     return _unwrap_chain(tuple(np.ascontiguousarray(p, np.float32) for p in phases), ratios,
                          top / two_pi, 0.5 * (length + top), np.asarray(phi, np.float32),
                          np.asarray(valid, bool))
+
+
+@kernel(parallel=True)
+def _agreed(code: np.ndarray, worst: np.ndarray, valid: np.ndarray, phi: np.ndarray,
+            limit: float, every: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    h, w = code.shape
+    two_pi = 2.0 * math.pi
+    order = np.empty((h, w), np.int32)
+    counts = np.zeros((h, 5), np.int64)  # valid, agreeing, kept, falling steps, others
+    ends = np.zeros((h, 2), np.float64)  # the falling step nearest 0, the other one too
+    for y in prange(h):
+        lit = 0
+        agree = 0
+        kept = 0
+        for x in range(w):
+            v = valid[y, x]
+            a = worst[y, x] < limit
+            ok = v and a and code[y, x] >= 0
+            order[y, x] = code[y, x] if ok else -1
+            lit += v
+            agree += v and a
+            kept += ok
+        counts[y, 0], counts[y, 1], counts[y, 2] = lit, agree, kept
+        if y % every:
+            continue
+        fall = 0
+        rise = 0
+        top = -np.inf  # the largest falling step
+        low = np.inf  # the smallest other one
+        for x in range(w - 1):
+            if order[y, x] < 0 or order[y, x + 1] < 0:
+                continue
+            d = ((np.float64(phi[y, x + 1]) + two_pi * np.float64(code[y, x + 1]))
+                 - (np.float64(phi[y, x]) + two_pi * np.float64(code[y, x])))
+            if d < 0:
+                fall += 1
+                top = max(top, d)
+            elif d >= 0:  # (NaN steps are left out)
+                rise += 1
+                low = min(low, d)
+        counts[y, 3], counts[y, 4] = fall, rise
+        ends[y, 0], ends[y, 1] = top, low
+    return order, counts, ends
+
+
+def agreed_orders(code: np.ndarray, worst: np.ndarray, valid: np.ndarray, phi: np.ndarray,
+                  limit: float = 0.25, every: int = 4) -> tuple[np.ndarray, int, int, bool]:
+    """The orders kept where every unwrapping step agrees, in one pass: ``order =
+    np.where(valid & (worst < limit) & (code >= 0), code, -1)`` (int32), the counts of
+    ``valid`` and of ``valid & (worst < limit)``, and whether the absolute phase falls
+    along the rows: ``np.nanmedian(np.diff(sub, axis=1)) < 0`` for ``sub =
+    np.where(kept, phi + 2*pi*code, nan)`` on every ``every``-th row, judged only with
+    over 100 kept pixels.
+
+    Parameters
+    ----------
+    code : (H, W) int array
+        Order per pixel.
+    worst : (H, W) float array
+        The largest miss of the unwrapping steps, in fringes.
+    valid : (H, W) bool array
+        The well-modulated pixels.
+    phi : (H, W) float array
+        The wrapped phase of ``code``'s period.
+    limit : float, default 0.25
+        The largest miss kept.
+    every : int, default 4
+        The rows whose steps are judged: 0, every, 2*every, ...
+
+    Returns
+    -------
+    order : (H, W) int32 array
+        ``code`` where kept, -1 elsewhere.
+    lit : int
+        Valid pixels.
+    agreeing : int
+        Valid pixels with ``worst < limit``.
+    falling : bool
+        The median step of the absolute phase along the rows is negative.
+
+    Examples
+    --------
+    >>> code = np.int32([[0, 0, 1, 1, -1]])
+    >>> worst = np.array([[0.1, 0.3, 0.0, 0.0, 0.0]])
+    >>> order, lit, agreeing, falling = agreed_orders(code, worst, np.ones((1, 5), bool),
+    ...                                               np.zeros((1, 5), np.float32))
+    >>> order.tolist(), lit, agreeing, falling
+    ([[0, -1, 1, 1, -1]], 5, 4, False)
+    """
+    code, worst, phi = (np.ascontiguousarray(a) for a in (code, worst, phi))
+    order, counts, ends = _agreed(code, worst, np.ascontiguousarray(valid, np.bool_), phi,
+                                  float(limit), int(max(every, 1)))
+    lit, agreeing, kept, fall, rise = (int(c) for c in counts.sum(axis=0))
+    n = fall + rise
+    if kept <= 100 or n == 0:  # (no step: NumPy's median is NaN, not negative)
+        return order, lit, agreeing, False
+    half = n // 2
+    if n % 2:  # the middle step falls when over half do
+        return order, lit, agreeing, fall > half
+    if fall != half:  # both middle steps fall, or neither
+        return order, lit, agreeing, fall > half
+    # the mean of the largest falling step and the smallest other one
+    middle = (np.float64(ends[:, 0].max()) + np.float64(ends[:, 1].min())) / 2.0
+    return order, lit, agreeing, bool(middle < 0)

@@ -10,11 +10,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import numpy as np
-from scipy import ndimage
 
 from ...core.measure import FringeSet
+from ...core.paper_kernels import column_median, column_runs, paint_labels, run_label_modes
 from ...core.regions import fringe_regions
-from ...core.resolve import mode_by_label
 from ...core.stair import quantize
 from .bands import nearest_level, union_levels
 
@@ -63,7 +62,7 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
     Returns
     -------
     numpy.ndarray
-        (H, W) int64 fringe order per pixel, -1 outside the fringe regions.
+        (H, W) int32 fringe order per pixel, -1 outside the fringe regions.
 
     Examples
     --------
@@ -84,48 +83,30 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
     h, w = ks.shape
     code = ks if P == S else np.where(fs.valid, nearest_level(theta.ravel(), union_levels(
         P, S)).reshape(h, w), -1)
-    if median > 1:  # addition 1
-        code = np.where(fs.valid, ndimage.median_filter(code, size=(median, 1),
-                                                         mode="nearest"), -1)
-    v = (fs.valid & (code >= 0)).T.ravel()
-    q = code.T.ravel()
-    t = theta.T.ravel()
-    col_start = np.zeros(v.size, bool)
-    col_start[::h] = True
-    seg_start = v & (col_start | ~np.r_[False, v[:-1]])
-    start = seg_start | (v & np.r_[True, q[1:] != q[:-1]])
-    pix = np.flatnonzero(v)
-    run_of = np.cumsum(start)[pix] - 1
-    length = np.bincount(run_of)
-    # addition 2: short runs join the run above them in their stretch
-    first_pix = np.flatnonzero(start)
-    keep = (length >= min_run) | seg_start[first_pix]
-    owner = np.maximum.accumulate(np.where(keep, np.arange(keep.size), 0))
-    owner = np.where(keep | seg_start[first_pix], np.arange(keep.size), owner)
-    segment = np.cumsum(seg_start[first_pix]) - 1
-    owner = np.where(segment[owner] == segment, owner, np.arange(keep.size))
-    run_of = owner[run_of]
-    runs = np.flatnonzero(keep | (owner == np.arange(keep.size)))
-    remap = np.full(keep.size, -1)
-    remap[runs] = np.arange(runs.size)
-    run_of = remap[run_of]
-    c_len = np.bincount(run_of, minlength=runs.size)  # C: run lengths
-    run_theta = np.arctan2(np.bincount(run_of, np.sin(t[pix]), runs.size),
-                           np.bincount(run_of, np.cos(t[pix]), runs.size))
-    new_group = seg_start[first_pix[runs]].copy()
+    # -1 outside the pixels the scan reads (valid, code >= 0); addition 1: the median
+    code = (column_median(code, fs.valid, median) if median > 1
+            else np.where(fs.valid, code, -1))
+    runs = column_runs(code, np.sin(theta), np.cos(theta), min_run)  # addition 2
+    del code
+    if runs.start.size == 0:
+        return np.full((h, w), -1, np.int32)
+    c_len = runs.length  # C: run lengths
+    run_theta = np.arctan2(runs.sum_sin, runs.sum_cos)
+    new_group = runs.first.copy()  # a column's valid stretch starts a group
     new_group[1:] |= c_len[1:] > c_len[:-1]  # difference of C above zero: a group starts
     # "When k_s1 and k_s2 are the same, the value of C is very large": such a run is a
     # group of its own (addition 3).
-    merged = c_len > 1.4 * np.median(c_len[run_of])
+    merged = c_len > 1.4 * _pixel_median(c_len)
     new_group[1:] |= merged[:-1]
     group = np.cumsum(new_group) - 1
     g_first = np.flatnonzero(new_group)
     g_second = g_first + 1
+    n_runs = c_len.size
     has_second = np.zeros(g_first.size, bool)
-    ok = g_second < runs.size
+    ok = g_second < n_runs
     has_second[ok] = group[g_second[ok]] == group[g_first[ok]]
     has_second &= ~merged[g_first]
-    second_theta = np.where(has_second, run_theta[np.minimum(g_second, runs.size - 1)],
+    second_theta = np.where(has_second, run_theta[np.minimum(g_second, n_runs - 1)],
                             run_theta[g_first])
     # The longer run opens a group: the local one unless the spec gives it fewer rows.
     local_first = 2 * spec.local_rows > spec.group_rows
@@ -134,10 +115,22 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
     k1 = quantize(local_theta, S)
     k2 = quantize(part_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
     k_group = k1 + S * k2
-    order = np.full(v.size, -1, np.int64)
-    order[pix] = k_group[group[run_of]]
-    order = order.reshape(w, h).T
     fringes, n_fringes = fringe_regions(fs.phi, fs.valid, min_size=1,
                                         phase_noise=fs.phase_noise)
-    mode, _ = mode_by_label(fringes, order, n_fringes, S * P)
-    return np.where(fringes > 0, mode[fringes], -1)
+    mode, _ = run_label_modes(fringes, runs, k_group[group], n_fringes, S * P)
+    return paint_labels(fringes, mode)
+
+
+def _pixel_median(length: np.ndarray) -> float:
+    """``np.median(np.repeat(length, length))``: the median run length a pixel sits in.
+
+    Examples
+    --------
+    >>> _pixel_median(np.array([1, 3, 2])), float(np.median([1, 3, 3, 3, 2, 2]))
+    (2.5, 2.5)
+    """
+    pixels = np.bincount(length) * np.arange(length.max() + 1)  # pixels per run length
+    cum = np.cumsum(pixels)
+    n = int(cum[-1])
+    mid = np.searchsorted(cum, [(n - 1) // 2, n // 2], side="right")
+    return float(mid.mean()) if n % 2 == 0 else float(mid[1])
