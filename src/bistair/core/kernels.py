@@ -187,7 +187,8 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
                       sums: np.ndarray, around: np.ndarray, ahead: np.ndarray) -> None:
     """Row ``y``'s mean wrapped gradients (x, y) and their sample counts over the columns
     ``[x-half, x+half)`` (``around``, for the vertical links) and ``[x, x+half)``
-    (``ahead``, for the horizontal ones), each (3, W) and clipped to the image; ``sums``
+    (``ahead``, for the horizontal ones), each (3, W) and clipped to the image (the means
+    only where the count reaches ``half``: :func:`_jump` reads them only there); ``sums``
     (4, W+1) is scratch for the running sums."""
     h, w = phi.shape
     one = np.float32(1.0)
@@ -206,19 +207,22 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
         sums[1, x + 1] = sums[1, x] + nx
         sums[2, x + 1] = sums[2, x] + gy
         sums[3, x + 1] = sums[3, x] + ny
-    for x in range(w):
+    few = np.float32(half)
+    for x in range(w):  # a window of under ``half`` samples never cuts: no means needed
         hi = min(x + half, w)
         lo = max(x - half, 0)
         nxs = sums[1, hi] - sums[1, lo]
         nys = sums[3, hi] - sums[3, lo]
-        around[0, x] = (sums[0, hi] - sums[0, lo]) / max(nxs, one)
-        around[1, x] = (sums[2, hi] - sums[2, lo]) / max(nys, one)
         around[2, x] = min(nxs, nys)
+        if around[2, x] >= few:
+            around[0, x] = (sums[0, hi] - sums[0, lo]) / max(nxs, one)
+            around[1, x] = (sums[2, hi] - sums[2, lo]) / max(nys, one)
         nxs = sums[1, hi] - sums[1, x]
         nys = sums[3, hi] - sums[3, x]
-        ahead[0, x] = (sums[0, hi] - sums[0, x]) / max(nxs, one)
-        ahead[1, x] = (sums[2, hi] - sums[2, x]) / max(nys, one)
         ahead[2, x] = min(nxs, nys)
+        if ahead[2, x] >= few:
+            ahead[0, x] = (sums[0, hi] - sums[0, x]) / max(nxs, one)
+            ahead[1, x] = (sums[2, hi] - sums[2, x]) / max(nys, one)
 
 
 @kernel(parallel=True)
