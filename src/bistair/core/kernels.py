@@ -677,9 +677,11 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
 
 @kernel(parallel=True)
 def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
-                  min_strong: int, min_size: int) -> np.ndarray:
-    """``strong | (weak & region kept)``, a region kept when it holds ``min_strong`` strong
-    pixels or ``min_size`` pixels (see :func:`bistair.core.measure.coherent_pixels`).
+                  min_strong: int, min_size: int, min_region: int) -> np.ndarray:
+    """``strong | (weak & region kept)``, a region kept when it holds ``min_region`` pixels
+    and ``min_strong`` strong pixels or ``min_size`` pixels (see
+    :func:`bistair.core.measure.coherent_pixels`; ``min_region``: the regions
+    :func:`bistair.core.regions.fringe_regions` would drop as too small).
 
     Parameters
     ----------
@@ -695,6 +697,8 @@ def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: i
         Strong pixels that keep a region.
     min_size : int
         Pixels in all that keep a region.
+    min_region : int
+        Pixels a region needs to be kept at all.
 
     Returns
     -------
@@ -705,8 +709,10 @@ def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: i
     --------
     >>> labels = np.int32([[1, 1, 1, 2, 2, 0]])
     >>> strong = np.array([[True, False, False, False, False, False]])
-    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10).tolist()
+    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 1).tolist()
     [[True, True, True, False, False, False]]
+    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 4).tolist()
+    [[True, False, False, False, False, False]]
     """
     h, w = labels.shape
     size = np.zeros(n + 1, np.int64)
@@ -717,7 +723,7 @@ def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: i
             size[lab] += 1
             if strong[y, x]:
                 bright[lab] += 1
-    keep = (bright >= min_strong) | (size >= min_size)
+    keep = ((bright >= min_strong) | (size >= min_size)) & (size >= min_region)
     keep[0] = False
     out = np.empty((h, w), np.bool_)
     for y in prange(h):

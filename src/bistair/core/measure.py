@@ -258,8 +258,10 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any())
     (True, False)
     """
-    labels, n = fringe_regions(phi, weak, phase_noise=phase_noise)
-    return keep_coherent(labels, weak, strong, n, min_strong, min_size)
+    # the regions fringe_regions drops as too small (under 20 pixels) are left out here,
+    # without its relabelling pass
+    labels, n = fringe_regions(phi, weak, min_size=1, phase_noise=phase_noise)
+    return keep_coherent(labels, weak, strong, n, min_strong, min_size, 20)
 
 
 def _chi2_median(dof: int) -> float:

@@ -314,7 +314,8 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     # Reattach the removed pixels through links that are not cut (a few passes, on the
     # removed pixels only: they are thin lines along the wraps).
     reattach(labels, valid, keep, vert, horiz, 3)
-    n = drop_small(labels, n, min_size)
+    if min_size > 1:  # (every region has a pixel)
+        n = drop_small(labels, n, min_size)
     return labels, int(n)
 
 
