@@ -418,15 +418,20 @@ def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agr
         seeds[box] = bad[box] & (num > share * den)
     if not seeds.any():
         return labels, n, 0
+    del decided
     _, parts = cv2.connectedComponents(bad.view(np.uint8), connectivity=4, ltype=cv2.CV_32S)
+    del bad
     seeded = np.zeros(int(parts.max()) + 1, bool)
     seeded[parts[seeds]] = True
     seeded[0] = False
+    del seeds
     grown = seeded[parts]  # the bad pixels connected to a seed
+    del parts  # (one label image at a time: 4 bytes a pixel each)
     _, parts = cv2.connectedComponents(grown.view(np.uint8), connectivity=4,
                                        ltype=cv2.CV_32S)
-    key = parts.astype(np.int64) * (n + 1) + labels
-    uniq, inv, size = np.unique(key[grown], return_inverse=True, return_counts=True)
+    key = parts[grown].astype(np.int64) * (n + 1) + labels[grown]
+    del parts
+    uniq, inv, size = np.unique(key, return_inverse=True, return_counts=True)
     new = np.where(size >= min_size, n + 1 + np.cumsum(size >= min_size) - 1, 0)
     labels = labels.copy()
     labels[grown] = new[inv]
