@@ -278,7 +278,7 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     for i, t in enumerate(spec.periods):
         s = fs if float(t) == shortest else measure(
             prepared, i * n, n, min_modulation, check=False, shift_sign=spec.shift_sign,
-            phase_offset=spec.phase_offset)
+            phase_offset=spec.phase_offset, maps=False)
         sets[float(t)] = (s.phi, s.valid)
         del s
     valid = np.logical_and.reduce([v for _, v in sets.values()])

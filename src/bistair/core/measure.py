@@ -33,8 +33,8 @@ class FringeSet:
     """One N-step set measured in a capture."""
 
     phi: np.ndarray  # wrapped phase in [0, 2*pi)
-    avg: np.ndarray  # average intensity A (fraction of full scale)
-    mod: np.ndarray  # modulation B
+    avg: np.ndarray | None  # average intensity A (fraction of full scale; None: let go)
+    mod: np.ndarray | None  # modulation B (None: let go, ``measure(..., maps=False)``)
     valid: np.ndarray  # enough modulation, not saturated
     noise: float  # camera noise sigma estimated from the fit residual
     steps: int | None = None  # N
@@ -130,7 +130,7 @@ def _along_fringe_noise(frames: np.ndarray) -> float:
 
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,
             check: bool = True, shift_sign: int = 1, phase_offset: float = 0.0,
-            coherent: bool = True) -> FringeSet:
+            coherent: bool = True, maps: bool = True) -> FringeSet:
     """Measure frames ``start .. start+steps-1`` of a prepared stack as an N-step set.
 
     ``shift_sign`` and ``phase_offset`` are the rig's phase convention
@@ -165,6 +165,10 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         The rig's phase convention.
     coherent : bool
         Also accept dim pixels in coherent fringe regions (see above).
+    maps : bool
+        Keep the average and modulation; without, they are let go once the validity is
+        known (before the fringe regions of ``coherent``, the stage's largest) and the set
+        holds ``None`` for them: for sets of which only phase and validity are read.
 
     Returns
     -------
@@ -209,12 +213,18 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     # saturation, validity and the white/black contrast of captures.py, in one pass
     valid, strong, weak = pixel_validity(mod, avg, prepared.clipped, lowest, threshold,
                                          prepared.white, prepared.black)
+    if not maps:
+        avg = None
     if lowest < threshold and weak:  # dim pixels to judge by their regions
-        valid = coherent_pixels(phi, valid, strong, phase_noise(mod, noise, steps))
+        sigma = phase_noise(mod, noise, steps)
+        if not (maps or check):
+            mod = None
+        valid = coherent_pixels(phi, valid, strong, sigma)
+        del sigma
     del strong
     if check:
         check_decodable(valid, prepared.clipped, min_modulation, mod)
-    return FringeSet(phi, avg, mod, valid, noise, steps, threshold)
+    return FringeSet(phi, avg, None if not maps else mod, valid, noise, steps, threshold)
 
 
 def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
