@@ -215,8 +215,10 @@ def _fmin(a: float, b: float) -> float:
 @_numba_inline
 def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.float32,
                   m: np.float32) -> tuple:
-    """One pixel's ``weight * cos``, ``weight * sin``, ``weight`` and ``ratio`` (float32,
-    as :func:`stair_weights` documents them)."""
+    """One pixel's ``weight * cos``, ``weight * sin``, ``weight`` and ``ratio`` in float32,
+    as NumPy computes :func:`bistair.codecs.bidirectional.bands.stair_values`' inputs:
+    ``ratio = clip(stair_mod / max(mod, 1e-6), 0, 2)``, ``weight = core_weight(phi) *
+    min(ratio, 1)`` (:func:`bistair.core.regions.core_weight`)."""
     tiny = np.float32(1e-6)
     zero, one, two = np.float32(0.0), np.float32(1.0), np.float32(2.0)
     ratio = _fmin(_fmax(sm / _fmax(m, tiny), zero), two)
@@ -227,65 +229,9 @@ def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.fl
 
 
 @kernel(parallel=True)
-def stair_weights(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
-                  stair_mod: np.ndarray, mod: np.ndarray, noise_scale: float
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """The per-pixel values the bidirectional region decoder sums per region row, and the
-    stair phase noise, from float32 maps in one pass (float32 arithmetic as NumPy's).
-
-    ``ratio = clip(stair_mod / max(mod, 1e-6), 0, 2)``, ``weight = core_weight(phi) *
-    min(ratio, 1)`` (:func:`bistair.core.regions.core_weight`) and ``noise = noise_scale /
-    max(stair_mod, 1e-6)`` (computed in float64, stored as float32). The decoder itself
-    sums the values without storing them (:func:`label_stair_sums`, :func:`stair_noise`).
-
-    Parameters
-    ----------
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    cos_t, sin_t : (H, W) float32 arrays
-        Cosine and sine of the stair phase (``np.cos``, ``np.sin``).
-    stair_mod, mod : (H, W) float32 arrays
-        Modulation of the stair pair and of the fringes.
-    noise_scale : float
-        Camera noise times ``sqrt(2)``.
-
-    Returns
-    -------
-    values : (5, H, W) float32 array
-        ``weight * cos``, ``weight * sin``, ``weight``, ``ratio`` and the column index
-        (as :func:`bistair.codecs.bidirectional.bands.stair_values`).
-    noise : (H, W) float32 array
-        Stair phase noise per pixel, radians.
-
-    Examples
-    --------
-    >>> one = np.ones((1, 2), np.float32)
-    >>> values, noise = stair_weights(np.float32([[np.pi, 0.3]]), one, 0 * one, 0.5 * one,
-    ...                               one, 0.01)
-    >>> values[:, 0, 1].astype(float).round(3).tolist(), noise.astype(float).round(3).tolist()
-    ([0.095, 0.0, 0.095, 0.5, 1.0], [[0.02, 0.02]])
-    """
-    h, w = phi.shape
-    values = np.empty((5, h, w), np.float32)
-    noise = np.empty((h, w), np.float32)
-    tiny = np.float32(1e-6)
-    for y in prange(h):
-        for x in range(w):
-            c, s, weight, ratio = _stair_values(phi[y, x], cos_t[y, x], sin_t[y, x],
-                                                stair_mod[y, x], mod[y, x])
-            values[0, y, x] = c
-            values[1, y, x] = s
-            values[2, y, x] = weight
-            values[3, y, x] = ratio
-            values[4, y, x] = np.float32(x)
-            noise[y, x] = np.float32(noise_scale / np.float64(_fmax(stair_mod[y, x], tiny)))
-    return values, noise
-
-
-@kernel(parallel=True)
 def stair_noise(stair_mod: np.ndarray, noise_scale: float) -> np.ndarray:
     """Stair phase noise per pixel, ``noise_scale / max(stair_mod, 1e-6)`` (float64
-    arithmetic, float32 result), as :func:`stair_weights` gives it.
+    arithmetic, float32 result, as NumPy gives it).
 
     Parameters
     ----------
@@ -342,7 +288,9 @@ def _stair_sum_rows(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
 def stair_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
                stair_mod: np.ndarray, mod: np.ndarray, n_labels: int, start: np.ndarray,
                entry: np.ndarray, count: np.ndarray, acc: np.ndarray) -> None:
-    """Add :func:`stair_weights`' five values, computed per pixel as they are summed, to
+    """Add the five values of :func:`bistair.codecs.bidirectional.bands.stair_values`
+    (``weight * cos``, ``weight * sin``, ``weight``, ``ratio``, the column; see
+    :func:`_stair_values`), computed per pixel as they are summed, to
     the pixel ``count`` (K,) and sums ``acc`` (5, K) of the entries of
     :func:`bistair.core.label_rows.row_entries` (of these rows: ``start`` has one more
     element than the maps have rows; ``entry`` is the whole image's).
@@ -352,7 +300,8 @@ def stair_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray, sin_t: np
     labels : (R, W) int32 array
         Region labels, 0 outside any.
     phi, cos_t, sin_t, stair_mod, mod : (R, W) float32 arrays
-        As for :func:`stair_weights`.
+        Wrapped phase, cosine and sine of the stair phase, modulation of the stair
+        pair and of the fringes.
     n_labels : int
         Highest label.
     start, entry : numpy.ndarray
@@ -380,7 +329,8 @@ def stair_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray, sin_t: np
 def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
                      stair_mod: np.ndarray, mod: np.ndarray, n_labels: int
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`bistair.core.label_rows.label_row_sums` of :func:`stair_weights`' five values
+    """:func:`bistair.core.label_rows.label_row_sums` of the five values of
+    :func:`bistair.codecs.bidirectional.bands.stair_values`
     (from ``np.cos(theta)`` and ``np.sin(theta)``), computed per pixel as they are summed:
     no (5, H, W) array, the cosine and sine made for a band of rows at a time. Returns
     ``(keys, counts, sums (5, K))``, ``keys = label * H + row`` ascending, float64 sums in

@@ -200,7 +200,8 @@ def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
 def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
                        stair_mod: np.ndarray, mod: np.ndarray) -> RowProfiles:
     """:func:`row_profiles` of the values :func:`stair_values` would make from float32 maps
-    (:func:`~bistair.core.region_maps.stair_weights`), summed as they are computed
+    (weight ``core_weight(phi) * min(ratio, 1)``, ``ratio = clip(stair_mod / max(mod,
+    1e-6), 0, 2)``), summed as they are computed
     (:func:`~bistair.core.region_maps.label_stair_sums`).
 
     Parameters
@@ -219,13 +220,14 @@ def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     Examples
     --------
     >>> from dataclasses import astuple
-    >>> from bistair.core.region_maps import stair_weights
+    >>> from bistair.core.regions import core_weight
     >>> rng = np.random.default_rng(0)
     >>> phi, theta, stair_mod, mod = (rng.uniform(0.1, 1, (6, 5)).astype(np.float32)
     ...                               for _ in range(4))
     >>> labels = rng.integers(0, 3, (6, 5)).astype(np.int32)
     >>> a = stair_row_profiles(labels, phi, theta, stair_mod, mod)
-    >>> values = stair_weights(phi, np.cos(theta), np.sin(theta), stair_mod, mod, 0.01)[0]
+    >>> ratio = np.clip(stair_mod / np.maximum(mod, 1e-6), 0.0, 2.0)
+    >>> values = stair_values(theta, core_weight(phi) * np.minimum(ratio, 1.0), ratio)
     >>> b = row_profiles(labels, values)
     >>> all(np.array_equal(u, v) for u, v in zip(astuple(a), astuple(b)))
     True
