@@ -55,14 +55,14 @@ def chunk_count(n: int) -> int:
     return max(1, min(64, n // 4096))
 
 
-@kernel()
+@kernel(parallel=True)
 def _finish_phase(phi: np.ndarray, num: np.ndarray, den: np.ndarray, scale: float,
                   chunks: int) -> np.ndarray:
     n = phi.size
     mod = np.empty(n, np.float32)
     s32 = np.float32(scale)
     zero = np.float32(0.0)
-    for c in range(chunks):
+    for c in prange(chunks):
         lo = c * n // chunks
         hi = (c + 1) * n // chunks
         for i in range(lo, hi):
@@ -112,7 +112,7 @@ def finish_phase(phi: np.ndarray, num: np.ndarray, den: np.ndarray, steps: int) 
     return mod.reshape(phi.shape)
 
 
-@kernel()
+@kernel(parallel=True)
 def _validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, white: np.ndarray,
               black: np.ndarray, contrast: bool, lowest: float, threshold: float
               ) -> tuple[np.ndarray, np.ndarray, int]:
@@ -124,7 +124,7 @@ def _validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, white: np.n
     thr32 = np.float32(threshold)
     sat32 = np.float32(1.02)
     need32 = np.float32(2.0 * lowest)
-    for y in range(h):
+    for y in prange(h):
         weak = 0
         for x in range(w):
             m = mod[y, x]
@@ -189,12 +189,12 @@ def pixel_validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, lowest
     return valid, strong, int(weak)
 
 
-@kernel()
+@kernel(parallel=True)
 def _phase_noise(mod: np.ndarray, noise: float, factor: float, chunks: int) -> np.ndarray:
     n = mod.size
     out = np.empty(n, np.float32)
     floor32 = np.float32(1e-6)
-    for c in range(chunks):
+    for c in prange(chunks):
         lo = c * n // chunks
         hi = (c + 1) * n // chunks
         for i in range(lo, hi):
@@ -233,7 +233,7 @@ def phase_noise(mod: np.ndarray, noise: float, steps: int) -> np.ndarray:
     return out.reshape(np.shape(mod))
 
 
-@kernel()
+@kernel(parallel=True)
 def _pair_sums(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     _, h, w = raw.shape
@@ -241,7 +241,7 @@ def _pair_sums(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     c = np.empty((h, w), np.float32)
     s = np.empty((h, w), np.float32)
     mod = np.empty((h, w), np.float32)
-    for y in range(h):
+    for y in prange(h):
         for x in range(w):
             a = np.float32(raw[first, y, x]) * s32 - avg[y, x]
             b = np.float32(raw[first + 1, y, x]) * s32 - avg[y, x]
@@ -290,11 +290,11 @@ def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     return theta, mod
 
 
-@kernel()
+@kernel(parallel=True)
 def _wrap(a: np.ndarray, pi: float, two_pi: float, chunks: int) -> np.ndarray:
     n = a.size
     out = np.empty_like(a)
-    for c in range(chunks):
+    for c in prange(chunks):
         lo = c * n // chunks
         hi = (c + 1) * n // chunks
         far = 0
@@ -337,7 +337,7 @@ def wrap_angles(angle: np.ndarray) -> np.ndarray:
     return out.reshape(np.shape(angle))
 
 
-@kernel()
+@kernel(parallel=True)
 def _nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.ndarray,
                 cos_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     _, h, w = raw.shape
@@ -347,7 +347,7 @@ def _nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np
     num = np.empty((h, w), np.float32)
     den = np.empty((h, w), np.float32)
     avg = np.empty((h, w), np.float32)
-    for y in range(h):
+    for y in prange(h):
         s = num[y]
         c = den[y]
         t = avg[y]

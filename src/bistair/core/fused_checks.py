@@ -22,12 +22,12 @@ from .kernels import kernel
 prange = range  # numba's prange once the first kernel compiles
 
 
-@kernel()
+@kernel(parallel=True)
 def _code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     h, w = edges.shape
     counts = np.zeros(h + 1, np.int64)
-    for y in range(h):
+    for y in prange(h):
         m = 0
         for j in range(w - 3):
             a = edges[y, j + 1] if valid[y, j + 1] else -1
@@ -44,7 +44,7 @@ def _code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
     pa = np.empty(total, np.float64)
     pb = np.empty(total, np.float64)
     step = np.empty(total, np.int64)
-    for y in range(h):
+    for y in prange(h):
         i = start[y]
         for j in range(w - 3):
             a = edges[y, j + 1] if valid[y, j + 1] else -1
@@ -92,11 +92,11 @@ def code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
     return _code_steps(phi, edges, np.asarray(valid, bool))
 
 
-@kernel()
+@kernel(parallel=True)
 def _sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
     h, w = valid.shape
     counts = np.zeros(h + 1, np.int64)
-    for y in range(h):
+    for y in prange(h):
         m = 0
         for x in range(w):
             if valid[y, x] and order[y, x] >= 0:
@@ -106,7 +106,7 @@ def _sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
     total = start[h]
     every = max(1, total // samples)
     out = np.empty((total + every - 1) // every, np.int64)
-    for y in range(h):
+    for y in prange(h):
         rank = start[y]
         for x in range(w):
             if valid[y, x] and order[y, x] >= 0:
