@@ -4,10 +4,10 @@ Every kernel gives, bit for bit, what the NumPy expression it replaces gives (th
 float32 or float64 operations in the same order, comparisons against float32 thresholds as
 NumPy makes them of Python floats), without the temporaries. Arctangents stay with NumPy
 (its vectorised ``arctan2`` is fast and its roundings are the reference). Kernels compile
-with numba on their first call (``cache=True``), as those of :mod:`bistair.core.kernels`;
-the heavier ones run their loops over rows or chunks of pixels on every core (``prange``,
-:func:`~bistair.core.kernels.set_threads`), the light ones are serial (a parallel kernel
-takes two to three times as long to compile; the decorator is
+with numba on their first call (``cache=True``), as those of :mod:`bistair.core.kernels`,
+and run their loops over rows or chunks of pixels on every core (``prange``,
+:func:`~bistair.core.kernels.set_threads`; each row or chunk writes only its own outputs,
+so the results do not depend on the threads; the decorator is
 :func:`bistair.core.kernels.kernel`). This module holds the phase stage; :mod:`.fused_codes`
 the code stage, :mod:`.fused_checks` the checks and the result.
 
