@@ -25,7 +25,7 @@ from .captures import Prepared, ScaledStack, check_decodable, modulation_thresho
 from .fused import nstep_sums, phase_noise, pixel_validity
 from .kernels import keep_coherent
 from .phase import phase_of_sums, residuals, shifts_of
-from .regions import fringe_regions
+from .regions import MIN_REGION, fringe_regions
 
 
 @dataclass(frozen=True)
@@ -268,10 +268,10 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any())
     (True, False)
     """
-    # the regions fringe_regions drops as too small (under 20 pixels) are left out here,
-    # without its relabelling pass
+    # the regions fringe_regions drops as too small are left out here, without its
+    # relabelling pass
     labels, n = fringe_regions(phi, weak, min_size=1, phase_noise=phase_noise)
-    return keep_coherent(labels, weak, strong, n, min_strong, min_size, 20)
+    return keep_coherent(labels, weak, strong, n, min_strong, min_size, MIN_REGION)
 
 
 def _chi2_median(dof: int) -> float:

@@ -29,6 +29,8 @@ from .kernels import fringe_links, period_jump_links, reattach, wrap_links
 from .phase import TWO_PI, order_from_reference
 from .region_kernels import drop_small
 
+MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
+
 
 def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray, cut: float,
                sigma: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -243,7 +245,7 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
-                   min_size: int = 20, phase_noise: np.ndarray | None = None,
+                   min_size: int = MIN_REGION, phase_noise: np.ndarray | None = None,
                    boundaries: tuple[np.ndarray, np.ndarray] | None = None
                    ) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
