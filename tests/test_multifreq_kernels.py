@@ -67,9 +67,32 @@ def test_unwrap_chain_is_numpys(shape, periods, threads):
     finally:
         set_threads(None)
     assert np.array_equal(got[0], expected[0])
-    for g, e in zip(got[1:], expected[1:], strict=True):
-        assert g.dtype == np.float64
-        assert np.array_equal(g, np.broadcast_to(e, shape), equal_nan=True)
+    worst, last = (np.broadcast_to(e, shape) for e in expected[1:])
+    assert got[1].dtype == got[2].dtype == np.float32
+    assert np.array_equal(got[1], _toward_zero(worst), equal_nan=True)
+    assert np.array_equal(got[2], last.astype(np.float32), equal_nan=True)
+    with np.errstate(invalid="ignore"):  # the float32 miss passes 0.25 where float64's does
+        assert np.array_equal(got[1] < 0.25, worst < 0.25)
+
+
+def _toward_zero(values):
+    """Float64 ``values`` (non-negative or NaN) as float32, rounded toward zero."""
+    rounded = values.astype(np.float32)
+    with np.errstate(invalid="ignore"):
+        return np.where(rounded > values, np.nextafter(rounded, np.float32(0)), rounded)
+
+
+def test_worst_miss_keeps_its_side_of_the_limit():
+    # float64 misses a hair under and over 0.25 (float32 rounds the first to 0.25)
+    worst = np.array([0.25 - 1e-12, 0.25, 0.25 + 1e-12, 0.1, 0.0])
+    assert (_toward_zero(worst) < 0.25).tolist() == [True, False, False, True, True]
+    # a pixel whose float64 miss is 0.2499999975, which float32 rounds to 0.25
+    fine = np.array([[1054589079]], np.uint32).view(np.float32)  # 0.42920372 rad
+    phases = (np.full((1, 1), 0.2, np.float32), fine)
+    miss = abs((np.float64(phases[0][0, 0]) * 10 - np.float64(fine[0, 0])) / TWO_PI)
+    assert miss < 0.25 and np.float32(miss) == 0.25
+    got = unwrap_chain(phases, (300.0, 30.0), 300, fine, np.ones((1, 1), bool))[1]
+    assert got.dtype == np.float32 and bool(got[0, 0] < 0.25)
 
 
 @pytest.mark.parametrize("shape", SHAPES)

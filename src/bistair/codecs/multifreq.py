@@ -258,8 +258,10 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     -------
     CodeMap
         ``code``: (H, W) int32 order of the shortest period, -1 where some period is not
-        valid; ``maps``: ``worst`` (float64, fringes), ``valid`` (bool) and ``residual``
-        (the last step's signed miss, fringes), all (H, W).
+        valid; ``maps``: ``worst`` (fringes), ``valid`` (bool) and ``residual`` (the last
+        step's signed miss, fringes), all (H, W). The hierarchical rule unwraps in float64
+        and stores float32 (``worst`` rounded toward zero: below 0.25 exactly where the
+        float64 miss is); the heterodyne rule keeps float64.
 
     Examples
     --------

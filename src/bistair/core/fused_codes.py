@@ -240,15 +240,16 @@ def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold:
     two_pi = 2.0 * math.pi
     inv = 1.0 / two_pi
     code = np.empty((h, w), np.int32)
-    worst = np.empty((h, w), np.float64)
-    last = np.zeros((h, w), np.float64)
+    worst = np.empty((h, w), np.float32)
+    last = np.zeros((h, w), np.float32)
+    zero = np.float32(0.0)
     for y in prange(h):  # step by step along the row (vector loops), the phase in `a`
         a = np.empty(w, np.float64)
+        most = np.zeros(w, np.float64)  # the row's worst miss, float64 until stored
         top = phases[0]
         for x in range(w):
             p = np.float64(top[y, x])
             a[x] = p - two_pi if p * top_scale >= top_fold else p
-            worst[y, x] = 0.0
         for i in range(n):
             fine = phases[i + 1]
             ratio = ratios[i]
@@ -258,13 +259,15 @@ def _unwrap_chain(phases: tuple, ratios: np.ndarray, top_scale: float, top_fold:
                 k = np.rint((ref - f) * inv)
                 miss = (ref - f) / two_pi - k
                 m = abs(miss)
-                most = worst[y, x]
-                worst[y, x] = m if most == most and (m != m or m > most) else most  # NaN wins
-                last[y, x] = miss
+                was = most[x]
+                most[x] = m if was == was and (m != m or m > was) else was  # NaN wins
+                last[y, x] = np.float32(miss)
                 a[x] = f + two_pi * k
         for x in range(w):
             order = np.rint((a[x] - np.float64(phi[y, x])) * inv)
             code[y, x] = np.int32(order) if valid[y, x] and np.isfinite(order) else -1
+            m32 = np.float32(most[x])  # rounded toward zero: `< limit` as in float64
+            worst[y, x] = np.nextafter(m32, zero) if m32 > most[x] else m32
     return code, worst, last
 
 
@@ -293,9 +296,11 @@ def unwrap_chain(phases: tuple[np.ndarray, ...], periods: tuple[float, ...], len
     -------
     code : (H, W) int32 array
         The order of ``phi``, -1 where not valid (or not finite).
-    worst : (H, W) float64 array
-        The largest miss of any unwrapping step, in fringes.
-    last : (H, W) float64 array
+    worst : (H, W) float32 array
+        The largest miss of any unwrapping step, in fringes: computed in float64 and
+        rounded toward zero, so that it is below a float32 limit (such as 0.25) exactly
+        where the float64 miss is.
+    last : (H, W) float32 array
         The signed miss of the last step, in fringes.
 
     Examples
