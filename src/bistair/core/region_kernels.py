@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from .kernels import _numba_inline, kernel
+from .kernels import _numba_called, _numba_inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -64,24 +64,27 @@ def nearest_levels(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
     >>> nearest_levels(np.array([0.9, 1.0, 3.1, -3.1]), levels).tolist()
     [1, 1, 2, 0]
     """
-    n, m = theta.size, levels.size
-    out = np.zeros(n, np.int32)
-    for i in range(n):
-        t = theta[i]
-        best = 0
-        low = _wrapped_abs(t - levels[0])
-        if low != low:
-            continue
-        for j in range(1, m):
-            d = _wrapped_abs(t - levels[j])
-            if d != d:  # NaN: numpy.argmin returns the first one
-                best = j
-                break
-            if d < low:
-                low = d
-                best = j
-        out[i] = best
+    out = np.zeros(theta.size, np.int32)
+    for i in range(theta.size):
+        out[i] = _nearest_level(theta[i], levels)
     return out
+
+
+@_numba_inline
+def _nearest_level(t: float, levels: np.ndarray) -> int:
+    """One phase's :func:`nearest_levels`."""
+    best = 0
+    low = _wrapped_abs(t - levels[0])
+    if low != low:
+        return 0
+    for j in range(1, levels.size):
+        d = _wrapped_abs(t - levels[j])
+        if d != d:  # NaN: numpy.argmin returns the first one
+            return j
+        if d < low:
+            low = d
+            best = j
+    return best
 
 
 @kernel()
@@ -108,8 +111,16 @@ def region_quantile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndar
     >>> region_quantile(np.array([0, 0, 3]), np.array([2.0, 1.0, 7.0]), 0.5).tolist()
     [1.0, 1.0, 7.0]
     """
+    out = np.empty(region.size, np.float64)
+    _region_quantile(region, values, q, out)
+    return out
+
+
+@_numba_called
+def _region_quantile(region: np.ndarray, values: np.ndarray, q: float, out: np.ndarray
+                     ) -> None:
+    """:func:`region_quantile` into ``out``."""
     n = region.size
-    out = np.empty(n, np.float64)
     i = 0
     while i < n:
         j = i + 1
@@ -124,7 +135,6 @@ def region_quantile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndar
         for k in range(i, j):
             out[k] = pick
         i = j
-    return out
 
 
 @kernel()
@@ -155,6 +165,13 @@ def group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
     ...                   0.8).tolist()
     [3.2, nan, 5.0]
     """
+    return _group_percentiles(group, values, n_groups, q)
+
+
+@_numba_called
+def _group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
+                       q: float) -> np.ndarray:
+    """The body of :func:`group_percentiles`."""
     n = group.size
     counts = np.zeros(n_groups + 1, np.int64)
     for i in range(n):

@@ -12,19 +12,16 @@ tell, the evidence says so and the neighbours decide (see
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from functools import lru_cache
 
 import numpy as np
 
 from ...core.label_rows import label_row_sums
 from ...core.phase import TWO_PI, wrap
-from ...core.region_kernels import (
-    group_percentiles,
-    nearest_levels,
-    region_quantile,
-)
+from ...core.region_kernels import nearest_levels
 from ...core.region_maps import label_stair_sums
+from ...core.run_kernels import band_reads, band_runs, band_sums
 from ...core.stair import stair_level_phase
 
 
@@ -242,19 +239,6 @@ def _profiles(h: int, keys: np.ndarray, count: np.ndarray, sums: np.ndarray) -> 
                        cols)
 
 
-def _region_percentile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndarray:
-    """The ``q`` quantile of ``values`` within each entry's region, per entry."""
-    if region.size == 0:
-        return values
-    if np.all(region[1:] >= region[:-1]):  # each region's entries together (row profiles)
-        return region_quantile(region, np.asarray(values, np.float64), q)
-    order = np.lexsort((values, region))
-    starts = np.flatnonzero(np.r_[True, region[order][1:] != region[order][:-1]])
-    counts = np.diff(np.r_[starts, region.size])
-    pick = values[order][starts + np.floor(q * (counts - 1)).astype(np.int64)]
-    return np.repeat(pick, counts)[np.argsort(order, kind="stable")]
-
-
 def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:
     """(row, column) centroid of each region 0..n_regions from its row profiles.
 
@@ -371,63 +355,30 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
     >>> runs.y0[:6].tolist(), runs.length[:6].tolist()
     ([0, 10, 16, 26, 32, 42], [10.0, 6.0, 10.0, 6.0, 10.0, 6.0])
     """
-    c, s, wsum = prof.cos, prof.sin, prof.weight
-    region, row = prof.region, prof.row
-    row_theta = np.arctan2(s, c)
-    core = prof.level >= 0.7 * _region_percentile(region, prof.level, 0.8)
-    levels = observed_levels(row_theta[core], wsum[core], levels)
-    read = nearest_level(row_theta, levels)
-    # each level's 80th percentile (as np.percentile), 1 for levels no core row reads
-    expected = group_percentiles(read[core], prof.level[core].astype(np.float64), levels.size,
-                                 0.8)
-    expected[np.bincount(read[core], minlength=levels.size) == 0] = 1.0
-    level = prof.level / np.maximum(expected[read], 1e-6)
-    kept = level >= 0.7 * _region_percentile(region, level, 0.8)
-    dropped_before = np.cumsum(~kept) - (~kept)  # dropped entries strictly before each entry
-    idx = np.flatnonzero(kept)
-    if idx.size == 0:  # no band row left (tiny or pure-noise captures)
+    if prof.region.size > 1 and not (np.all(prof.region[1:] >= prof.region[:-1])
+                                     and np.all((prof.row[1:] > prof.row[:-1])
+                                                | (prof.region[1:] != prof.region[:-1]))):
+        prof = RowProfiles(*(v[np.lexsort((prof.row, prof.region))]
+                             for v in astuple(prof)))  # by region, then row
+    region, row, level = prof.region, prof.row, np.asarray(prof.level, np.float64)
+    row_theta = np.arctan2(prof.sin, prof.cos)
+    core, c, s, w = band_sums(region, level, row_theta, prof.weight, levels)
+    # levels no core row reads keep their nominal phase (as observed_levels)
+    levels = np.where(w > 0.01 * prof.weight[core].sum(), np.arctan2(s, c), levels)
+    read, kept = band_reads(region, level, row_theta, core, levels)
+    if not kept.any():  # no band row left (tiny or pure-noise captures)
         empty = np.zeros(0)
         return Runs(*(empty.astype(np.int64),) * 3, empty, empty, empty,
                     empty.astype(np.int64), empty.astype(bool), empty.astype(bool), empty)
-    region_k, row_k = region[idx], row[idx]
-    uid = read[idx]
-    same = np.zeros(idx.size, bool)
-    same[1:] = region_k[1:] == region_k[:-1]
-    gap = np.zeros(idx.size, np.int64)
-    gap[1:] = row_k[1:] - row_k[:-1] - 1
-    between = np.zeros(idx.size, np.int64)
-    between[1:] = dropped_before[idx[1:]] - dropped_before[idx[:-1]]
-    soft = same & (gap == between) & (gap <= 3)
-    changed = np.ones(idx.size, bool)
-    changed[1:] = uid[1:] != uid[:-1]
-    start = ~soft | changed
-    start[0] = True
-    run_id = np.cumsum(start) - 1
-    first = np.flatnonzero(start)
-    last = np.r_[first[1:] - 1, idx.size - 1]
-    top_ok = soft[first] & changed[first]
-    nxt = np.r_[first[1:], idx.size]
-    bottom_ok = np.zeros(first.size, bool)
-    has_next = nxt < idx.size
-    bottom_ok[has_next] = top_ok[1:][has_next[:-1]] if first.size > 1 else False
-    half_top = np.where(top_ok, gap[first] / 2.0, 0.0)
-    half_bottom = np.zeros(first.size)
-    half_bottom[:-1] = np.where(bottom_ok[:-1], gap[first[1:]] / 2.0, 0.0)
-    cw = np.bincount(run_id, c[idx])
-    sw = np.bincount(run_id, s[idx])
-    run_theta = np.arctan2(sw, cw)
-    # Distance of the rows from their level, in half the distance to the nearest other level
-    # (where a reading would change level): blur mixing two bands puts rows in between.
+    # distance of the rows from their level, in half the distance to the nearest other level
+    # (where a reading would change level): blur mixing two bands puts rows in between
     gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
-    off = np.abs(wrap(row_theta[idx] - levels[uid])) / (0.5 * gaps.min(axis=1)[uid])
-    misfit = np.bincount(run_id, off * wsum[idx]) / np.maximum(np.bincount(run_id, wsum[idx]),
-                                                               1e-12)
-    runs = Runs(
-        region=region_k[first], y0=row_k[first], y1=row_k[last],
-        length=(row_k[last] - row_k[first] + 1) + half_top + half_bottom,
-        theta=run_theta, weight=np.bincount(run_id, wsum[idx]),
-        uid=uid[first], top_ok=top_ok, bottom_ok=bottom_ok, misfit=misfit,
-    )
+    reg, y0, y1, length, cw, sw, weight, misfit, uid, top_ok, bottom_ok = band_runs(
+        region, row, read, kept, prof.cos, prof.sin, prof.weight, row_theta, levels,
+        0.5 * gaps.min(axis=1))
+    runs = Runs(region=reg, y0=y0, y1=y1, length=length, theta=np.arctan2(sw, cw),
+                weight=weight, uid=uid, top_ok=top_ok,
+                bottom_ok=bottom_ok, misfit=misfit)
     return _drop_transitions(runs)
 
 
