@@ -246,8 +246,8 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                    min_size: int = MIN_REGION, phase_noise: np.ndarray | None = None,
-                   boundaries: tuple[np.ndarray, np.ndarray] | None = None
-                   ) -> tuple[np.ndarray, int]:
+                   boundaries: tuple[np.ndarray, np.ndarray] | None = None,
+                   sign: int | None = None) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
 
     Links are cut at wraps, at steps above ``cut``, where the fringe period jumps
@@ -274,6 +274,9 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
         Per-pixel phase noise in radians.
     boundaries : tuple of (H-1, W) and (H, W-1) bool arrays, optional
         Vertical and horizontal links to cut as well.
+    sign : int, optional
+        The phase's direction along the rows, when the caller has it already:
+        ``fringe_direction(phi, valid)``.
 
     Returns
     -------
@@ -302,7 +305,8 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     h, w = phi.shape
     noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
              else np.ascontiguousarray(phase_noise, dtype=np.float32))
-    sign = fringe_direction(phi, valid)
+    if sign is None:
+        sign = fringe_direction(phi, valid)
     jump_v, jump_h = period_jump_links(phi, valid, noise, 3, 0.3)
     if boundaries is not None:  # the links are this call's own arrays: marked in place
         jump_v |= boundaries[0]

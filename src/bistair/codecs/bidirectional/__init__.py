@@ -53,7 +53,7 @@ from ...core.kernels import quantize32, stair_turns
 from ...core.measure import FringeSet
 from ...core.phase import TWO_PI, wrap
 from ...core.region_maps import row_bands, stair_noise
-from ...core.regions import core_weight, fringe_regions
+from ...core.regions import core_weight, fringe_direction, fringe_regions
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair
 from ...errors import BistairError
@@ -521,11 +521,15 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         def stair_noise_map() -> np.ndarray:
             return noise_scale / np.maximum(stair_mod, 1e-6)
 
+    # the phase noise and the fringes' direction, once for the regions and their orders
+    phase_noise = fs.phase_noise
+    direction = fringe_direction(fs.phi, fs.valid)
+
     def regions() -> np.ndarray:
         """Fringe regions, cut where the stair code says two surfaces meet."""
         edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
-        return fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise,
-                              boundaries=edges)[0]
+        return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise, boundaries=edges,
+                              sign=direction)[0]
 
     levels = union_levels(spec.partitions, spec.stairs)
 
@@ -552,7 +556,7 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
 
     # the labels are passed on, not kept here: the decode replaces them as it splits regions
     return orders_from_regions(fs.phi, fs.valid, regions(), evidence_of, agrees, info,
-                               phase_noise=fs.phase_noise)
+                               phase_noise=phase_noise, direction=direction)
 
 
 def stairs_for(fringes: int) -> tuple[int, int]:
