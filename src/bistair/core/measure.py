@@ -100,7 +100,8 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
         return _along_fringe_noise(frames)
     top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
     low = (slice(None), slice(1, None, 4), slice(None, None, 4))
-    n_rows = min(frames[top].shape[1], frames[low].shape[1])
+    h = frames.shape[1]
+    n_rows = min(len(range(h)[top[1]]), len(range(h)[low[1]]))  # (without reading frames)
     pair = []
     for sub in (top, low):
         f = frames[sub][:, :n_rows]

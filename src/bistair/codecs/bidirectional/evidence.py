@@ -11,7 +11,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ...core.region_kernels import value_changes
-from ...core.stair import level_misfit, quantize
+from ...core.run_kernels import band_evidence
 from .bands import RowProfiles, Runs, union_levels
 
 
@@ -378,74 +378,13 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
     >>> ev.shape, ev[1:].argmax(axis=1).tolist(), ev[1:].max(axis=1).round(2).tolist()
     ((3, 12), [5, 6], [1.0, 1.0])
     """
-    S, P = layout.stairs, layout.partitions
-    ks = np.arange(S * P)
-    a_of_k, b_of_k = ks % S, ks // S
-    ev = np.zeros((n_regions + 1, S * P))
     if runs.uid.size == 0:
-        return ev
-    order = np.argsort(runs.region, kind="stable")
+        return np.zeros((n_regions + 1, layout.stairs * layout.partitions))
+    order = np.argsort(runs.region, kind="stable")  # (row_runs gives them in this order)
     runs = runs.take(order)
-    bounds = np.flatnonzero(np.r_[True, runs.region[1:] != runs.region[:-1], True])
-    f_loc, f_par = layout.local_share, 1.0 - layout.local_share
-    for lo, hi in zip(bounds[:-1], bounds[1:], strict=True):
-        r = int(runs.region[lo])
-        uid, wgt, length = runs.uid[lo:hi], runs.weight[lo:hi], runs.length[lo:hi]
-        complete = runs.top_ok[lo:hi] & runs.bottom_ok[lo:hi]
-        h = heights[r] if np.isfinite(heights[r]) else layout.default_height
-        total = wgt.sum()
-        row_weight = total / max(length.sum(), 1.0)
-        if (runs.misfit[lo:hi] * wgt).sum() > 0.32 * total:
-            continue  # rows read between levels: the bands are blurred together, no order
-        vals, inv = np.unique(uid, return_inverse=True)
-        cls_w = np.bincount(inv, wgt)
-        rank = np.argsort(cls_w)[::-1]
-        x = rank[0]
-        y = rank[1] if vals.size > 1 else -1
-        if y >= 0 and (cls_w[y] < 0.05 * total or length[inv == y].max() < 2):
-            y = -1
-        # A class's level is the one its rows were read as (against the levels observed in
-        # this capture); its nominal phase says which stair index that is.
-        th_x = layout.levels[vals[x]]
-        if y < 0:
-            a, b = quantize(th_x, S), quantize(th_x, P)
-            if length.max() >= 1.3 * max(f_loc, f_par) * h:
-                fit = level_misfit(th_x, a, S) + level_misfit(th_x, b, P)
-                ev[r, a + S * b] = cls_w[x] / total - 0.5 * fit
-            else:
-                share = 0.4 * cls_w[x] / total
-                ev[r, a_of_k == a] = share
-                ev[r, b_of_k == b] = share
-            continue
-        th_y = layout.levels[vals[y]]
-        options = []
-        for loc, par in ((x, y), (y, x)):
-            th_l, th_p = (th_x, th_y) if loc == x else (th_y, th_x)
-            a, b = quantize(th_l, S), quantize(th_p, P)
-            expect = np.where(inv == loc, f_loc * h, np.where(inv == par, f_par * h, np.nan))
-            cost = _length_cost(length, expect, complete)
-            fit = level_misfit(th_l, a, S) + level_misfit(th_p, b, P)
-            # A class seen in 3 or more rows' worth of pixels is certain; a match counts +1,
-            # a mismatch -1, each weighted by how certain its class is.
-            e_l, e_p = np.minimum(1.0, cls_w[[loc, par]] / (3.0 * row_weight))
-            hits = e_l * np.where(a_of_k == a, 1.0, -1.0) + e_p * np.where(b_of_k == b, 1.0, -1.0)
-            options.append((hits / (e_l + e_p) - 0.5 * fit, cost))
-        # Band lengths decide which value is the local one: the worse-fitting reading
-        # loses up to 0.5, the better one nothing (its absolute fit depends on h).
-        low = min(cost for _, cost in options)
-        ev[r] = np.max([score - 0.5 * min(1.0, cost - low) for score, cost in options], axis=0)
-    return ev
-
-
-def _length_cost(length: np.ndarray, expect: np.ndarray, complete: np.ndarray) -> float:
-    """How badly band lengths fit the expected local/partition heights (summed squared
-    log-ratios). Complete bands must match; bands cut by the region's edge only must not be
-    longer.
-    """
-    ok = np.isfinite(expect)
-    if not ok.any():
-        return 0.0
-    ratio = np.log(np.maximum(length[ok], 0.5) / expect[ok])
-    over = np.maximum(ratio - np.log(1.25), 0.0)
-    terms = np.where(complete[ok], ratio**2, over**2)
-    return float(terms.sum())
+    return band_evidence(runs.region, runs.uid, np.asarray(runs.weight, np.float64),
+                         np.asarray(runs.length, np.float64),
+                         np.asarray(runs.misfit, np.float64), runs.top_ok & runs.bottom_ok,
+                         np.asarray(heights, np.float64), np.asarray(layout.levels),
+                         layout.stairs, layout.partitions, float(layout.local_share),
+                         float(layout.default_height), int(n_regions))
