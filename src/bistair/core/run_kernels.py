@@ -8,16 +8,6 @@ the caller: NumPy's vectorised ``arctan2`` and the C library's differ in the las
 
 The profile entries come sorted by region, then row (as
 :class:`~bistair.codecs.bidirectional.bands.RowProfiles` keeps them).
-
-Examples
---------
->>> import numpy as np
->>> region = np.array([1, 1, 1, 2])
->>> level = np.array([1.0, 0.2, 1.0, 1.0])
->>> theta = np.array([0.1, 0.1, 3.0, -3.1])
->>> core, c, s, w = band_sums(region, level, theta, np.ones(4), np.array([0.0, 3.0]))
->>> core.tolist(), w.tolist()
-([True, False, True, True], [1.0, 2.0])
 """
 
 from __future__ import annotations
@@ -62,6 +52,15 @@ def band_sums(region: np.ndarray, level: np.ndarray, theta: np.ndarray, weight: 
         The band-core entries.
     cos, sin, weight : (L,) float64 arrays
         The core entries' sums per level.
+
+    Examples
+    --------
+    >>> region = np.array([1, 1, 1, 2])
+    >>> level = np.array([1.0, 0.2, 1.0, 1.0])  # the second row a blurred transition
+    >>> theta = np.array([0.1, 0.1, 3.0, -3.1])
+    >>> core, c, s, w = band_sums(region, level, theta, np.ones(4), np.array([0.0, 3.0]))
+    >>> core.tolist(), w.tolist()
+    ([True, False, True, True], [1.0, 2.0])
     """
     n, m = region.size, levels.size
     q = np.empty(n, np.float64)
@@ -104,6 +103,16 @@ def band_reads(region: np.ndarray, level: np.ndarray, theta: np.ndarray, core: n
         The nearest level of each entry.
     kept : (n,) bool array
         The band rows.
+
+    Examples
+    --------
+    >>> region = np.array([1, 1, 1, 2])
+    >>> level = np.array([1.0, 0.2, 1.0, 1.0])
+    >>> theta = np.array([0.1, 0.1, 3.0, -3.1])
+    >>> core = np.array([True, False, True, True])
+    >>> read, kept = band_reads(region, level, theta, core, np.array([0.0, 3.0]))
+    >>> read.tolist(), kept.tolist()
+    ([0, 0, 1, 1], [True, False, True, True])
     """
     n, m = region.size, levels.size
     read = np.empty(n, np.int32)
@@ -171,7 +180,19 @@ def band_runs(region: np.ndarray, row: np.ndarray, read: np.ndarray, kept: np.nd
     tuple of (runs,) arrays
         ``region, y0, y1`` (int64), ``length, cos, sin, weight, misfit`` (float64),
         ``uid`` (int32), ``top_ok, bottom_ok`` (bool): each run's sums and the mean
-        distance of its rows from their level in ``half_gap``\\ s, weighted.
+        distance of its rows from their level, in units of ``half_gap``, weighted.
+
+    Examples
+    --------
+    Six rows of one region, three read as level 0 and three as level 1:
+
+    >>> one = np.ones(6)
+    >>> runs = band_runs(np.ones(6, np.int64), np.arange(6), np.int32([0, 0, 0, 1, 1, 1]),
+    ...                  np.ones(6, bool), one, 0 * one, one, np.array([0, 0, 0, 3, 3, 3.0]),
+    ...                  np.array([0.0, 3.0]), np.array([1.5, 1.5]))
+    >>> y0, y1, length, top_ok, bottom_ok = runs[1], runs[2], runs[3], runs[9], runs[10]
+    >>> y0.tolist(), y1.tolist(), length.tolist(), top_ok.tolist(), bottom_ok.tolist()
+    ([0, 3], [2, 5], [3.0, 3.0], [False, True], [True, False])
     """
     n = region.size
     runs = 0
@@ -265,6 +286,23 @@ def band_evidence(region: np.ndarray, uid: np.ndarray, weight: np.ndarray,
     (n_regions + 1, S*P) float64 array
         Evidence per region and order (zero for regions without runs or whose rows read
         between levels).
+
+    Examples
+    --------
+    One region of order 5 with ``S = 4``, ``P = 3``: its bands read local level 1 (10 rows
+    of a 16-row group) and partition level 1 (6 rows), alternately:
+
+    >>> from bistair.codecs.bidirectional.bands import nearest_level, union_levels
+    >>> from bistair.core.stair import stair_level_phase
+    >>> levels = union_levels(3, 4)
+    >>> uid = nearest_level(np.array([stair_level_phase(1, 4), stair_level_phase(1, 3)]),
+    ...                     levels)[[0, 1, 0, 1]].astype(np.int64)
+    >>> ev = band_evidence(np.ones(4, np.int64), uid, np.full(4, 10.0),
+    ...                    np.array([10.0, 6, 10, 6]), np.zeros(4),
+    ...                    np.array([False, True, True, False]), np.array([np.nan, 16.0]),
+    ...                    levels, 4, 3, 10 / 16, 16.0, 1)
+    >>> ev.shape, int(ev[1].argmax()), float(ev[1].max())
+    ((2, 12), 5, 1.0)
     """
     S, P = stairs, partitions
     ev = np.zeros((n_regions + 1, S * P), np.float64)
