@@ -114,10 +114,13 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
                                else (second_theta, run_theta[g_first]))
     k1 = quantize(local_theta, S)
     k2 = quantize(part_theta, P)  # merged runs: k = k_s1 + S*k_s1 (= 7 k_s1 for 6 x 6)
-    k_group = k1 + S * k2
+    run_k = (k1 + S * k2)[group]
+    # the per-run work is done: let it go before the fringe regions, the stage's peak
+    del run_theta, new_group, merged, group, g_first, g_second, has_second, second_theta
+    del local_theta, part_theta, k1, k2, c_len, ok
     fringes, n_fringes = fringe_regions(fs.phi, fs.valid, min_size=1,
                                         phase_noise=fs.phase_noise)
-    mode, _ = run_label_modes(fringes, runs, k_group[group], n_fringes, S * P)
+    mode, _ = run_label_modes(fringes, runs, run_k, n_fringes, S * P)
     return paint_labels(fringes, mode)
 
 
