@@ -9,6 +9,7 @@ import pytest
 
 from bistair.codecs.bidirectional.bands import Runs, union_levels
 from bistair.codecs.bidirectional.evidence import _own_heights, band_splits
+from bistair.core.kernels import period_jump_links, set_threads
 from bistair.core.phase import wrap
 from bistair.core.region_kernels import (
     group_percentiles,
@@ -16,6 +17,7 @@ from bistair.core.region_kernels import (
     region_quantile,
 )
 from bistair.core.region_maps import dense_tile, window_seeds
+from bistair.core.regions import period_jumps
 
 
 def _nearest_before(theta, levels):
@@ -336,3 +338,26 @@ def test_in_place_fills_and_splits_equal_the_copies():
     got, m = split_regions(given, 3, splits, in_place=True)
     assert got is given and m == n and np.array_equal(got, want)
     assert not np.array_equal(want, labels)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (9, 1), (2, 5), (37, 41), (70, 1200)])
+@pytest.mark.parametrize("half", [1, 3, 5])
+@pytest.mark.parametrize("threads", [1, None])
+def test_period_jump_links_are_numpys(shape, half, threads):
+    # fringes whose period and slant change from place to place, noise, invalid pixels
+    h, w = shape
+    rng = np.random.default_rng(h * w + half)
+    y, x = np.mgrid[0:h, 0:w].astype(np.float64)
+    period = np.where((x // 37 + y // 23) % 2 == 0, 20.0, 33.0)
+    phi = ((2 * np.pi * (x + 0.3 * y) / period + rng.normal(0, 0.05, shape)) % (2 * np.pi)
+           ).astype(np.float32)
+    valid = rng.random(shape) > 0.15
+    noise = rng.uniform(0.001, 0.05, shape).astype(np.float32)
+    expected = period_jumps(phi, valid, noise, 0.3, half)
+    try:
+        set_threads(threads)
+        got = period_jump_links(phi, valid, noise, half, 0.3)
+    finally:
+        set_threads(None)
+    assert np.array_equal(got[0], expected[0]) and np.array_equal(got[1], expected[1])
+    assert got[1].any() or w < 2 * half + 2 or h * w < 1000
