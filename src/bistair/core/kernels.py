@@ -183,6 +183,16 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
 
 
 @_numba_inline
+def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
+           rel: np.float32) -> bool:
+    """Not clearly below ``rel`` of the larger gradient: :func:`_jump`'s first test, which
+    most links fail (True for NaN)."""
+    dx, dy = px - qx, py - qy
+    return not (dx * dx + dy * dy < rel * rel * max(px * px + py * py, qx * qx + qy * qy)
+                * np.float32(0.9999))
+
+
+@_numba_inline
 def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
                       sums: np.ndarray, around: np.ndarray, ahead: np.ndarray) -> None:
     """Row ``y``'s mean wrapped gradients (x, y) and their sample counts over the columns
@@ -288,6 +298,7 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
     sums = np.zeros((4, w + 1), np.float32)
     ahead = np.zeros((3, w), np.float32)
     rows = np.zeros((2, 3, w), np.float32)  # ``around`` of rows y-1 and y (at y % 2)
+    maybe = np.zeros(w, np.bool_)  # links that pass _jump's first test
     if y0 > 0:
         _gradient_windows(phi, valid, y0 - 1, half, sums, rows[(y0 - 1) % 2], ahead)
     for y in range(y0, y1):
@@ -299,9 +310,15 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
         around = rows[y % 2]
         _gradient_windows(phi, valid, y, half, sums, around, ahead)
         # left of link x the window [x-half, x) is ``ahead`` of x-half; nearer the image's
-        # left edge it holds under ``half`` samples and no link is cut
+        # left edge it holds under ``half`` samples and no link is cut. Most links fail
+        # _jump's first test: it runs for every link in one vector loop, the rest only
+        # where it passes.
         for x in range(half, w - 1):
-            if valid[y, x] and valid[y, x + 1]:
+            lo = x - half
+            maybe[x] = _steep(ahead[0, lo], ahead[1, lo], ahead[0, x + 1], ahead[1, x + 1],
+                              rel)
+        for x in range(half, w - 1):
+            if maybe[x] and valid[y, x] and valid[y, x + 1]:
                 lo = x - half
                 horiz[y, x] = _jump(ahead[0, lo], ahead[1, lo], ahead[2, lo],
                                     ahead[0, x + 1], ahead[1, x + 1], ahead[2, x + 1],
@@ -309,7 +326,9 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
         if y > 0:
             above = rows[(y - 1) % 2]
             for x in range(w):
-                if valid[y - 1, x] and valid[y, x]:
+                maybe[x] = _steep(above[0, x], above[1, x], around[0, x], around[1, x], rel)
+            for x in range(w):
+                if maybe[x] and valid[y - 1, x] and valid[y, x]:
                     vert[y - 1, x] = _jump(above[0, x], above[1, x], above[2, x],
                                            around[0, x], around[1, x], around[2, x],
                                            noise[y - 1, x], noise[y, x], rel, fhalf)
