@@ -12,7 +12,7 @@ from bistair.codecs.bidirectional import edge_runs
 from bistair.codecs.graycode import gray_to_binary
 from bistair.core import fused, fused_checks, fused_codes
 from bistair.core.captures import ScaledStack
-from bistair.core.kernels import quantize32
+from bistair.core.kernels import quantize32, set_threads
 from bistair.core.phase import TWO_PI, wrap
 
 RNG = np.random.default_rng(7)
@@ -87,7 +87,35 @@ def test_pair_phase_is_stair_phase(dtype):
     avg = RNG.uniform(0, 1, (30, 40)).astype(np.float32)
     c, s = frames[3] - avg, frames[4] - avg
     theta, mod = fused.pair_phase(raw, 3, np.float32(1.0 / top), avg)
-    assert _same(theta, np.arctan2(s, c)) and _same(mod, np.hypot(s, c))
+    assert _same(theta, _arctan2_rounded(s, c)) and _same(mod, np.hypot(s, c))
+
+
+def _arctan2_rounded(y, x):
+    """The correctly rounded float32 arctangent: float64 ``arctan2`` rounded once."""
+    return np.arctan2(y.astype(np.float64), x.astype(np.float64)).astype(np.float32)
+
+
+@pytest.mark.parametrize("threads", [1, None])
+def test_arctan2_32_is_correctly_rounded(threads):
+    # every scale, both signs, zeros of both signs, infinities and NaN
+    n = 400_000
+    y = (RNG.standard_normal(n) * 10.0 ** RNG.uniform(-30, 30, n)).astype(np.float32)
+    x = (RNG.standard_normal(n) * 10.0 ** RNG.uniform(-30, 30, n)).astype(np.float32)
+    special = np.float32([0.0, -0.0, 1.0, -1.0, np.inf, -np.inf, np.nan, 1e-45, 3e38])
+    y = np.concatenate([y, np.repeat(special, special.size)])
+    x = np.concatenate([x, np.tile(special, special.size)])
+    y[:1000] = x[:1000] * np.float32(0.41421357)  # at the reduction's switch, tan(pi/8)
+    try:
+        set_threads(threads)
+        got = fused.arctan2_32(y, x)
+    finally:
+        set_threads(None)
+    expected = _arctan2_rounded(y, x)
+    finite = np.isfinite(x) & np.isfinite(y)
+    assert np.array_equal(got[finite], expected[finite], equal_nan=True)
+    assert np.array_equal(np.signbit(got[finite]), np.signbit(expected[finite]))
+    # infinities: the same angle to within a unit in the last place (or both NaN)
+    assert np.allclose(got[~finite], expected[~finite], rtol=2e-7, atol=0, equal_nan=True)
 
 
 @pytest.mark.parametrize(("stairs", "partitions"), [(8, 8), (4, 3), (2, 32)])

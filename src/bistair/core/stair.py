@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from .fused import arctan2_32
 from .phase import TWO_PI
 
 
@@ -99,7 +100,8 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     Returns
     -------
     theta : ndarray
-        Float32 stair phase in radians (``arctan2`` of the frames minus ``avg``).
+        Float32 stair phase in radians (:func:`~bistair.core.fused.arctan2_32` of the frames
+        minus ``avg``).
     modulation : ndarray
         Float32 length of that (cos, sin) vector, same shape.
 
@@ -112,7 +114,7 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     """
     c = np.asarray(cos_frame, dtype=np.float32) - avg
     s = np.asarray(sin_frame, dtype=np.float32) - avg
-    return np.arctan2(s, c).astype(np.float32), np.hypot(s, c).astype(np.float32)
+    return arctan2_32(s, c), np.hypot(s, c).astype(np.float32)
 
 
 def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
