@@ -13,7 +13,15 @@ from bistair.codecs.graycode import gray_to_binary
 from bistair.core import fused, fused_checks, fused_codes
 from bistair.core.captures import ScaledStack
 from bistair.core.kernels import quantize32, set_threads
-from bistair.core.phase import TWO_PI, wrap
+from bistair.core.measure import _chi2_median, noise_level
+from bistair.core.phase import (
+    TWO_PI,
+    phase_shift_patterns,
+    residuals,
+    shifts_of,
+    wrap,
+    wrapped_phase,
+)
 
 RNG = np.random.default_rng(7)
 
@@ -315,3 +323,43 @@ def test_nstep_sums_are_numpys(dtype):
                 np.cos(d).astype(np.float32))
         assert all(_same(a, b) for a, b in zip(_nstep_sums(*args), fused.nstep_sums(*args),
                                                strict=True))
+
+
+def _noise_before(frames, phi, avg, mod, shift_sign, phase_offset):
+    """The NumPy ``noise_level`` (N >= 4): its sample of fit-residual differences."""
+    top = (slice(None), slice(0, -1, 4), slice(None, None, 4))
+    low = (slice(None), slice(1, None, 4), slice(None, None, 4))
+    n_rows = min(len(range(frames.shape[1])[top[1]]), len(range(frames.shape[1])[low[1]]))
+    pair = []
+    for sub in (top, low):
+        f = frames[sub][:, :n_rows]
+        p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
+        pair.append((residuals(f, p, a, m, shift_sign, phase_offset),
+                     (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
+    (r0, ok0), (r1, ok1) = pair
+    return ((r1 - r0) ** 2).sum(axis=0), ok0 & ok1
+
+
+@pytest.mark.parametrize("steps", [4, 5, 8])
+@pytest.mark.parametrize("convention", [(1, 0.0), (-1, 0.7)])
+@pytest.mark.parametrize("shape", [(2, 1), (9, 13), (120, 97)])
+def test_fit_residual_energy_is_numpys(steps, convention, shape):
+    shift_sign, offset = convention
+    x = np.tile(np.arange(shape[1], dtype=np.float64), (shape[0], 1))
+    clean = phase_shift_patterns(x, 17, steps, amplitude=0.45, phase_offset=offset,
+                                 shift_sign=shift_sign)
+    raw = np.clip(np.round(255 * (clean + RNG.normal(0, 0.01, clean.shape))), 0, 255
+                  ).astype(np.uint8)  # some pixels clip at 0 and 255
+    frames = ScaledStack(raw, 1 / 255)
+    phi, avg, mod = wrapped_phase(frames[...], shift_sign=shift_sign, phase_offset=offset)
+    energy, ok = fused.fit_residual_energy(raw, 0, steps, np.float32(1 / 255), phi, avg, mod,
+                                           shifts_of(steps, shift_sign, offset))
+    expected, expected_ok = _noise_before(frames, phi, avg, mod, shift_sign, offset)
+    # the same but for the cosine's last bit (the C library's cosf against NumPy's)
+    assert np.array_equal(ok, expected_ok)
+    np.testing.assert_allclose(energy, expected, rtol=1e-4, atol=1e-9)
+    if expected.size >= 100:
+        got = noise_level(frames, phi, avg, mod, shift_sign, offset)
+        want = float(np.sqrt(np.median(expected[expected_ok] if expected_ok.sum() >= 100
+                                       else expected.ravel()) / (2.0 * _chi2_median(steps - 3))))
+        assert got == pytest.approx(want, rel=1e-5)

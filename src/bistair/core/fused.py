@@ -182,6 +182,84 @@ def finish_phase(phi: np.ndarray, num: np.ndarray, den: np.ndarray, steps: int) 
     return mod.reshape(phi.shape)
 
 
+def fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
+                        phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
+                        shifts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The sample :func:`~bistair.core.measure.noise_level` takes its median of, in one
+    pass: on every fourth row ``y`` and column, the squared norm over the frames of the
+    difference between the fit residuals of pixel ``(y + 1, x)`` and pixel ``(y, x)``, and
+    whether neither pixel's frames reach 0 or full scale.
+
+    A residual is ``f - (avg + mod * cos(phi + shift))`` in float32 (the cosine as the C
+    library's ``cosf``), ``f`` a frame value times ``scale``.
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The capture stack, any numeric dtype.
+    start, steps : int
+        The set's first frame and its frame count ``N``.
+    scale : float
+        Factor that turns a raw value into a fraction of full scale.
+    phi, avg, mod : (H, W) float32 arrays
+        The set's fitted phase, average and modulation.
+    shifts : (N,) float32 array
+        The frames' phase shifts (:func:`~bistair.core.phase.shifts_of`).
+
+    Returns
+    -------
+    energy : (rows, cols) float32 array
+        The squared norms, ``rows`` the pairs of rows ``(4i, 4i + 1)`` in the image.
+    ok : (rows, cols) bool array
+        Neither pixel clipped or black in any frame.
+
+    Examples
+    --------
+    >>> raw = np.full((4, 6, 5), 0.5, np.float32)
+    >>> raw[2, 1, 0] = 0.6  # one frame of the pixel below (0, 0) off its fit
+    >>> flat = np.zeros((6, 5), np.float32)
+    >>> energy, ok = fit_residual_energy(raw, 0, 4, 1.0, flat, flat + 0.5, flat,
+    ...                                  np.zeros(4, np.float32))
+    >>> energy.shape, round(float(energy[0, 0]), 4), bool(ok.all())
+    ((2, 2), 0.01, True)
+    """
+    return _fit_residual_energy(raw, int(start), int(steps), float(np.float32(scale)),
+                                *(np.ascontiguousarray(a, np.float32) for a in (phi, avg, mod)),
+                                np.asarray(shifts, np.float32))
+
+
+@kernel(parallel=True)
+def _fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
+                         phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
+                         shifts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    _, h, w = raw.shape
+    rows = min(len(range(0, h - 1, 4)), len(range(1, h, 4)))
+    cols = (w + 3) // 4
+    s32 = np.float32(scale)
+    zero = np.float32(0.0)
+    one = np.float32(1.0)
+    energy = np.empty((rows, cols), np.float32)
+    ok = np.empty((rows, cols), np.bool_)
+    for r in prange(rows):
+        y0 = 4 * r
+        y1 = y0 + 1
+        for c in range(cols):
+            x = 4 * c
+            e = zero
+            good = True
+            for n in range(steps):
+                f0 = np.float32(raw[start + n, y0, x]) * s32
+                f1 = np.float32(raw[start + n, y1, x]) * s32
+                fit0 = avg[y0, x] + mod[y0, x] * np.cos(phi[y0, x] + shifts[n])
+                fit1 = avg[y1, x] + mod[y1, x] * np.cos(phi[y1, x] + shifts[n])
+                d = (f1 - fit1) - (f0 - fit0)
+                e += d * d
+                good = good and zero < f0 < one and zero < f1 < one
+            energy[r, c] = e
+            ok[r, c] = good
+    return energy, ok
+
+
 @kernel(parallel=True)
 def _validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, white: np.ndarray,
               black: np.ndarray, contrast: bool, lowest: float, threshold: float

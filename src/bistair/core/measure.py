@@ -22,9 +22,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
-from .fused import nstep_sums, phase_noise, pixel_validity
+from .fused import fit_residual_energy, nstep_sums, phase_noise, pixel_validity
 from .kernels import keep_coherent
-from .phase import phase_of_sums, residuals, shifts_of
+from .phase import phase_of_sums, shifts_of
 from .regions import MIN_REGION, fringe_regions
 
 
@@ -98,19 +98,11 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
     steps = frames.shape[0]
     if steps <= 3:
         return _along_fringe_noise(frames)
-    top = (slice(None), slice(0, -1, 4), slice(None, None, 4))  # plenty for a median
-    low = (slice(None), slice(1, None, 4), slice(None, None, 4))
-    h = frames.shape[1]
-    n_rows = min(len(range(h)[top[1]]), len(range(h)[low[1]]))  # (without reading frames)
-    pair = []
-    for sub in (top, low):
-        f = frames[sub][:, :n_rows]
-        p, a, m = (v[sub[1:]][:n_rows] for v in (phi, avg, mod))
-        pair.append((residuals(f, p, a, m, shift_sign, phase_offset),
-                     (f.min(axis=0) > 0.0) & (f.max(axis=0) < 1.0)))
-    (r0, ok0), (r1, ok1) = pair
-    energy = ((r1 - r0) ** 2).sum(axis=0)
-    ok = ok0 & ok1
+    # every fourth row and column: plenty for a median
+    raw, scale = ((frames.raw, frames.scale) if isinstance(frames, ScaledStack)
+                  else (np.asarray(frames, np.float32), 1.0))
+    energy, ok = fit_residual_energy(raw, 0, steps, scale, phi, avg, mod,
+                                     shifts_of(steps, shift_sign, phase_offset))
     sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
     dof = steps - 3
     return float(np.sqrt(np.median(sample) / (2.0 * _chi2_median(dof))))
