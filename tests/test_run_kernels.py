@@ -23,34 +23,27 @@ from bistair.codecs.bidirectional.bands import (
 )
 from bistair.codecs.bidirectional.evidence import BandLayout, region_evidence
 from bistair.core.phase import TWO_PI, wrap
-from bistair.core.region_kernels import group_percentiles
+from bistair.core.region_kernels import group_percentiles, region_quantile
 from bistair.core.stair import level_misfit, quantize
 from bistair.sim.warp import WarpScene, render_warp
 
 RNG = np.random.default_rng(5)
 
 
-def _region_percentile(region, values, q):
-    order = np.lexsort((values, region))
-    starts = np.flatnonzero(np.r_[True, region[order][1:] != region[order][:-1]])
-    counts = np.diff(np.r_[starts, region.size])
-    pick = values[order][starts + np.floor(q * (counts - 1)).astype(np.int64)]
-    return np.repeat(pick, counts)[np.argsort(order, kind="stable")]
-
-
 def _row_runs_before(prof, levels):
-    """``row_runs`` as NumPy computed it (profiles sorted by region, then row)."""
+    """``row_runs`` as NumPy computed it (profiles sorted by region, then row: the region
+    quantiles from ``region_quantile``, as it took them for sorted profiles)."""
     c, s, wsum = prof.cos, prof.sin, prof.weight
     region, row = prof.region, prof.row
     row_theta = np.arctan2(s, c)
-    core = prof.level >= 0.7 * _region_percentile(region, prof.level, 0.8)
+    core = prof.level >= 0.7 * region_quantile(region, prof.level, 0.8)
     levels = observed_levels(row_theta[core], wsum[core], levels)
     read = nearest_level(row_theta, levels)
     expected = group_percentiles(read[core], prof.level[core].astype(np.float64), levels.size,
                                  0.8)
     expected[np.bincount(read[core], minlength=levels.size) == 0] = 1.0
     level = prof.level / np.maximum(expected[read], 1e-6)
-    kept = level >= 0.7 * _region_percentile(region, level, 0.8)
+    kept = level >= 0.7 * region_quantile(region, level, 0.8)
     dropped_before = np.cumsum(~kept) - (~kept)
     idx = np.flatnonzero(kept)
     if idx.size == 0:

@@ -195,13 +195,9 @@ def band_runs(region: np.ndarray, row: np.ndarray, read: np.ndarray, kept: np.nd
     ([0, 3], [2, 5], [3.0, 3.0], [False, True], [True, False])
     """
     n = region.size
-    runs = 0
-    prev = -1
-    for i in range(n):  # count the runs
-        if kept[i]:
-            if prev < 0 or not _goes_on(region, row, prev, i) or read[i] != read[prev]:
-                runs += 1
-            prev = i
+    runs = 0  # at most one a kept entry: the arrays are cut to the runs found
+    for i in range(n):
+        runs += kept[i]
     reg = np.empty(runs, np.int64)
     y0 = np.empty(runs, np.int64)
     y1 = np.empty(runs, np.int64)
@@ -232,13 +228,15 @@ def band_runs(region: np.ndarray, row: np.ndarray, read: np.ndarray, kept: np.nd
         off[r] += _wrapped_abs(theta[i] - levels[read[i]]) / half_gap[read[i]] * weight[i]
         ww[r] += weight[i]
         prev = i
+    runs = r + 1
     misfit = np.empty(runs, np.float64)
     for r in range(runs):
         bottom_ok[r] = r + 1 < runs and top_ok[r + 1]
         half_bottom = half_top[r + 1] if bottom_ok[r] else 0.0
         length[r] = np.float64(y1[r] - y0[r] + 1) + half_top[r] + half_bottom
         misfit[r] = off[r] / (ww[r] if (ww[r] != ww[r] or ww[r] >= 1e-12) else 1e-12)
-    return reg, y0, y1, length, cw, sw, ww, misfit, uid, top_ok, bottom_ok
+    return (reg[:runs], y0[:runs], y1[:runs], length[:runs], cw[:runs], sw[:runs],
+            ww[:runs], misfit, uid[:runs], top_ok[:runs], bottom_ok[:runs])
 
 
 @_numba_inline
