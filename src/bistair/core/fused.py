@@ -92,7 +92,7 @@ def _atan2(y: np.float32, x: np.float32) -> np.float32:
 def arctan2_32(y: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``np.arctan2`` of float32 arrays, in one compiled pass on every core: the correctly
     rounded float32 arctangent (computed in float64 to 3e-14; it matched float64
-    ``arctan2`` rounded once on all of 4.4 million random pairs). NumPy's own float32
+    ``arctan2`` rounded once on all of 4 million random pairs). NumPy's own float32
     ``arctan2`` differs between machines (a vectorised one with AVX-512, a third of its
     values 1-3 units in the last place off; the C library's without, several times
     slower); this one does not.
