@@ -27,3 +27,5 @@ bench: $(STAMP)
 
 clean:
 	rm -rf $(VENV) demo-out .pytest_cache build src/*.egg-info
+	# numba's cache files are keyed by file and line: they pile up after code moves
+	find src tests -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete

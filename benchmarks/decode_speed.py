@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 import bistair
-from bistair.core.kernels import set_threads
+from bistair.core.jit import set_threads
 from bistair.core.memory import keep_freed_memory
 from bistair.sim.warp import Blob, WarpScene, render_warp
 

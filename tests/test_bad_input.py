@@ -19,7 +19,7 @@ from conftest import cli_run
 
 import bistair
 from bistair.app.jobs import save_patterns
-from bistair.io.files import write_image
+from bistair.io.atomic import write_image
 
 SIM = ["simulate", "--scene", "plane", "--method", "graycode", "--out", "{out}"]
 BIDI = ["patterns", "bidirectional", "--out", "{out}"]

@@ -24,7 +24,7 @@ from bistair.app.batch import MARKER, Options, SetJob, find_sets, run_set
 from bistair.app.simulate import simulate
 from bistair.errors import BistairError
 from bistair.geometry.calibration import Calibration, save_calibration
-from bistair.io.files import replace_folder
+from bistair.io.atomic import replace_folder
 from bistair.sim import preset
 
 CAMERA = (160, 128)

@@ -29,7 +29,7 @@ from bistair.geometry.calibration import (
     load_calibration,
     save_calibration,
 )
-from bistair.io.files import write_image
+from bistair.io.atomic import write_image
 from bistair.sim import Imaging, Rig, Scene, Sphere, expose, trace
 from bistair.sim.boards import POSES, synthetic_views, write_board_captures
 

@@ -199,7 +199,7 @@ def test_cli_takes_globs_files_and_folders(tmp_path, monkeypatch, capsys):
     pats = bistair.encode(spec)
     caps = tmp_path / "scan"
     caps.mkdir()
-    from bistair.io.files import write_image
+    from bistair.io.atomic import write_image
 
     for i, img in enumerate(pats):  # names that sort wrong as text: pat2 before pat10
         write_image(caps / f"pat{i * 5}.png", np.round(img * 255).astype(np.uint8))

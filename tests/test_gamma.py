@@ -11,7 +11,8 @@ from conftest import cli_run
 
 import bistair
 from bistair.core.phase import TWO_PI
-from bistair.io.files import read_captures, write_image
+from bistair.io.atomic import write_image
+from bistair.io.read import read_captures
 from bistair.sim import Imaging, expose, preset, trace
 
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from bistair.io.files import output_folder, remove_stale
+from bistair.io.atomic import output_folder, remove_stale
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 

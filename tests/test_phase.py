@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from bistair.core.phase import TWO_PI, phase_shift_patterns, residual_noise, wrapped_phase
+from bistair.core.phase import TWO_PI, phase_shift_patterns, residuals, wrapped_phase
 from bistair.core.regions import fill_orders, fringe_regions, region_links
 from bistair.core.stair import quantize, stair_level_phase, stair_pair, stair_phase
 
@@ -25,7 +25,7 @@ def test_noise_estimate_tracks_added_noise():
     x = np.tile(np.arange(400.0), (200, 1))
     frames = phase_shift_patterns(x, 30, 4) + rng.normal(0, 0.01, (4, 200, 400))
     phi, avg, mod = wrapped_phase(frames)
-    res = residual_noise(frames, phi, avg, mod)
+    res = np.sqrt((residuals(frames, phi, avg, mod) ** 2).sum(axis=0))  # N - 3 = 1 dof
     # One redundant sample of four: the residual's median is about 0.67 sigma.
     assert 0.005 < np.median(res) < 0.012
 

@@ -15,7 +15,7 @@ import pytest
 from conftest import CFPE, cli_run
 
 import bistair
-from bistair.io.files import read_captures
+from bistair.io.read import read_captures
 
 needs_cfpe = pytest.mark.skipif(not CFPE.is_dir(), reason="../shared/data/cfpe not present")
 
@@ -76,8 +76,8 @@ def test_kamino_decodes_straight_from_its_folder(tmp_path, monkeypatch, capsys):
     Agreement with the rig's own decoder (tests/kamino_reference.py) within 0.5 rad at T =
     100 px on >= 95% of the pixels both decode, and <= 3% of ours off their 5x5 median by
     more than a period (measured: 96.7% / 97.2% and 0.4% / 0.03% for x / y)."""
-    from kamino_reference import decode_kamino
     from numpy.lib.stride_tricks import sliding_window_view
+    from support.kamino_reference import decode_kamino
 
     code, out, err = cli_run(monkeypatch, capsys, "decode", KAMINO, "--spec", EXAMPLE,
                              "--out", tmp_path / "res", "--no-previews")

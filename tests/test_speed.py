@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from pre_speed import DATA, cases
+from support.pre_speed import DATA, cases
 
 from bistair import BistairError, decode
 from bistair.core.captures import prepare
@@ -47,7 +47,7 @@ def test_same_orders_and_phases_as_before(name, images, spec, options):
 
 def test_one_thread_gives_the_same_result():
     """The kernels split rows over threads; the result must not depend on how many."""
-    from bistair.core.kernels import set_threads
+    from bistair.core.jit import set_threads
 
     name, images, spec, options = next(c for c in CASES if c[2].method == "bidirectional")
     many = decode(images, spec, **options)

@@ -27,7 +27,7 @@ from .errors import BistairError
 if TYPE_CHECKING:
     from .codecs import decode, encode, get_codec, make_spec, methods, spec_from_dict
     from .core.result import DecodeResult
-    from .io.files import load_spec
+    from .io.read import load_spec
 
 __all__ = ["BistairError", "DecodeResult", "decode", "encode", "get_codec", "load_spec",
            "make_spec", "methods", "spec_from_dict"]
@@ -37,7 +37,7 @@ __version__ = "0.1.0"
 # ``bistair --version`` do not pay for SciPy and the codecs before they are needed
 _LAZY = {"decode": ".codecs", "encode": ".codecs", "get_codec": ".codecs",
          "make_spec": ".codecs", "methods": ".codecs", "spec_from_dict": ".codecs",
-         "DecodeResult": ".core.result", "load_spec": ".io.files"}
+         "DecodeResult": ".core.result", "load_spec": ".io.read"}
 
 
 def __getattr__(name: str) -> Any:

@@ -23,7 +23,7 @@ Examples
 >>> import tempfile, pathlib
 >>> from bistair.codecs import encode, make_spec
 >>> from bistair.core.captures import to_bit_depth
->>> from bistair.io.files import write_image
+>>> from bistair.io.atomic import write_image
 >>> spec = make_spec("graycode", width=120, height=32, period=30)
 >>> with tempfile.TemporaryDirectory() as tmp:
 ...     root = pathlib.Path(tmp) / "scans"
@@ -57,17 +57,9 @@ from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
 from ..geometry.calibration import load_calibration
 from ..geometry.triangulate import check_depth_range
-from ..io.files import (
-    IMAGE_SUFFIXES,
-    capture_files,
-    check_output,
-    default_spec_path,
-    load_spec,
-    natural_key,
-    output_file,
-    replace_folder,
-)
+from ..io.atomic import check_output, output_file, replace_folder
 from ..io.jsonfile import read_json, write_json
+from ..io.read import IMAGE_SUFFIXES, capture_files, default_spec_path, load_spec, natural_key
 from .engine import (
     BATCH_PREFIX,
     check_workers,

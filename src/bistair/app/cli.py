@@ -55,7 +55,7 @@ def _threads(func: Callable) -> Callable:
         if value is not None:
             import cv2
 
-            from ..core.kernels import set_threads
+            from ..core.jit import set_threads
 
             set_threads(value)
             cv2.setNumThreads(value)

@@ -19,7 +19,7 @@ from tqdm import tqdm
 from ..evaluation.benchmark import format_table, method_specs, run, table
 from ..evaluation.report import method_figure, write_report
 from ..evaluation.views import cloud_view
-from ..io.files import output_folder
+from ..io.atomic import output_folder
 from ..io.jsonfile import write_json
 from ..sim import Imaging, preset, trace
 

@@ -35,10 +35,10 @@ from typing import Any
 import dask
 from distributed import Client, LocalCluster, as_completed
 
-from ..core.kernels import set_threads
+from ..core.jit import set_threads
 from ..core.memory import keep_freed_memory
 from ..errors import BistairError
-from ..io.files import TEMP_PREFIX, remove_temporaries
+from ..io.atomic import TEMP_PREFIX, remove_temporaries
 
 BATCH_PREFIX = TEMP_PREFIX + "batch-"  # the temporaries of every batch run
 CONNECT_TIMEOUT = 20  # seconds to reach a scheduler

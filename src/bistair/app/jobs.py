@@ -37,21 +37,18 @@ from ..geometry.calibration import Calibration, load_calibration, save_calibrati
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
-from ..io.files import (
+from ..io.atomic import check_output, output_file, output_folder, write_image
+from ..io.jsonfile import read_json, write_json
+from ..io.previews import colorize
+from ..io.read import (
     Captures,
     capture_files,
-    check_output,
     find_spec,
     load_spec,
     natural_key,
-    output_file,
-    output_folder,
     read_captures,
     read_with_spec,
-    write_image,
 )
-from ..io.jsonfile import read_json, write_json
-from ..io.previews import colorize
 from ..io.writers import RESULT_FILES, write_depth, write_ply, write_result
 from ..spec import BaseSpec
 
@@ -119,7 +116,7 @@ def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Pa
                   previews: bool = True, progress: Say | None = None,
                   **options: Any) -> DecodeResult | AxesResult:
     """Decode captures (folders, files, glob patterns or a ``.npy`` stack; see
-    :func:`~bistair.io.files.capture_files`) and write the result into the folder ``out``.
+    :func:`~bistair.io.read.capture_files`) and write the result into the folder ``out``.
 
     ``spec`` defaults to ``spec.json`` in the captures' folder. A decode with no valid pixel
     is refused. ``progress`` is called with each stage's name as it starts.

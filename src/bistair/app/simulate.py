@@ -49,7 +49,7 @@ from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
 from ..geometry.board import Board
 from ..geometry.calibration import Calibration, save_calibration
-from ..io.files import output_file, output_folder, replace_folder, write_image
+from ..io.atomic import output_file, output_folder, replace_folder, write_image
 from ..io.jsonfile import write_json
 from ..sim import Imaging, Rig, Scene, Truth, expose, preset, scene_names, trace
 from ..sim.boards import write_board_captures

@@ -60,7 +60,6 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.fused_codes import code_bits, gray_orders
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, wrap
 from ..core.regions import core_weight, fringe_regions
@@ -68,6 +67,7 @@ from ..core.resolve import code_evidence, orders_from_regions
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
+from .graycode_jit import code_bits, gray_orders
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:

@@ -31,13 +31,12 @@ import numpy as np
 
 from ..core.captures import Prepared
 from ..core.checks import stair_misfit
-from ..core.fused import pair_phase
-from ..core.kernels import quantize32
 from ..core.measure import FringeSet
-from ..core.region_maps import row_bands
+from ..core.memory import row_bands
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..core.resolve import code_evidence, orders_from_regions
 from ..core.stair import stair_level_phase, stair_pair
+from ..core.stair_jit import pair_phase, quantize32
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns

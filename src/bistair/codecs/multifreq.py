@@ -38,12 +38,12 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.fused_codes import agreed_orders, unwrap_chain
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, order_from_reference
 from ..errors import BistairError
 from ..spec import BaseSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, shift_patterns
+from .multifreq_jit import agreed_orders, unwrap_chain
 
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:

@@ -38,13 +38,12 @@ import dataclasses
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.fused import pair_phase
-from ..core.kernels import quantize32
 from ..core.measure import FringeSet
 from ..core.phase import shifts_of, wrapped_phase
 from ..core.regions import core_weight, fringe_regions
 from ..core.resolve import code_evidence, orders_from_regions
 from ..core.stair import stair_level_phase, stair_pair
+from ..core.stair_jit import pair_phase, quantize32
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns

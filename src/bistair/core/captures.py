@@ -1,5 +1,6 @@
-"""Captured stacks: checks, scaling to float32 full scale, bit depths, saturation and
-validity masks.
+"""Captured stacks: checks, scaling to float32 full scale, bit depths, the modulation
+threshold and the decodable check (the validity mask itself comes from
+:func:`bistair.core.measure_jit.pixel_validity`).
 
 Every codec calls :func:`prepare` first, so frame count, sizes, dark and saturated captures
 are refused the same way whatever the method.
@@ -187,32 +188,6 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
     return Prepared(used, clipped, scale, *extra)
 
 
-def saturation(clipped: np.ndarray, avg: np.ndarray, mod: np.ndarray) -> np.ndarray:
-    """Pixels clipped by the camera: a frame at full scale where the fitted sinusoid's peak
-    ``A + B`` exceeds it. An exact capture of a full-range pattern touches full scale with a
-    peak of exactly 1 and is not saturated.
-
-    Parameters
-    ----------
-    clipped : (H, W) bool array
-        Pixels where some frame reaches full scale (:attr:`Prepared.clipped`).
-    avg, mod : (H, W) array
-        Fitted average ``A`` and modulation ``B`` (fractions of full scale).
-
-    Returns
-    -------
-    (H, W) bool array
-        ``clipped & (A + B > 1.02)``.
-
-    Examples
-    --------
-    >>> saturation(np.array([True, True, False]), np.array([0.5, 0.6, 0.6]),
-    ...            np.array([0.5, 0.5, 0.5])).tolist()
-    [False, True, False]
-    """
-    return clipped & (avg + mod > 1.02)
-
-
 def modulation_threshold(noise: float, min_modulation: float | None = None) -> float:
     """The modulation a valid pixel needs (fraction of full scale): ``min_modulation`` if
     given (checked by :func:`check_min_modulation`), else ``max(0.01, 4 * noise)`` (pure
@@ -277,31 +252,6 @@ def check_min_modulation(min_modulation: float | None) -> None:
     if not (ok and 0.0 < min_modulation < 1.0):
         raise BistairError(f"the minimum modulation must lie between 0 and 1 (a fraction of full "
                            f"scale), got {min_modulation}")
-
-
-def validity(mod: np.ndarray, saturated: np.ndarray, threshold: float) -> np.ndarray:
-    """Pixels with at least ``threshold`` modulation and no saturation.
-
-    Parameters
-    ----------
-    mod : (H, W) array
-        Modulation ``B`` (fraction of full scale).
-    saturated : (H, W) bool array
-        Saturated pixels (:func:`saturation`).
-    threshold : float
-        The modulation a valid pixel needs (:func:`modulation_threshold`).
-
-    Returns
-    -------
-    (H, W) bool array
-        ``(mod >= threshold) & ~saturated``.
-
-    Examples
-    --------
-    >>> validity(np.array([0.005, 0.2, 0.3]), np.array([False, False, True]), 0.01).tolist()
-    [False, True, False]
-    """
-    return (mod >= threshold) & ~saturated
 
 
 def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: float | None = None,

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .fused_checks import code_steps, wrap_step_counts
+from .checks_jit import code_steps, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 
 MIN_EDGES = 50  # code steps needed before the check says anything

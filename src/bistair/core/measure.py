@@ -20,11 +20,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import special
 
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
-from .fused import fit_residual_energy, nstep_sums, phase_noise, pixel_validity
-from .kernels import keep_coherent
+from .measure_jit import fit_residual_energy, keep_coherent, phase_noise, pixel_validity
 from .phase import phase_of_sums, shifts_of
+from .phase_jit import nstep_sums
 from .regions import MIN_REGION, fringe_regions
 
 
@@ -43,7 +44,7 @@ class FringeSet:
     @property
     def phase_noise(self) -> np.ndarray:
         """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``
-        (float32, :func:`~bistair.core.fused.phase_noise`; computed when asked for, not
+        (float32, :func:`~bistair.core.measure_jit.phase_noise`; computed when asked for, not
         kept: a map of 4 bytes a pixel that most stages need only for a moment)."""
         return phase_noise(self.mod, self.noise, 4 if self.steps is None else self.steps)
 
@@ -270,6 +271,4 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
 def _chi2_median(dof: int) -> float:
     """The median of a chi-squared distribution of ``dof`` degrees of freedom (scipy.stats'
     ``chi2.ppf(0.5, dof)`` without importing scipy.stats, half a second at start-up)."""
-    from scipy import special  # imported when first needed: keeps the CLI's start-up short
-
     return float(2.0 * special.gammaincinv(dof / 2.0, 0.5))

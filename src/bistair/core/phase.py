@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .fused import arctan2_32, finish_phase, wrap_angles
+from .phase_jit import arctan2_32, finish_phase, wrap_angles
 
 TWO_PI = 2.0 * np.pi
 
@@ -144,7 +144,7 @@ def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: fl
                   ) -> tuple[np.ndarray, np.ndarray]:
     """The wrapped phase in ``[0, 2*pi)`` and the modulation of an N-step set from its sums
     ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32; the arctangent
-    correctly rounded, :func:`~bistair.core.fused.arctan2_32`).
+    correctly rounded, :func:`~bistair.core.phase_jit.arctan2_32`).
 
     Parameters
     ----------
@@ -208,39 +208,6 @@ def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndar
     shifts = shifts_of(steps, shift_sign, phase_offset).astype(np.float32)
     shifts = shifts.reshape((steps,) + (1,) * (stack.ndim - 1))
     return stack - (avg[None] + mod[None] * np.cos(phi[None] + shifts))
-
-
-def residual_noise(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
-                   shift_sign: int = 1, phase_offset: float = 0.0) -> np.ndarray:
-    """Per-pixel RMS residual of the sinusoid fit (zero for N = 3, which has no redundancy).
-
-    The squared residuals are summed over the frames and divided by the ``N - 3`` degrees of
-    freedom the fit leaves (1 for N = 3).
-
-    Parameters
-    ----------
-    frames : (N, ...) array
-        The N-step stack, any dtype.
-    phi, avg, mod : ndarray
-        The fitted wrapped phase (radians), average and modulation (:func:`wrapped_phase`).
-    shift_sign, phase_offset : int, float
-        The rig's phase convention (see the module docstring).
-
-    Returns
-    -------
-    ndarray
-        Float32 RMS residual per pixel, in the frames' units, shape (...).
-
-    Examples
-    --------
-    >>> frames = phase_shift_patterns(np.arange(3.0), period=12, steps=5)
-    >>> frames[0] += 0.01  # one frame off the sinusoid
-    >>> residual_noise(frames, *wrapped_phase(frames)).astype(float).round(4).tolist()
-    [0.0045, 0.0045, 0.0045]
-    """
-    dof = max(np.shape(frames)[0] - 3, 1)
-    res = residuals(frames, phi, avg, mod, shift_sign, phase_offset)
-    return np.sqrt((res**2).sum(axis=0) / dof).astype(np.float32)
 
 
 def wrap(angle: np.ndarray) -> np.ndarray:

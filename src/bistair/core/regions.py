@@ -25,9 +25,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .kernels import fringe_links, period_jump_links, reattach, wrap_links
 from .phase import TWO_PI, order_from_reference
-from .region_kernels import drop_small
+from .regions_jit import drop_small, fringe_links, period_jump_links, reattach, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -78,8 +77,9 @@ def _backward_runs(raw: np.ndarray, ok: np.ndarray, sigma: np.ndarray) -> np.nda
 
 def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
                  relative: float = 0.3, half: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """Links across which the fringes' spacing or slant jumps: (vertical links (H-1, W),
-    horizontal links (H, W-1)) to cut.
+    """NumPy reference of :func:`~bistair.core.regions_jit.period_jump_links`, which a decode
+    runs: the links across which the fringes' spacing or slant jumps (vertical links
+    (H-1, W), horizontal links (H, W-1)) to cut.
 
     Where one surface hides another the wrapped phase may happen to run on across the edge,
     but its gradient (the fringe period and slant in the image) jumps. Both gradient
@@ -89,7 +89,7 @@ def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
     times their noise (``sigma``: per-pixel phase noise, radians). Only links between two
     valid pixels are cut (no other link joins a region).
 
-    The NumPy formulation of :func:`~bistair.core.kernels.period_jump_links`.
+    The NumPy formulation of :func:`~bistair.core.regions_jit.period_jump_links`.
 
     Parameters
     ----------

@@ -23,16 +23,23 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from .label_rows import label_code_votes
-from .region_kernels import pass_messages
-from .region_maps import dense_tile, label_orders, pixel_orders, window_seeds
 from .regions import RegionLinks, fill_orders, fringe_direction, region_links
+from .resolve_jit import (
+    dense_tile,
+    label_code_votes,
+    label_orders,
+    pass_messages,
+    pixel_orders,
+    window_seeds,
+)
 from .split import adopt_demanded, contradicted_regions, split_contradicted
 
 
 def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
                   weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """Most frequent value (0..n_values-1) per label 1..n_labels; label 0 and values < 0 ignored.
+    """NumPy reference of :func:`~bistair.codecs.bidirectional.paper_jit.run_label_modes`,
+    which a decode runs: the most frequent value (0..n_values-1) per label 1..n_labels; label
+    0 and values < 0 ignored.
 
     Returns ``(mode, support)`` indexed by label (index 0 unused, mode -1 where no vote).
 

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from .fused_checks import assemble
 from .measure import FringeSet
+from .result_jit import assemble
 
 # the arrays a decode writes as NAME.npy (DecodeResult.arrays)
 ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")

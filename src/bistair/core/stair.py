@@ -21,8 +21,8 @@ import math
 
 import numpy as np
 
-from .fused import arctan2_32
 from .phase import TWO_PI
+from .phase_jit import arctan2_32
 
 
 def stair_level_phase(level: np.ndarray | int, levels: int) -> np.ndarray | float:
@@ -85,7 +85,8 @@ def stair_pair(theta: np.ndarray, offset: float = 0.5, amplitude: float = 0.5) -
 
 def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
                 avg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Decoded stair phase in ``[-pi, pi)`` and its modulation (Eq. 19).
+    """NumPy reference of :func:`~bistair.core.stair_jit.pair_phase`, which a decode runs:
+    the decoded stair phase in ``[-pi, pi)`` and its modulation (Eq. 19).
 
     ``avg`` is the average intensity of the fringe frames (Eq. 9).
 
@@ -100,7 +101,7 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     Returns
     -------
     theta : ndarray
-        Float32 stair phase in radians (:func:`~bistair.core.fused.arctan2_32` of the frames
+        Float32 stair phase in radians (:func:`~bistair.core.phase_jit.arctan2_32` of the frames
         minus ``avg``).
     modulation : ndarray
         Float32 length of that (cos, sin) vector, same shape.
@@ -150,8 +151,9 @@ def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
 
 
 def level_misfit(theta: float, level: int, levels: int) -> float:
-    """Squared distance of a phase from a stair level, in half steps: 0 on the level, 1 at
-    the border of its quantisation bin.
+    """NumPy reference of the band evidence's compiled ``_level_misfit``, which a decode runs:
+    the squared distance of a phase from a stair level, in half steps (0 on the level, 1 at
+    the border of its quantisation bin).
 
     Parameters
     ----------

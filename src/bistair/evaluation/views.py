@@ -22,7 +22,7 @@ from scipy.spatial import cKDTree
 
 from ..geometry.calibration import Calibration
 from ..geometry.triangulate import reconstruct
-from ..io.files import output_file
+from ..io.atomic import output_file
 
 
 def render_cloud(points: np.ndarray, colors: np.ndarray | None = None,

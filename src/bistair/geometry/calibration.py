@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import BistairError
-from ..io.files import output_file
+from ..io.atomic import output_file
 from ..io.jsonfile import read_json
 
 FORMAT, VERSION = "bistair-calibration", 1
@@ -264,7 +264,7 @@ def save_calibration(calibration: Calibration, path: str | Path) -> Path:
 
     The file has the layout of the module docstring (2-space indent, final newline); it is
     written to a temporary file beside ``path`` and renamed onto it
-    (:func:`~bistair.io.files.output_file`), so a reader never sees half a file.
+    (:func:`~bistair.io.atomic.output_file`), so a reader never sees half a file.
 
     Parameters
     ----------
@@ -281,7 +281,7 @@ def save_calibration(calibration: Calibration, path: str | Path) -> Path:
     Raises
     ------
     BistairError
-        Raised by :func:`~bistair.io.files.output_file` if the file cannot be written.
+        Raised by :func:`~bistair.io.atomic.output_file` if the file cannot be written.
 
     Examples
     --------

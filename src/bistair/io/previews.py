@@ -118,7 +118,7 @@ def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -
     returns their paths.
 
     The files are written in place (not atomically; see
-    :func:`bistair.io.files.output_folder`) and replace files of the same names.
+    :func:`bistair.io.atomic.output_folder`) and replace files of the same names.
 
     Parameters
     ----------

@@ -1,7 +1,7 @@
 """Writers of results: decode arrays and their previews, point clouds (PLY) and depth maps.
 
 Each writes into a folder (or file) the caller made atomic with
-:func:`bistair.io.files.output_folder` / :func:`~bistair.io.files.output_file`.
+:func:`bistair.io.atomic.output_folder` / :func:`~bistair.io.atomic.output_file`.
 
 Examples
 --------
@@ -24,7 +24,7 @@ import numpy as np
 from plyfile import PlyData, PlyElement
 
 from ..core.result import ARRAY_NAMES, AxesResult, DecodeResult
-from .files import output_file
+from .atomic import output_file
 from .jsonfile import write_json
 from .previews import PREVIEW_NAMES, colorize, write_previews
 
@@ -44,7 +44,7 @@ def write_result(result: DecodeResult | AxesResult, folder: str | Path,
     where both are valid.
 
     The files are written in place, replacing files of the same names; make the folder
-    with :func:`bistair.io.files.output_folder` for an atomic result.
+    with :func:`bistair.io.atomic.output_folder` for an atomic result.
 
     Parameters
     ----------
@@ -87,7 +87,7 @@ def write_ply(path: str | Path, points: np.ndarray, colors: np.ndarray | None = 
     green blue`` uchar) atomically; readable by Open3D, MeshLab and plyfile.
 
     The file is written to a temporary file beside ``path`` and renamed onto it
-    (:func:`~bistair.io.files.output_file`); its header comment says the points are in the
+    (:func:`~bistair.io.atomic.output_file`); its header comment says the points are in the
     camera frame, in millimetres. Points are written as given: drop invalid (NaN) points
     first (e.g. :meth:`Reconstruction.cloud
     <bistair.geometry.triangulate.Reconstruction.cloud>`).
@@ -109,7 +109,7 @@ def write_ply(path: str | Path, points: np.ndarray, colors: np.ndarray | None = 
     Raises
     ------
     BistairError
-        Raised by :func:`~bistair.io.files.output_file` if the file cannot be written.
+        Raised by :func:`~bistair.io.atomic.output_file` if the file cannot be written.
 
     Examples
     --------
@@ -144,7 +144,7 @@ def write_depth(depth: np.ndarray, folder: str | Path) -> None:
 
     The preview maps the 1st to 99th percentile of the valid depths to the reversed turbo
     colormap (near red, far blue), invalid pixels black. Both files are written in place
-    (make the folder with :func:`bistair.io.files.output_folder` for atomic output).
+    (make the folder with :func:`bistair.io.atomic.output_folder` for atomic output).
 
     Parameters
     ----------

@@ -24,7 +24,7 @@ from ..codecs import encode
 from ..errors import BistairError
 from ..geometry.board import Board
 from ..geometry.calibration import Calibration
-from ..io.files import output_folder, write_image
+from ..io.atomic import output_folder, write_image
 from ..spec import BaseSpec
 from .render import Imaging, expose, trace
 from .rig import Rig, euler

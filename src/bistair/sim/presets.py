@@ -35,6 +35,7 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+import trimesh
 
 from ..codecs import make_spec
 from ..spec import BaseSpec
@@ -77,8 +78,6 @@ def _mask_prism() -> Scene:
 
 
 def _bust():
-    import trimesh
-
     head = trimesh.creation.icosphere(subdivisions=4, radius=36)
     head.apply_scale((0.85, 1.0, 0.92))
     head.apply_translation((0, -62, 0))
@@ -92,8 +91,6 @@ def _bust():
 
 
 def _vase():
-    import trimesh
-
     z = np.linspace(0, 165, 60)
     r = 26 + 16 * np.sin(np.pi * z / 165 * 1.25) ** 2 - 10 * (z / 165) ** 3
     profile = np.vstack([[0, 0], np.column_stack([r, z]), [0, 165]])
@@ -141,8 +138,6 @@ def _mugs_on_wall() -> Scene:
 
 
 def _mug():
-    import trimesh
-
     body = trimesh.creation.cylinder(radius=42, height=105, sections=96)
     body.apply_transform(_pose(euler(x=90), (0, 0, 0)))  # axis along y, upright
     handle = trimesh.creation.torus(major_radius=24, minor_radius=7, major_sections=48,

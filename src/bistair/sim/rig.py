@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+import cv2
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -173,8 +174,6 @@ class Pinhole:
     @property
     def rvec(self) -> np.ndarray:
         """The rotation as an OpenCV rotation vector (``cv2.Rodrigues``)."""
-        import cv2
-
         return cv2.Rodrigues(self.R)[0].ravel()
 
     @property

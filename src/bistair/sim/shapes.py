@@ -25,6 +25,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import trimesh
 from numpy.typing import ArrayLike
 
 from .raycast import Triangles, barycentric
@@ -317,8 +318,6 @@ class Mesh(_Triangles):
     scale: float = 1.0
 
     def __post_init__(self) -> None:
-        import trimesh
-
         mesh = self.mesh
         if isinstance(mesh, str | Path):
             mesh = trimesh.load(mesh, force="mesh")
@@ -354,8 +353,6 @@ class MaskRelief(_Triangles):
     sectors: int = 160
 
     def __post_init__(self) -> None:
-        import trimesh
-
         rho = np.sin(0.5 * np.pi * np.arange(1, self.rings + 1) / self.rings)
         ang = 2 * np.pi * np.arange(self.sectors) / self.sectors
         x = np.concatenate([[0.0], (rho[:, None] * np.cos(ang)).ravel()]) * self.width / 2

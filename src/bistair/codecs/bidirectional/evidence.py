@@ -10,9 +10,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ...core.region_kernels import value_changes
-from ...core.run_kernels import band_evidence
-from .bands import RowProfiles, Runs, union_levels
+from .bands import Runs, union_levels
+from .evidence_jit import band_evidence, value_changes
+from .profiles import RowProfiles
 
 
 def band_splits(runs: Runs, heights: np.ndarray, local_share: float
@@ -51,8 +51,9 @@ def band_splits(runs: Runs, heights: np.ndarray, local_share: float
 
     Examples
     --------
-    >>> from bistair.codecs.bidirectional.bands import (row_profiles, row_runs,
-    ...     profile_centroids, stair_values, union_levels)
+    >>> from bistair.codecs.bidirectional.bands import row_runs, union_levels
+    >>> from bistair.codecs.bidirectional.profiles import (profile_centroids, row_profiles,
+    ...     stair_values)
     >>> from bistair.core.stair import stair_level_phase
 
     One region of 64 rows: order 5 above row 32, order 10 below it.
@@ -140,8 +141,9 @@ def split_profiles(prof: RowProfiles, n_regions: int,
 
     Examples
     --------
-    >>> from bistair.codecs.bidirectional.bands import (row_profiles, row_runs,
-    ...     profile_centroids, stair_values, union_levels)
+    >>> from bistair.codecs.bidirectional.bands import row_runs, union_levels
+    >>> from bistair.codecs.bidirectional.profiles import (profile_centroids, row_profiles,
+    ...     stair_values)
     >>> from bistair.core.stair import stair_level_phase
     >>> labels = np.ones((6, 2), np.int32)
     >>> values = stair_values(np.zeros((6, 2), np.float32), np.ones((6, 2)), np.ones((6, 2)))
@@ -255,8 +257,9 @@ def group_heights(runs: Runs, n_regions: int, centroids: np.ndarray) -> np.ndarr
 
     Examples
     --------
-    >>> from bistair.codecs.bidirectional.bands import (row_profiles, row_runs,
-    ...     profile_centroids, stair_values, union_levels)
+    >>> from bistair.codecs.bidirectional.bands import row_runs, union_levels
+    >>> from bistair.codecs.bidirectional.profiles import (profile_centroids, row_profiles,
+    ...     stair_values)
     >>> from bistair.core.stair import stair_level_phase
 
     A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code
@@ -358,8 +361,9 @@ def region_evidence(runs: Runs, n_regions: int, heights: np.ndarray,
 
     Examples
     --------
-    >>> from bistair.codecs.bidirectional.bands import (row_profiles, row_runs,
-    ...     profile_centroids, stair_values, union_levels)
+    >>> from bistair.codecs.bidirectional.bands import row_runs, union_levels
+    >>> from bistair.codecs.bidirectional.profiles import (profile_centroids, row_profiles,
+    ...     stair_values)
     >>> from bistair.core.stair import stair_level_phase
 
     A 48 x 16 image of two fringe regions (orders 5 and 6, eight columns each) of a code

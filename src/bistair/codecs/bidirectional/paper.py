@@ -12,10 +12,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ...core.measure import FringeSet
-from ...core.paper_kernels import column_median, column_runs, paint_labels, run_label_modes
 from ...core.regions import fringe_regions
 from ...core.stair import quantize
 from .bands import nearest_level, union_levels
+from .paper_jit import column_median, column_runs, paint_labels, run_label_modes
 
 if TYPE_CHECKING:
     from . import BidirectionalSpec

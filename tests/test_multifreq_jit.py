@@ -1,6 +1,6 @@
-"""The multi-frequency decoder's compiled passes (fused_codes.unwrap_chain and
-agreed_orders) give exactly what the NumPy they replaced gave, on random phases with NaN,
-tiny images, single rows and columns, and with one thread or all."""
+"""The multi-frequency decoder's compiled passes (bistair.codecs.multifreq_jit: unwrap_chain
+and agreed_orders) give exactly what the NumPy they replaced gave, on random phases with
+NaN, tiny images, single rows and columns, and with one thread or all."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import warnings
 import numpy as np
 import pytest
 
-from bistair.core.fused_codes import agreed_orders, unwrap_chain
-from bistair.core.kernels import set_threads
+from bistair.codecs.multifreq_jit import agreed_orders, unwrap_chain
+from bistair.core.jit import set_threads
 from bistair.core.phase import TWO_PI
 
 RNG = np.random.default_rng(11)

@@ -1,13 +1,19 @@
-"""Compiled loops of the band analysis: the row profiles of fringe regions read as stair
-levels and cut into runs of one level (the passes of
-:func:`bistair.codecs.bidirectional.bands.row_runs`).
+"""Compiled passes of the band analysis (:mod:`.bands`): the row profiles of fringe regions
+read as stair levels and cut into runs of one level (the passes of
+:func:`bistair.codecs.bidirectional.bands.row_runs`), and the per-region order statistics
+they use.
 
-Like :mod:`bistair.core.region_kernels` (same decorator, same helpers): each gives exactly
-what the NumPy it replaces gave, float64 sums in the same order. The arctangents stay with
-the caller: NumPy's vectorised ``arctan2`` and the C library's differ in the last bit.
+Each gives exactly what the NumPy it replaces gave, float64 sums in the same order. The
+arctangents stay with the caller: NumPy's vectorised ``arctan2`` and the C library's differ
+in the last bit. The profile entries come sorted by region, then row (as
+:class:`~bistair.codecs.bidirectional.profiles.RowProfiles` keeps them).
 
-The profile entries come sorted by region, then row (as
-:class:`~bistair.codecs.bidirectional.bands.RowProfiles` keeps them).
+Examples
+--------
+>>> import numpy as np
+>>> region = np.array([1, 1, 1, 2, 2])
+>>> region_quantile(region, np.array([3.0, 1.0, 2.0, 5.0, 4.0]), 0.8).tolist()
+[2.0, 2.0, 2.0, 4.0, 4.0]
 """
 
 from __future__ import annotations
@@ -16,10 +22,10 @@ import math
 
 import numpy as np
 
-from .kernels import _numba_inline, kernel
-from .region_kernels import _group_percentiles, _nearest_level, _region_quantile, _wrapped_abs
+from ...core.jit import _numba_called, _numba_inline, kernel
 
-prange = range  # numba's once the first kernel compiles (the helpers above compiled with it)
+prange = range  # numba's prange once the first kernel of this module compiles
+TWO_PI = 2.0 * math.pi
 
 
 @kernel()
@@ -247,193 +253,183 @@ def _goes_on(region: np.ndarray, row: np.ndarray, prev: int, i: int) -> bool:
     return region[i] == region[prev] and gap == i - prev - 1 and gap <= 3
 
 
+@_numba_inline
+def _wrapped_abs(x: float) -> float:
+    """``abs((x + pi) % 2pi - pi)`` in float64, as NumPy computes it."""
+    a = x + math.pi
+    if 0.0 <= a < TWO_PI:
+        m = a
+    elif TWO_PI <= a < 2.0 * TWO_PI:
+        m = a - TWO_PI  # exact, as fmod
+    elif -TWO_PI < a < 0.0:
+        m = a + TWO_PI  # fmod leaves a; Python's modulo then adds the divisor
+    else:
+        m = a % TWO_PI  # Python's float modulo, as NumPy's
+    return abs(m - math.pi)
+
+
 @kernel()
-def band_evidence(region: np.ndarray, uid: np.ndarray, weight: np.ndarray,
-                  length: np.ndarray, misfit: np.ndarray, complete: np.ndarray,
-                  heights: np.ndarray, levels: np.ndarray, stairs: int, partitions: int,
-                  local_share: float, default_height: float, n_regions: int) -> np.ndarray:
-    """The order evidence of every region from its band runs (the loop of
-    :func:`bistair.codecs.bidirectional.evidence.region_evidence`, whose docstring says
-    what it weighs).
+def nearest_levels(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
+    """Index of the level nearest each phase on the circle: ``argmin |wrap(theta - level)|``
+    (the first of equally near levels, as ``numpy.argmin``).
+
+    Parameters
+    ----------
+    theta : (n,) float64 array
+        Phases in radians.
+    levels : (L,) float64 array
+        Level phases in radians.
+
+    Returns
+    -------
+    (n,) int32 array
+        Indices into ``levels``.
+
+    Examples
+    --------
+    >>> levels = np.array([-2.0, 0.0, 2.0])
+    >>> nearest_levels(np.array([0.9, 1.0, 3.1, -3.1]), levels).tolist()
+    [1, 1, 2, 0]
+    """
+    out = np.zeros(theta.size, np.int32)
+    for i in range(theta.size):
+        out[i] = _nearest_level(theta[i], levels)
+    return out
+
+
+@_numba_inline
+def _nearest_level(t: float, levels: np.ndarray) -> int:
+    """One phase's :func:`nearest_levels`."""
+    best = 0
+    low = _wrapped_abs(t - levels[0])
+    if low != low:
+        return 0
+    for j in range(1, levels.size):
+        d = _wrapped_abs(t - levels[j])
+        if d != d:  # NaN: numpy.argmin returns the first one
+            return j
+        if d < low:
+            low = d
+            best = j
+    return best
+
+
+@kernel()
+def region_quantile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndarray:
+    """Per entry, the ``floor(q * (count - 1))``-th smallest of the values of its region;
+    ``region`` must be non-decreasing (each region's entries contiguous).
 
     Parameters
     ----------
     region : (n,) int array
-        The runs' regions, non-decreasing.
-    uid : (n,) int array
-        The runs' levels (indices into ``levels``).
-    weight, length, misfit : (n,) float64 arrays
-        The runs' weight, length in rows and level misfit.
-    complete : (n,) bool array
-        Runs bounded by other runs above and below.
-    heights : (n_regions + 1,) float64 array
-        Group height per region, camera rows (NaN: ``default_height``).
-    levels : (L,) float64 array
-        Nominal phases of the union levels, radians.
-    stairs, partitions : int
-        ``S`` and ``P``.
-    local_share : float
-        Local rows over group rows.
-    default_height : float
-        Group height where a region has none.
-    n_regions : int
-        The highest region label.
+        Region of each entry, non-decreasing.
+    values : (n,) float64 array
+        The values.
+    q : float
+        Quantile in [0, 1].
 
     Returns
     -------
-    (n_regions + 1, S*P) float64 array
-        Evidence per region and order (zero for regions without runs or whose rows read
-        between levels).
+    (n,) float64 array
+        The chosen order statistic of each entry's region (NaNs sort last).
 
     Examples
     --------
-    One region of order 5 with ``S = 4``, ``P = 3``: its bands read local level 1 (10 rows
-    of a 16-row group) and partition level 1 (6 rows), alternately:
-
-    >>> from bistair.codecs.bidirectional.bands import nearest_level, union_levels
-    >>> from bistair.core.stair import stair_level_phase
-    >>> levels = union_levels(3, 4)
-    >>> uid = nearest_level(np.array([stair_level_phase(1, 4), stair_level_phase(1, 3)]),
-    ...                     levels)[[0, 1, 0, 1]].astype(np.int64)
-    >>> ev = band_evidence(np.ones(4, np.int64), uid, np.full(4, 10.0),
-    ...                    np.array([10.0, 6, 10, 6]), np.zeros(4),
-    ...                    np.array([False, True, True, False]), np.array([np.nan, 16.0]),
-    ...                    levels, 4, 3, 10 / 16, 16.0, 1)
-    >>> ev.shape, int(ev[1].argmax()), float(ev[1].max())
-    ((2, 12), 5, 1.0)
+    >>> region_quantile(np.array([0, 0, 3]), np.array([2.0, 1.0, 7.0]), 0.5).tolist()
+    [1.0, 1.0, 7.0]
     """
-    S, P = stairs, partitions
-    ev = np.zeros((n_regions + 1, S * P), np.float64)
-    f_loc, f_par = local_share, 1.0 - local_share
-    cls_w = np.zeros(levels.size, np.float64)
-    cls_long = np.zeros(levels.size, np.float64)  # the longest run of each level
+    out = np.empty(region.size, np.float64)
+    _region_quantile(region, values, q, out)
+    return out
+
+
+@_numba_called
+def _region_quantile(region: np.ndarray, values: np.ndarray, q: float, out: np.ndarray
+                     ) -> None:
+    """:func:`region_quantile` into ``out``."""
     n = region.size
-    lo = 0
-    while lo < n:
-        hi = lo + 1
-        while hi < n and region[hi] == region[lo]:
-            hi += 1
-        r = region[lo]
-        h = heights[r] if np.isfinite(heights[r]) else default_height
-        total = 0.0
-        rows = 0.0
-        off = 0.0
-        longest = -np.inf
-        for i in range(lo, hi):
-            total += weight[i]
-            rows += length[i]
-            off += misfit[i] * weight[i]
-            longest = max(longest, length[i])
-        row_weight = total / max(rows, 1.0)
-        if off > 0.32 * total:  # rows read between levels: blurred together, no order
-            lo = hi
-            continue
-        for i in range(lo, hi):
-            cls_w[uid[i]] = 0.0
-            cls_long[uid[i]] = -np.inf
-        for i in range(lo, hi):
-            cls_w[uid[i]] += weight[i]
-            cls_long[uid[i]] = max(cls_long[uid[i]], length[i])
-        x, y = _two_heaviest(uid, lo, hi, cls_w)
-        if y >= 0 and (cls_w[y] < 0.05 * total or cls_long[y] < 2):
-            y = -1
-        th_x = levels[x]
-        if y < 0:
-            a, b = _quantize(th_x, S), _quantize(th_x, P)
-            if longest >= 1.3 * max(f_loc, f_par) * h:
-                fit = _level_misfit(th_x, a, S) + _level_misfit(th_x, b, P)
-                ev[r, a + S * b] = cls_w[x] / total - 0.5 * fit
-            else:
-                share = 0.4 * cls_w[x] / total
-                for k in range(S * P):
-                    if k % S == a or k // S == b:
-                        ev[r, k] = share
-            lo = hi
-            continue
-        th_y = levels[y]
-        cost_xy = _length_cost(uid, length, complete, lo, hi, x, y, f_loc * h, f_par * h)
-        cost_yx = _length_cost(uid, length, complete, lo, hi, y, x, f_loc * h, f_par * h)
-        low = min(cost_xy, cost_yx)
-        pen_xy = 0.5 * min(1.0, cost_xy - low)
-        pen_yx = 0.5 * min(1.0, cost_yx - low)
-        # a class seen in 3 or more rows' worth of pixels is certain
-        e_x = _minimum(1.0, cls_w[x] / (3.0 * row_weight))
-        e_y = _minimum(1.0, cls_w[y] / (3.0 * row_weight))
-        ax, bx, ay, by = _quantize(th_x, S), _quantize(th_x, P), _quantize(th_y, S), \
-            _quantize(th_y, P)
-        fit_xy = _level_misfit(th_x, ax, S) + _level_misfit(th_y, by, P)
-        fit_yx = _level_misfit(th_y, ay, S) + _level_misfit(th_x, bx, P)
-        for k in range(S * P):
-            a_k, b_k = k % S, k // S
-            hits_xy = e_x * (1.0 if a_k == ax else -1.0) + e_y * (1.0 if b_k == by else -1.0)
-            hits_yx = e_y * (1.0 if a_k == ay else -1.0) + e_x * (1.0 if b_k == bx else -1.0)
-            s_xy = hits_xy / (e_x + e_y) - 0.5 * fit_xy - pen_xy
-            s_yx = hits_yx / (e_y + e_x) - 0.5 * fit_yx - pen_yx
-            ev[r, k] = s_xy if (s_xy != s_xy or s_xy >= s_yx) else s_yx  # NaN, as np.max
-        lo = hi
-    return ev
-
-
-@_numba_inline
-def _minimum(a: float, b: float) -> float:
-    """``np.minimum``: NaN if either is."""
-    if a != a or b != b:
-        return np.nan
-    return a if a <= b else b
-
-
-@_numba_inline
-def _two_heaviest(uid: np.ndarray, lo: int, hi: int, cls_w: np.ndarray) -> tuple[int, int]:
-    """The levels of runs ``lo..hi-1`` with the largest and second largest weight (ties:
-    the higher level first; -1 where there is no second)."""
-    x = -1
-    y = -1
-    for i in range(lo, hi):
-        u = uid[i]
-        if u == x or u == y:
-            continue
-        if x < 0 or cls_w[u] > cls_w[x] or (cls_w[u] == cls_w[x] and u > x):
-            x, y = u, x
-        elif y < 0 or cls_w[u] > cls_w[y] or (cls_w[u] == cls_w[y] and u > y):
-            y = u
-    return x, y
-
-
-@_numba_inline
-def _quantize(theta: float, levels: int) -> int:
-    """:func:`bistair.core.stair.quantize` of one phase."""
-    two_pi = 2.0 * math.pi
-    return int(math.floor(((theta + math.pi) % two_pi) * levels / two_pi)) % levels
-
-
-@_numba_inline
-def _level_misfit(theta: float, level: int, levels: int) -> float:
-    """:func:`bistair.core.stair.level_misfit` of one phase."""
-    two_pi = 2.0 * math.pi
-    phase = -math.pi + math.pi / levels + two_pi * level / levels
-    d = (theta - phase + math.pi) % two_pi
-    return ((d - math.pi) / (math.pi / levels)) ** 2
-
-
-@_numba_inline
-def _length_cost(uid: np.ndarray, length: np.ndarray, complete: np.ndarray, lo: int,
-                 hi: int, loc: int, par: int, h_loc: float, h_par: float) -> float:
-    """How badly the run lengths fit the local (level ``loc``) and partition (``par``)
-    heights: summed squared log-ratios; a band cut by the region's edge only must not be
-    over 1.25 times as long."""
-    cost = 0.0
-    slack = math.log(1.25)
-    for i in range(lo, hi):
-        if uid[i] == loc:
-            expect = h_loc
-        elif uid[i] == par:
-            expect = h_par
+    i = 0
+    while i < n:
+        j = i + 1
+        while j < n and region[j] == region[i]:
+            j += 1
+        k = int(math.floor(q * (j - i - 1)))
+        seg = values[i:j]
+        if np.isnan(seg).any():  # NaNs sort last
+            pick = np.sort(seg)[k]
         else:
+            pick = np.partition(seg, k)[k]
+        for k in range(i, j):
+            out[k] = pick
+        i = j
+
+
+@kernel()
+def group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
+                      q: float) -> np.ndarray:
+    """``numpy.percentile(values[group == g], 100 * q)`` (linear interpolation) for every
+    group ``g`` in ``0 .. n_groups-1``; NaN for a group without values.
+
+    Parameters
+    ----------
+    group : (n,) int array
+        Group of each value, in ``0 .. n_groups-1``.
+    values : (n,) float64 array
+        The values.
+    n_groups : int
+        Number of groups.
+    q : float
+        Quantile in [0, 1] (``percentile / 100``).
+
+    Returns
+    -------
+    (n_groups,) float64 array
+        Each group's quantile, computed as NumPy's ``linear`` method does.
+
+    Examples
+    --------
+    >>> group_percentiles(np.array([0, 0, 0, 2]), np.array([1.0, 2.0, 4.0, 5.0]), 3,
+    ...                   0.8).tolist()
+    [3.2, nan, 5.0]
+    """
+    return _group_percentiles(group, values, n_groups, q)
+
+
+@_numba_called
+def _group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
+                       q: float) -> np.ndarray:
+    """The body of :func:`group_percentiles`."""
+    n = group.size
+    counts = np.zeros(n_groups + 1, np.int64)
+    for i in range(n):
+        counts[group[i] + 1] += 1
+    starts = np.cumsum(counts)
+    fill = starts[:-1].copy()
+    buf = np.empty(n, np.float64)
+    for i in range(n):
+        g = group[i]
+        buf[fill[g]] = values[i]
+        fill[g] += 1
+    out = np.full(n_groups, np.nan)
+    for g in range(n_groups):
+        m = counts[g + 1]
+        if m == 0:
             continue
-        ratio = math.log(max(length[i], 0.5) / expect)
-        if complete[i]:
-            cost += ratio * ratio
-        else:
-            over = max(ratio - slack, 0.0)
-            cost += over * over
-    return cost
+        seg = buf[starts[g]:starts[g] + m]
+        if np.isnan(seg).any():
+            continue  # NaN, as NumPy gives
+        v = (m - 1) * q
+        prev = math.floor(v)
+        if v >= m - 1:
+            out[g] = seg.max()
+            continue
+        part = np.partition(seg, int(prev))  # the two order statistics, without a sort
+        a = part[int(prev)]
+        b = part[int(prev) + 1:].min()
+        t = v - prev
+        diff = b - a
+        r = a + diff * t
+        if t >= 0.5:
+            r = b - diff * (1.0 - t)
+        out[g] = r
+    return out

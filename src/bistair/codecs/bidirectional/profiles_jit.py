@@ -1,4 +1,6 @@
-"""Sums per (region label, image row), kept only for the pairs that have pixels.
+"""Compiled passes of the row profiles (:mod:`.profiles`): sums per (region label, image
+row), kept only for the pairs that have pixels, of any values or of the stair values
+computed as they are summed.
 
 A region decoder reads each fringe region row by row. Summing into a bin for every
 (label, row) pair would take ``(labels + 1) * H`` bins, which a noisy 12 MP capture with
@@ -17,11 +19,18 @@ Examples
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .kernels import _numba_called, kernel
+from ...core.jit import _fmax, _fmin, _numba_called, _numba_inline, kernel
+from ...core.memory import row_bands
 
 prange = range  # numba's prange once the first kernel of this module compiles
+BLOCK = 32  # rows per task of the parallel loops
+TWO_PI = 2.0 * math.pi
+
+
 BLOCK = 32  # rows per task of the parallel loops
 
 
@@ -234,47 +243,132 @@ def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
     return label_major(start, entry, count, acc, n_labels)
 
 
-@kernel()
-def label_code_votes(labels: np.ndarray, codes: np.ndarray, weights: np.ndarray,
-                     n_labels: int, n_codes: int) -> tuple[np.ndarray, np.ndarray]:
-    """Each label's (weighted) votes per code and in all: ``(votes (n+1, C), total
-    (n+1,))``, float64, over the pixels with a label (1 .. n) and a code (0 .. C-1; others
-    abstain), added in raster order as ``np.bincount`` adds them (one thread: a label
-    spans rows).
+@_numba_inline
+def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.float32,
+                  m: np.float32) -> tuple:
+    """One pixel's ``weight * cos``, ``weight * sin``, ``weight`` and ``ratio`` in float32,
+    as NumPy computes :func:`bistair.codecs.bidirectional.profiles.stair_values`' inputs:
+    ``ratio = clip(stair_mod / max(mod, 1e-6), 0, 2)``, ``weight = core_weight(phi) *
+    min(ratio, 1)`` (:func:`bistair.core.regions.core_weight`)."""
+    tiny = np.float32(1e-6)
+    zero, one, two = np.float32(0.0), np.float32(1.0), np.float32(2.0)
+    ratio = _fmin(_fmax(sm / _fmax(m, tiny), zero), two)
+    core = _fmin(_fmax(_fmin(p, np.float32(TWO_PI) - p) / np.float32(math.pi / 2),
+                       np.float32(0.1)), one)
+    weight = core * _fmin(ratio, one)
+    return weight * cos_t, weight * sin_t, weight, ratio
+
+
+@_numba_called
+def _stair_sum_rows(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
+                    sin_t: np.ndarray, stair_mod: np.ndarray, mod: np.ndarray, n_labels: int,
+                    start: np.ndarray, entry: np.ndarray, y0: int, y1: int,
+                    count: np.ndarray, acc: np.ndarray) -> None:
+    """:func:`stair_sums` of rows ``y0 .. y1-1``."""
+    w = labels.shape[1]
+    slot = np.empty(n_labels + 1, np.int64)
+    for y in range(y0, y1):
+        for i in range(start[y], start[y + 1]):
+            slot[entry[i]] = i
+        for x in range(w):
+            lab = labels[y, x]
+            if lab > 0:
+                i = slot[lab]
+                count[i] += 1
+                c, s, weight, ratio = _stair_values(phi[y, x], cos_t[y, x], sin_t[y, x],
+                                                    stair_mod[y, x], mod[y, x])
+                acc[0, i] += np.float64(c)
+                acc[1, i] += np.float64(s)
+                acc[2, i] += np.float64(weight)
+                acc[3, i] += np.float64(ratio)
+                acc[4, i] += np.float64(np.float32(x))
+
+
+@kernel(parallel=True)
+def stair_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray,
+               stair_mod: np.ndarray, mod: np.ndarray, n_labels: int, start: np.ndarray,
+               entry: np.ndarray, count: np.ndarray, acc: np.ndarray) -> None:
+    """Add the five values of :func:`bistair.codecs.bidirectional.profiles.stair_values`
+    (``weight * cos``, ``weight * sin``, ``weight``, ``ratio``, the column; see
+    :func:`_stair_values`), computed per pixel as they are summed, to
+    the pixel ``count`` (K,) and sums ``acc`` (5, K) of the entries of
+    :func:`row_entries` (of these rows: ``start`` has one more
+    element than the maps have rows; ``entry`` is the whole image's).
 
     Parameters
     ----------
-    labels : (H, W) int array
+    labels : (R, W) int32 array
         Region labels, 0 outside any.
-    codes : (H, W) int array
-        Code per pixel, 0 .. n_codes-1, negative to abstain.
-    weights : (H, W) float array or (0, 0) array
-        Vote weight per pixel; an empty array for one vote each.
-    n_labels, n_codes : int
-        Highest label and number of codes.
-
-    Returns
-    -------
-    votes : (n_labels + 1, n_codes) float64 array
-    total : (n_labels + 1,) float64 array
+    phi, cos_t, sin_t, stair_mod, mod : (R, W) float32 arrays
+        Wrapped phase, cosine and sine of the stair phase, modulation of the stair
+        pair and of the fringes.
+    n_labels : int
+        Highest label.
+    start, entry : numpy.ndarray
+        From :func:`row_entries` (``start`` of these rows).
+    count : (K,) int64 array
+        Pixels per entry, added to.
+    acc : (5, K) float64 array
+        Sums per entry, added to.
 
     Examples
     --------
-    >>> votes, total = label_code_votes(np.array([[1, 1, 2]]), np.array([[0, 1, -1]]),
-    ...                                 np.empty((0, 0)), 2, 2)
-    >>> votes.tolist(), total.tolist()
-    ([[0.0, 0.0], [1.0, 1.0], [0.0, 0.0]], [0.0, 2.0, 0.0])
+    >>> one = np.ones((1, 3), np.float32)
+    >>> count, acc = np.zeros(1, np.int64), np.zeros((5, 1))
+    >>> stair_sums(np.int32([[1, 1, 0]]), np.pi * one, one, 0 * one, one, one, 1,
+    ...            np.array([0, 1]), np.int32([1]), count, acc)
+    >>> count.tolist(), acc[:, 0].tolist()
+    ([2], [2.0, 0.0, 2.0, 2.0, 1.0])
     """
-    h, w = labels.shape
-    votes = np.zeros((n_labels + 1, n_codes), np.float64)
-    total = np.zeros(n_labels + 1, np.float64)
-    weighted = weights.size > 0
-    for y in range(h):
-        for x in range(w):
-            lab = labels[y, x]
-            c = codes[y, x]
-            if lab > 0 and c >= 0 and lab <= n_labels and c < n_codes:
-                v = np.float64(weights[y, x]) if weighted else 1.0
-                votes[lab, c] += v
-                total[lab] += v
-    return votes, total
+    h = labels.shape[0]
+    for b in prange((h + BLOCK - 1) // BLOCK):
+        _stair_sum_rows(labels, phi, cos_t, sin_t, stair_mod, mod, n_labels, start, entry,
+                        b * BLOCK, min(b * BLOCK + BLOCK, h), count, acc)
+
+
+def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
+                     stair_mod: np.ndarray, mod: np.ndarray, n_labels: int
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`label_row_sums` of the five values of
+    :func:`bistair.codecs.bidirectional.profiles.stair_values`
+    (from ``np.cos(theta)`` and ``np.sin(theta)``), computed per pixel as they are summed:
+    no (5, H, W) array, the cosine and sine made for a band of rows at a time. Returns
+    ``(keys, counts, sums (5, K))``, ``keys = label * H + row`` ascending, float64 sums in
+    raster order.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Region labels, 0 outside any.
+    phi, theta, stair_mod, mod : (H, W) float32 arrays
+        Wrapped phase, stair phase and the modulations of the stair pair and the fringes.
+    n_labels : int
+        Highest label.
+
+    Returns
+    -------
+    keys : (K,) int64 array
+        ``label * H + row`` of each (label, row) with pixels, ascending.
+    counts : (K,) int64 array
+        Pixels per key.
+    sums : (5, K) float64 array
+        The sums of ``weight * cos``, ``weight * sin``, ``weight``, ``ratio`` and the column.
+
+    Examples
+    --------
+    >>> one = np.ones((1, 3), np.float32)
+    >>> keys, counts, sums = label_stair_sums(np.int32([[1, 1, 0]]), np.pi * one, 0 * one,
+    ...                                       one, one, 1)
+    >>> keys.tolist(), counts.tolist(), sums[:, 0].tolist()
+    ([1], [2], [2.0, 0.0, 2.0, 2.0, 1.0])
+    """
+    start, entry = row_entries(labels, n_labels)
+    count = np.zeros(entry.size, np.int64)
+    acc = np.zeros((5, entry.size), np.float64)
+    bands = row_bands(labels.shape[0])
+    for y0 in bands:
+        rows = slice(y0, y0 + bands.step)
+        t = theta[rows]
+        stair_sums(labels[rows], phi[rows], np.cos(t), np.sin(t), stair_mod[rows], mod[rows],
+                   n_labels, start[y0:y0 + bands.step + 1], entry, count, acc)
+    return label_major(start, entry, count, acc, n_labels)

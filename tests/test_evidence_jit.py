@@ -1,137 +1,27 @@
-"""The band analysis's compiled passes (bistair.core.run_kernels) give what the NumPy they
-replaced gave: ``bands.row_runs`` exactly the same runs, levels, lengths and sums on random
-row profiles (zero weights, one entry, no band row, several level sets, profiles out of
-order); ``evidence.region_evidence`` the evidence of its loop over regions to 1e-12 (sums
-taken in order rather than pairwise, the C library's log), on random runs and a decode's."""
+"""The band evidence's compiled passes (bistair.codecs.bidirectional.evidence_jit) give what
+the NumPy they replaced gave: region_evidence the evidence of its loop over regions to 1e-12
+(sums taken in order rather than pairwise, the C library's log), on random runs and a
+decode's; the heights and band splits exactly."""
 
 from __future__ import annotations
-
-from dataclasses import astuple
 
 import numpy as np
 import pytest
 
 from bistair.codecs import make_spec
 from bistair.codecs.bidirectional.bands import (
-    RowProfiles,
     Runs,
-    _drop_transitions,
-    nearest_level,
-    observed_levels,
-    row_runs,
-    union_levels,
 )
-from bistair.codecs.bidirectional.evidence import BandLayout, region_evidence
-from bistair.core.phase import TWO_PI, wrap
-from bistair.core.region_kernels import group_percentiles, region_quantile
+from bistair.codecs.bidirectional.evidence import (
+    BandLayout,
+    _own_heights,
+    band_splits,
+    region_evidence,
+)
 from bistair.core.stair import level_misfit, quantize
 from bistair.sim.warp import WarpScene, render_warp
 
 RNG = np.random.default_rng(5)
-
-
-def _row_runs_before(prof, levels):
-    """``row_runs`` as NumPy computed it (profiles sorted by region, then row: the region
-    quantiles from ``region_quantile``, as it took them for sorted profiles)."""
-    c, s, wsum = prof.cos, prof.sin, prof.weight
-    region, row = prof.region, prof.row
-    row_theta = np.arctan2(s, c)
-    core = prof.level >= 0.7 * region_quantile(region, prof.level, 0.8)
-    levels = observed_levels(row_theta[core], wsum[core], levels)
-    read = nearest_level(row_theta, levels)
-    expected = group_percentiles(read[core], prof.level[core].astype(np.float64), levels.size,
-                                 0.8)
-    expected[np.bincount(read[core], minlength=levels.size) == 0] = 1.0
-    level = prof.level / np.maximum(expected[read], 1e-6)
-    kept = level >= 0.7 * region_quantile(region, level, 0.8)
-    dropped_before = np.cumsum(~kept) - (~kept)
-    idx = np.flatnonzero(kept)
-    if idx.size == 0:
-        return None
-    region_k, row_k, uid = region[idx], row[idx], read[idx]
-    same = np.zeros(idx.size, bool)
-    same[1:] = region_k[1:] == region_k[:-1]
-    gap = np.zeros(idx.size, np.int64)
-    gap[1:] = row_k[1:] - row_k[:-1] - 1
-    between = np.zeros(idx.size, np.int64)
-    between[1:] = dropped_before[idx[1:]] - dropped_before[idx[:-1]]
-    soft = same & (gap == between) & (gap <= 3)
-    changed = np.ones(idx.size, bool)
-    changed[1:] = uid[1:] != uid[:-1]
-    start = ~soft | changed
-    start[0] = True
-    run_id = np.cumsum(start) - 1
-    first = np.flatnonzero(start)
-    last = np.r_[first[1:] - 1, idx.size - 1]
-    top_ok = soft[first] & changed[first]
-    bottom_ok = np.r_[top_ok[1:], False]
-    half_top = np.where(top_ok, gap[first] / 2.0, 0.0)
-    half_bottom = np.zeros(first.size)
-    half_bottom[:-1] = np.where(bottom_ok[:-1], gap[first[1:]] / 2.0, 0.0)
-    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
-    off = np.abs(wrap(row_theta[idx] - levels[uid])) / (0.5 * gaps.min(axis=1)[uid])
-    misfit = np.bincount(run_id, off * wsum[idx]) / np.maximum(np.bincount(run_id, wsum[idx]),
-                                                               1e-12)
-    return _drop_transitions(Runs(
-        region=region_k[first], y0=row_k[first], y1=row_k[last],
-        length=(row_k[last] - row_k[first] + 1) + half_top + half_bottom,
-        theta=np.arctan2(np.bincount(run_id, s[idx]), np.bincount(run_id, c[idx])),
-        weight=np.bincount(run_id, wsum[idx]), uid=uid[first], top_ok=top_ok,
-        bottom_ok=bottom_ok, misfit=misfit))
-
-
-def _profiles(n, regions, steps, zero_weights=False):
-    """Random profiles: bands of stair levels down each region, noisy, some rows missing."""
-    region = np.sort(RNG.integers(1, regions + 1, n))
-    row = np.zeros(n, np.int64)
-    for r in np.unique(region):
-        at = region == r
-        row[at] = np.sort(RNG.choice(4 * n, at.sum(), replace=False))
-    k = (row // RNG.integers(2, 12)) % steps
-    theta = -np.pi + (k + 0.5) * TWO_PI / steps + RNG.normal(0, 0.25, n)
-    weight = RNG.uniform(0, 3, n)
-    if zero_weights:
-        weight[RNG.random(n) < 0.2] = 0.0
-    return RowProfiles(region.astype(np.int64), row, weight * np.cos(theta),
-                       weight * np.sin(theta), weight, RNG.uniform(0, 2, n),
-                       RNG.integers(1, 50, n), RNG.uniform(0, 100, n))
-
-
-def _same(got, expected):
-    for name, value in got.__dict__.items():
-        other = getattr(expected, name)
-        assert value.dtype == other.dtype, name
-        assert np.array_equal(value, other, equal_nan=True), name
-
-
-@pytest.mark.parametrize("n", [1, 2, 7, 60, 900])
-@pytest.mark.parametrize("levels", [(6, 6), (3, 4), (8, 8)])
-def test_row_runs_are_numpys(n, levels):
-    lv = union_levels(*levels)
-    for trial in range(8):
-        prof = _profiles(n, int(RNG.integers(1, 12)), len(lv), zero_weights=trial % 2 == 1)
-        expected = _row_runs_before(prof, lv)
-        got = row_runs(prof, lv)
-        if expected is None:
-            assert got.uid.size == 0
-        else:
-            _same(got, expected)
-
-
-def test_row_runs_sort_profiles_given_out_of_order():
-    lv = union_levels(6, 6)
-    prof = _profiles(300, 5, len(lv))
-    order = RNG.permutation(prof.region.size)
-    shuffled = RowProfiles(*(v[order] for v in astuple(prof)))
-    _same(row_runs(shuffled, lv), row_runs(prof, lv))
-
-
-def test_no_band_row_gives_no_run():
-    lv = union_levels(3, 4)
-    prof = _profiles(20, 2, len(lv))
-    prof.level[:] = np.nan  # no row reaches its region's band cores
-    runs = row_runs(prof, lv)
-    assert runs.uid.size == 0 and runs.length.size == 0
 
 
 def _region_evidence_before(runs, n_regions, heights, layout):
@@ -195,6 +85,7 @@ def _region_evidence_before(runs, n_regions, heights, layout):
     return ev
 
 
+
 def _length_cost(length, expect, complete):
     ok = np.isfinite(expect)
     if not ok.any():
@@ -203,6 +94,7 @@ def _length_cost(length, expect, complete):
     over = np.maximum(ratio - np.log(1.25), 0.0)
     terms = np.where(complete[ok], ratio**2, over**2)
     return float(terms.sum())
+
 
 
 def _runs(n, regions, layout, rng):
@@ -221,6 +113,7 @@ def _runs(n, regions, layout, rng):
                 misfit=rng.uniform(0, 0.5, n) * (rng.random(n) < 0.5))
 
 
+
 @pytest.mark.parametrize("n", [1, 2, 9, 80, 700])
 @pytest.mark.parametrize("stairs", [(6, 6), (3, 4), (8, 8)])
 def test_region_evidence_is_the_loops(n, stairs):
@@ -235,6 +128,7 @@ def test_region_evidence_is_the_loops(n, stairs):
         got = region_evidence(runs, regions + 2, heights, layout)
         assert got.shape == expected.shape
         np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
+
 
 
 def test_region_evidence_of_a_decode_is_the_loops():
@@ -261,3 +155,76 @@ def test_region_evidence_of_a_decode_is_the_loops():
         np.testing.assert_allclose(region_evidence(runs, n, heights, layout),
                                    _region_evidence_before(runs, n, heights, layout),
                                    rtol=1e-12, atol=1e-12)
+
+
+def _own_heights_before(region, uid, length, n_regions):
+    own = np.full(n_regions + 1, np.nan)
+    for r in np.unique(region):
+        sel = region == r
+        vals, inv, counts = np.unique(uid[sel], return_inverse=True, return_counts=True)
+        if vals.size < 2:
+            continue
+        top_two = np.argsort(counts)[-2:]
+        own[r] = sum(np.median(length[sel][inv == v]) for v in top_two)
+    return own
+
+
+
+def _band_splits_before(runs, heights, local_share):
+    splits = []
+    if runs.uid.size < 2:
+        return splits
+    uid, reg, length = runs.uid, runs.region, runs.length
+    solid = length >= 2.0
+    h = np.asarray(heights, float)[reg]
+    merged = np.isfinite(h) & (length >= 1.3 * max(local_share, 1 - local_share) * h)
+
+    def same(*idx):
+        return all(0 <= j < uid.size and reg[j] == reg[idx[0]] and solid[j] for j in idx)
+
+    for i in range(1, uid.size):
+        if not same(i - 1, i) or uid[i] == uid[i - 1]:
+            continue
+        if same(i - 2, i - 1, i) and not merged[i - 1] and uid[i] != uid[i - 2]:
+            confirmed = ((same(i, i + 2) and uid[i + 2] == uid[i])
+                         or (same(i, i + 1) and uid[i + 1] not in (uid[i - 1], uid[i - 2]))
+                         or merged[i])
+        elif merged[i - 1]:
+            confirmed = same(i, i + 2) and uid[i + 2] == uid[i] and not merged[i]
+        else:
+            confirmed = False
+        if not confirmed and merged[i] and same(i - 2, i - 1, i) and not merged[i - 1] \
+                and uid[i - 2] == uid[i]:
+            confirmed = True
+        if confirmed and (not splits or splits[-1][0] != reg[i] or splits[-1][1] < runs.y0[i - 1]):
+            splits.append((int(reg[i]), int(runs.y0[i])))
+    return splits
+
+
+
+def test_own_heights():
+    rng = np.random.default_rng(4)
+    for _ in range(300):
+        n = int(rng.integers(1, 80))
+        region = np.sort(rng.integers(1, int(rng.integers(2, 12)), n))
+        uid = rng.integers(0, int(rng.integers(1, 6)), n)  # few values: count ties
+        length = rng.integers(2, 20, n) + rng.choice([0.0, 0.5], n)
+        got = _own_heights(region, uid, length, 12)
+        want = _own_heights_before(region, uid, length, 12)
+        assert np.array_equal(got, want, equal_nan=True)
+
+
+
+def test_band_splits():
+    rng = np.random.default_rng(5)
+    for _ in range(300):
+        n = int(rng.integers(0, 60))
+        region = np.sort(rng.integers(1, 5, n))
+        uid = rng.integers(0, 4, n)
+        length = rng.choice([1.0, 2.0, 6.0, 10.0, 16.0, 30.0], n)
+        y0 = np.cumsum(rng.integers(1, 12, n))
+        runs = Runs(region, y0, y0 + length.astype(int), length, np.zeros(n), np.ones(n), uid,
+                    np.ones(n, bool), np.ones(n, bool), np.zeros(n))
+        heights = np.r_[np.nan, rng.choice([np.nan, 16.0, 20.0], 5)]
+        assert band_splits(runs, heights, 10 / 16) == _band_splits_before(runs, heights,
+                                                                          10 / 16)

@@ -1,6 +1,7 @@
-"""The paper decoder's compiled column scan (bistair.core.paper_kernels) gives exactly what
-the SciPy and NumPy code it replaced gave: the same column medians, runs, run sums, modes
-and orders, on random codes with invalid pixels, tiny images, single rows and columns."""
+"""The paper decoder's compiled column scan (bistair.codecs.bidirectional.paper_jit) gives
+exactly what the SciPy and NumPy code it replaced gave: the same column medians, runs, run
+sums, modes and orders, on random codes with invalid pixels, tiny images, single rows and
+columns."""
 
 from __future__ import annotations
 
@@ -13,9 +14,14 @@ from bistair.codecs.base import measure_shifts
 from bistair.codecs.bidirectional import code_columns
 from bistair.codecs.bidirectional.bands import nearest_level, union_levels
 from bistair.codecs.bidirectional.paper import _pixel_median, paper_orders
+from bistair.codecs.bidirectional.paper_jit import (
+    column_median,
+    column_runs,
+    paint_labels,
+    run_label_modes,
+)
 from bistair.core.captures import prepare
-from bistair.core.kernels import set_threads
-from bistair.core.paper_kernels import column_median, column_runs, paint_labels, run_label_modes
+from bistair.core.jit import set_threads
 from bistair.core.regions import fringe_regions
 from bistair.core.resolve import mode_by_label
 from bistair.core.stair import quantize

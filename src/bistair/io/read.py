@@ -1,13 +1,11 @@
-"""Reading captures and specs, and writing outputs without leaving half-written results
-behind.
+"""Reading captures and specs.
 
 Captures are given as folders, image files or quoted glob patterns (``'scan/pat*.png'``),
 in the order given; a folder's or a pattern's images are taken in natural name order
 (``2.bmp`` before ``10.bmp``), skipping files that are not PNG, TIFF or BMP images and hidden
 files (such as macOS's ``._00.png``). Images are 8 or 16 bit, grey or colour (converted to
 grey). One ``.npy`` stack of shape (frames, height, width) is an alternative. Frames the
-spec marks ``ignore`` are not read. Outputs go to a temporary folder beside the destination
-and are moved in only when every file is written.
+spec marks ``ignore`` are not read. Outputs are written by :mod:`.atomic`.
 
 Examples
 --------
@@ -17,13 +15,9 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 import glob
-import os
 import re
-import shutil
-import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -85,6 +79,7 @@ def list_images(folder: Path) -> list[Path]:
     Examples
     --------
     >>> import pathlib, shutil, tempfile
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> for name in ("10.png", "2.PNG", "1.tif", "spec.json", ".hidden.png"):
     ...     _ = (tmp / name).write_bytes(b"")
@@ -121,6 +116,7 @@ def read_image(path: str | Path) -> np.ndarray:
     Examples
     --------
     >>> import pathlib, shutil, tempfile
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> write_image(tmp / "rgb.png", np.array([[[255, 0, 0], [0, 255, 0]]], np.uint8))
     >>> read_image(tmp / "rgb.png")
@@ -257,6 +253,7 @@ def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
     Examples
     --------
     >>> import pathlib, shutil, tempfile
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> for i in range(3):
     ...     write_image(tmp / f"{i}.png", np.full((2, 4), 10 * i, np.uint8))
@@ -322,6 +319,7 @@ def load_spec(path: str | Path) -> BaseSpec:
     --------
     >>> import pathlib, shutil, tempfile
     >>> from bistair.codecs import make_spec
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> spec = make_spec("graycode", width=120, height=16, period=30)
     >>> _ = (tmp / "spec.json").write_text(spec.to_json())
@@ -359,6 +357,7 @@ def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
     --------
     >>> import pathlib, shutil, tempfile
     >>> from bistair.codecs import make_spec
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> _ = (tmp / "spec.json").write_text(make_spec("graycode", width=64, height=48,
     ...                                              period=16).to_json())
@@ -438,6 +437,7 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     --------
     >>> import pathlib, shutil, tempfile
     >>> from bistair.codecs import make_spec
+    >>> from bistair.io.atomic import write_image
     >>> tmp = pathlib.Path(tempfile.mkdtemp())
     >>> spec = make_spec("graycode", width=120, height=16, period=30)
     >>> spec = spec.replace(frame_order=("ignore", *spec.frames))
@@ -471,389 +471,3 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     return stack, spec
 
 
-def write_image(path: str | Path, image: np.ndarray) -> None:
-    """Write an 8- or 16-bit image (PNG, TIFF or BMP by suffix).
-
-    TIFF (``.tif``, ``.tiff``) is written with tifffile, other suffixes with imageio. The
-    file is written in place (not atomically): use :func:`output_folder` or
-    :func:`output_file` for that.
-
-    Parameters
-    ----------
-    path : str or Path
-        The file to write (replaced if it exists); its suffix chooses the format.
-    image : numpy.ndarray
-        ``(height, width)`` grey or ``(height, width, 3)`` RGB, ``uint8`` or ``uint16``
-        (BMP takes ``uint8`` only).
-
-    Examples
-    --------
-    >>> import pathlib, shutil, tempfile
-    >>> tmp = pathlib.Path(tempfile.mkdtemp())
-    >>> write_image(tmp / "ramp.png", np.arange(6, dtype=np.uint16).reshape(2, 3) * 1000)
-    >>> read_image(tmp / "ramp.png").tolist()
-    [[0, 1000, 2000], [3000, 4000, 5000]]
-    >>> shutil.rmtree(tmp)
-    """
-    path = Path(path)
-    if path.suffix.lower() in (".tif", ".tiff"):
-        tifffile.imwrite(path, image)
-    else:
-        iio.imwrite(path, image)
-
-
-def check_output(out: str | Path, captures: Captures | None = None) -> Path:
-    """Refuse an output path that is empty or is the captures' own folder (writing there
-    would add files to the next decode of that folder); returns it as a Path.
-
-    Parameters
-    ----------
-    out : str or Path
-        The output folder.
-    captures : str, Path, sequence of str or Path, or None, optional
-        The captures it is made from (as for :func:`capture_files`): a folder, the folder
-        of a file or the folder part of a glob pattern counts as their own folder. Paths
-        are compared resolved.
-
-    Returns
-    -------
-    Path
-        ``out`` as a :class:`~pathlib.Path`.
-
-    Raises
-    ------
-    BistairError
-        If ``out`` is empty (or blank) or is the captures' own folder.
-
-    Examples
-    --------
-    >>> check_output("result", "scan/*.png")
-    PosixPath('result')
-    >>> check_output("scan", "scan/*.png")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    bistair.errors.BistairError: the output folder scan is the captures' own folder: ...
-    >>> check_output(" ")
-    Traceback (most recent call last):
-    ...
-    bistair.errors.BistairError: the output path is empty
-    """
-    if str(out).strip() == "":
-        raise BistairError("the output path is empty")
-    out = Path(out)
-    if captures is not None:
-        items = [captures] if isinstance(captures, str | Path) else list(captures)
-        folders = {Path(i).resolve() if Path(i).is_dir() else Path(i).resolve().parent
-                   for i in items if not any(c in str(i) for c in "*?[")}
-        folders |= {Path(str(i)).parent.resolve() for i in items if any(c in str(i) for c in "*?[")}
-        if out.resolve() in folders:
-            raise BistairError(f"the output folder {out} is the captures' own folder: choose "
-                               "another (the outputs would be read as captures next time)")
-    return out
-
-
-TEMP_PREFIX = ".bistair-"  # the names of every temporary beside an output
-
-
-@contextlib.contextmanager
-def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
-    """Yield a temporary folder; on success its files are moved into ``out`` (created if
-    needed, other files in it left alone); on any error nothing reaches ``out``.
-
-    The temporary folder (``.bistair-<pid>-...``) is made inside ``out``, or beside it if
-    ``out`` does not exist yet, so the moves stay on one file system; temporaries left by
-    killed processes there are removed first (:func:`remove_stale`). A new ``out`` is the
-    temporary folder renamed; into an existing ``out`` each item is moved, replacing a
-    file or folder of the same name.
-
-    Parameters
-    ----------
-    out : str or Path
-        The output folder.
-    prefix : str, optional
-        The temporary folder's name prefix (it must start with :data:`TEMP_PREFIX`); by
-        default ``.bistair-<pid>-``. A batch run gives its own, to find its leftovers.
-
-    Yields
-    ------
-    Path
-        The temporary folder to write into; it is removed afterwards in every case.
-
-    Raises
-    ------
-    BistairError
-        If ``out`` exists and is not a folder, or the folder cannot be created or written
-        (any ``OSError``, also one raised in the ``with`` block, in one line). Other errors
-        in the ``with`` block propagate unchanged.
-
-    Examples
-    --------
-    >>> import pathlib, shutil, tempfile
-    >>> tmp = pathlib.Path(tempfile.mkdtemp())
-    >>> with output_folder(tmp / "out") as work:
-    ...     _ = (work / "a.txt").write_text("a")
-    >>> sorted(p.name for p in tmp.iterdir()), (tmp / "out" / "a.txt").read_text()
-    (['out'], 'a')
-    >>> with output_folder(tmp / "out") as work:
-    ...     _ = (work / "b.txt").write_text("b")
-    ...     raise RuntimeError("interrupted")
-    Traceback (most recent call last):
-    ...
-    RuntimeError: interrupted
-    >>> sorted(p.name for p in (tmp / "out").iterdir())
-    ['a.txt']
-    >>> shutil.rmtree(tmp)
-    """
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise BistairError(f"output {out} exists and is not a folder")
-    parent = out if out.exists() else out.parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        remove_stale(parent)
-        tmp = Path(tempfile.mkdtemp(prefix=prefix or _prefix(), dir=parent))
-        tmp.chmod(0o777 & ~_umask())  # mkdtemp makes it private; outputs are not
-    except OSError as exc:
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
-    try:
-        yield tmp
-        if not out.exists():
-            os.replace(tmp, out)
-            return
-        for item in tmp.iterdir():
-            target = out / item.name
-            if target.is_dir() and not target.is_symlink():
-                shutil.rmtree(target)
-            os.replace(item, target)
-    except OSError as exc:
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-
-
-@contextlib.contextmanager
-def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
-    """Yield a temporary folder beside ``out`` that replaces ``out`` as a whole on success.
-
-    Unlike :func:`output_folder`, files already in ``out`` do not survive: the old folder
-    is renamed aside (``prefix`` + random letters) just before the new one is renamed in,
-    then deleted, so ``out`` is at every moment absent, the old folder or the new one,
-    never a mixture. On any error ``out`` is left as it was.
-
-    Parameters
-    ----------
-    out : str or Path
-        The folder to replace (created with its parents if missing).
-    prefix : str
-        Name prefix of the temporary and of the old folder set aside.
-
-    Yields
-    ------
-    Path
-        The new folder's contents go here; removed afterwards if not renamed in.
-
-    Raises
-    ------
-    BistairError
-        If ``out`` exists and is not a folder, or the folders cannot be made or renamed
-        (in one line; the old folder is put back).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     out = pathlib.Path(tmp) / "set"
-    ...     out.mkdir(); _ = (out / "old.txt").write_text("old")
-    ...     with replace_folder(out) as new:
-    ...         _ = (new / "new.txt").write_text("new")
-    ...     sorted(p.name for p in pathlib.Path(tmp).rglob("*"))
-    ['new.txt', 'set']
-    """
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise BistairError(f"output {out} exists and is not a folder")
-    try:
-        out.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
-        tmp.chmod(0o777 & ~_umask())
-    except OSError as exc:
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
-    old = None
-    try:
-        yield tmp
-        if out.exists():
-            old = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
-            os.replace(out, old)  # an empty folder is replaced by a rename
-        os.replace(tmp, out)
-    except OSError as exc:
-        if old is not None and not out.exists():
-            os.replace(old, out)  # put the old folder back
-            old = None
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-
-
-def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Path]:
-    """Delete the temporaries named ``prefix*`` directly inside ``folder`` (left behind by a
-    process killed while writing).
-
-    Parameters
-    ----------
-    folder : str or Path
-        Where to look (a missing folder has nothing to delete).
-    prefix : str
-        The temporaries' name prefix; it must start with :data:`TEMP_PREFIX`.
-
-    Returns
-    -------
-    list of Path
-        What was deleted.
-
-    Raises
-    ------
-    ValueError
-        If ``prefix`` does not start with :data:`TEMP_PREFIX` (a guard against deleting
-        anything else).
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     (pathlib.Path(tmp) / ".bistair-abc").mkdir()
-    ...     _ = (pathlib.Path(tmp) / "result").mkdir()
-    ...     [p.name for p in remove_temporaries(tmp)], sorted(os.listdir(tmp))
-    (['.bistair-abc'], ['result'])
-    """
-    folder = Path(folder)
-    if not prefix.startswith(TEMP_PREFIX):
-        raise ValueError(f"temporaries are named {TEMP_PREFIX}*, not {prefix}*")
-    try:
-        found = sorted(p for p in folder.iterdir() if p.name.startswith(prefix))
-    except OSError:  # no folder, nothing left behind
-        return []
-    for path in found:
-        if path.is_dir() and not path.is_symlink():
-            shutil.rmtree(path, ignore_errors=True)
-        else:
-            with contextlib.suppress(OSError):
-                path.unlink()
-    return found
-
-
-@contextlib.contextmanager
-def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
-    """Yield a temporary file path beside ``path``; it replaces ``path`` only on success.
-
-    The temporary file (``.bistair-<pid>-...`` with ``path``'s suffix, so writers that go
-    by the suffix work) is made in ``path``'s folder, which is created if needed; temporaries
-    left there by killed processes are removed first (:func:`remove_stale`). On success it
-    gets the usual permissions (``0o666`` less the umask) and is renamed onto ``path``.
-
-    Parameters
-    ----------
-    path : str or Path
-        The file to write.
-    prefix : str, optional
-        The temporary file's name prefix, as for :func:`output_folder`.
-
-    Yields
-    ------
-    Path
-        The temporary file (created empty) to write; it is removed if still there afterwards.
-
-    Raises
-    ------
-    BistairError
-        If the folder or the temporary file cannot be made, or the rename fails (any
-        ``OSError``, also one raised in the ``with`` block, in one line). Other errors in
-        the ``with`` block propagate unchanged.
-
-    Examples
-    --------
-    >>> import pathlib, shutil, tempfile
-    >>> tmp = pathlib.Path(tempfile.mkdtemp())
-    >>> with output_file(tmp / "sub" / "info.txt") as work:
-    ...     _ = work.write_text("done")
-    >>> [p.name for p in (tmp / "sub").iterdir()], (tmp / "sub" / "info.txt").read_text()
-    (['info.txt'], 'done')
-    >>> shutil.rmtree(tmp)
-    """
-    path = Path(path)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        remove_stale(path.parent)
-        fd, name = tempfile.mkstemp(prefix=prefix or _prefix(), suffix=path.suffix,
-                                    dir=path.parent)
-        os.close(fd)
-    except OSError as exc:
-        raise BistairError(f"cannot write {path}: {exc.strerror}") from None
-    tmp = Path(name)
-    try:
-        yield tmp
-        tmp.chmod(0o666 & ~_umask())
-        os.replace(tmp, path)
-    except OSError as exc:
-        raise BistairError(f"cannot write {path}: {exc.strerror}") from None
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
-def _prefix() -> str:
-    """Temporary outputs are named ``.bistair-<pid>-...``: whose they are stays known."""
-    return f".bistair-{os.getpid()}-"
-
-
-def remove_stale(folder: str | Path) -> int:
-    """Remove temporary outputs (``.bistair-<pid>-*``) in ``folder`` left by processes that
-    no longer run (killed while writing); returns how many were removed.
-
-    Temporaries of running processes (this one included) are left alone.
-
-    Parameters
-    ----------
-    folder : str or Path
-        The folder to clean (not searched recursively).
-
-    Returns
-    -------
-    int
-        How many files or folders were removed.
-
-    Examples
-    --------
-    >>> import tempfile, pathlib
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     _ = (pathlib.Path(tmp) / ".bistair-999999999-x").mkdir()
-    ...     remove_stale(tmp), list(pathlib.Path(tmp).iterdir())
-    (1, [])
-    """
-    removed = 0
-    for item in Path(folder).glob(".bistair-*-*"):
-        pid = item.name.split("-")[1]
-        if not pid.isdigit() or _running(int(pid)):
-            continue
-        if item.is_dir() and not item.is_symlink():
-            shutil.rmtree(item, ignore_errors=True)
-        else:
-            item.unlink(missing_ok=True)
-        removed += 1
-    return removed
-
-
-def _running(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return pid < 2**22  # someone else's process, or no process at all
-    return True
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

@@ -1,5 +1,5 @@
 """The scenes whose decoded fringe orders are recorded (tests/data/pre_speed.npz), and the
-code that records them: ``python tests/pre_speed.py``.
+code that records them: ``python tests/support/pre_speed.py``.
 
 The orders were first recorded before the decoders were made fast, and recorded again
 when the robustness work settled the decoder (regions cut where two surfaces meet, faint
@@ -16,13 +16,13 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # conftest
 
 import bistair  # noqa: E402
 from bistair.sim import Imaging, expose, preset, trace  # noqa: E402
 from bistair.sim.warp import render_warp  # noqa: E402
 
-DATA = Path(__file__).resolve().parent / "data" / "pre_speed.npz"
+DATA = Path(__file__).resolve().parents[1] / "data" / "pre_speed.npz"
 HARD = dict(gamma=2.2, read_noise=0.03, camera_blur=1.2, projector_blur=1.0, ambient=0.15)
 CODECS = {
     "bidirectional": ("bidirectional", dict(period=30), {}),

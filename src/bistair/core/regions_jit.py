@@ -1,10 +1,9 @@
-"""Compiled loops for the per-pixel and per-link work NumPy cannot express in one pass.
+"""Compiled passes of the fringe regions (:mod:`bistair.core.regions`): the links between
+neighbouring pixels that a labelling cuts (wrapped-phase steps, fringe period jumps), pixels
+reattached to their regions, the wraps between regions and the small regions dropped.
 
-Every kernel here is written in plain Python over arrays and compiled with numba on its
-first call (``cache=True``: once per machine, kept in ``__pycache__``); numba itself is
-imported only then, so importing bistair or starting the command line does not pay for it.
-Kernels that loop over image rows run them on every core (``prange``); :func:`set_threads`
-limits that.
+Each gives exactly what the NumPy formulation gives (:func:`bistair.core.regions.period_jumps`
+is the reference of :func:`period_jump_links`).
 
 Examples
 --------
@@ -20,140 +19,12 @@ Examples
 from __future__ import annotations
 
 import math
-import os
-from collections.abc import Callable
-from functools import wraps
-from typing import Any
 
 import numpy as np
 
-prange = range  # numba's prange once the first kernel compiles
-_COMPILED: dict[str, Any] = {}
+from .jit import PI32, _numba_called, _numba_inline, _wrapped, kernel
 
-
-def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
-    """Compile the decorated function with ``numba.njit`` on its first call.
-
-    The compiled function is kept per function (module and name) and cached on disk
-    (``cache=True``); the plain Python function stays available as the wrapper's
-    ``py_func``. Helpers marked for inlining are compiled into the kernels when the first
-    kernel of their module compiles (and ``prange`` becomes numba's there).
-
-    Parameters
-    ----------
-    parallel : bool
-        Compile with ``parallel=True``, so that loops over ``prange`` run on every core.
-
-    Returns
-    -------
-    callable
-        A decorator: it takes the kernel's Python function and returns a wrapper with the
-        same name and signature (positional arguments only).
-
-    Examples
-    --------
-    >>> def total(a):
-    ...     return a.sum()
-    >>> compiled = kernel()(total)  # nothing is compiled until the first call
-    >>> compiled.__name__, compiled.py_func is total
-    ('total', True)
-    """
-
-    def wrap(fn: Callable) -> Callable:
-        key = f"{fn.__module__}.{fn.__qualname__}"
-
-        @wraps(fn)
-        def call(*args: Any) -> Any:
-            compiled = _COMPILED.get(key)
-            if compiled is None:
-                numba = _numba()  # heavy: imported when the first kernel runs
-                module = fn.__globals__  # the kernel's own module (kernels, region_kernels)
-                if module.get("prange") is range:  # its first kernel: helpers compiled once
-                    module["prange"] = numba.prange
-                    for name, value in list(module.items()):
-                        how = getattr(value, "_inline", None)
-                        if how is not None:
-                            module[name] = numba.njit(cache=True, inline=how)(value)
-                compiled = numba.njit(cache=True, parallel=parallel, fastmath=False,
-                                      error_model="numpy")(fn)
-                _COMPILED[key] = compiled
-            return compiled(*args)
-
-        call.py_func = fn  # type: ignore[attr-defined]
-        return call
-
-    return wrap
-
-
-def set_threads(count: int | None) -> int:
-    """Use ``count`` threads in the kernels (all cores when ``None``); returns the count.
-
-    Parameters
-    ----------
-    count : int or None
-        Threads for the parallel kernels, capped at numba's ``NUMBA_NUM_THREADS``; ``None``
-        (or 0) for every core.
-
-    Returns
-    -------
-    int
-        The number of threads numba now uses.
-
-    Examples
-    --------
-    >>> set_threads(1)
-    1
-    >>> set_threads(None) >= 1  # back to every core
-    True
-    """
-    numba = _numba()
-    count = count or os.cpu_count() or 1
-    numba.set_num_threads(max(1, min(int(count), numba.config.NUMBA_NUM_THREADS)))
-    return numba.get_num_threads()
-
-
-def _numba() -> Any:
-    """Import numba, its OpenMP threads told to sleep rather than spin between loops.
-
-    OpenMP's default (``OMP_WAIT_POLICY=active``) keeps a finished loop's threads spinning:
-    on a machine whose cores other work also wants, each of a decode's few dozen parallel
-    loops then waits a scheduler slice for a thread to come back (a 2-core machine with one
-    busy core decoded three times slower on two threads than on one). Passive threads cost
-    some microseconds a loop on an idle machine. A policy set by the user is kept; it acts
-    only if the OpenMP runtime is not loaded yet.
-    """
-    os.environ.setdefault("OMP_WAIT_POLICY", "passive")
-    import numba
-
-    return numba
-
-
-TWO_PI32 = np.float32(2.0 * math.pi)
-PI32 = np.float32(math.pi)
-
-
-def _numba_inline(fn: Callable) -> Callable:
-    """Mark a helper that the kernels call: compiled into them with ``numba.njit``."""
-    fn._inline = "always"  # type: ignore[attr-defined]
-    return fn
-
-
-def _numba_called(fn: Callable) -> Callable:
-    """Mark a helper that the kernels call: compiled with ``numba.njit`` on its own (not
-    inlined: numba's parallel loops miscompile some inlined bodies that write arrays)."""
-    fn._inline = "never"  # type: ignore[attr-defined]
-    return fn
-
-
-@_numba_inline
-def _wrapped(raw: np.float32) -> np.float32:
-    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it, for ``|raw| < 2pi``."""
-    d = raw + PI32
-    if d >= TWO_PI32:
-        d = d - TWO_PI32
-    elif d < 0:
-        d = d + TWO_PI32
-    return d - PI32
+prange = range  # numba's prange once the first kernel of this module compiles
 
 
 @_numba_inline
@@ -182,6 +53,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
     return step > rel * size
 
 
+
 @_numba_inline
 def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
            rel: np.float32) -> bool:
@@ -190,6 +62,7 @@ def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
     dx, dy = px - qx, py - qy
     return not (dx * dx + dy * dy < rel * rel * max(px * px + py * py, qx * qx + qy * qy)
                 * np.float32(0.9999))
+
 
 
 @_numba_inline
@@ -233,6 +106,7 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
         if ahead[2, x] >= few:
             ahead[0, x] = (sums[0, hi] - sums[0, x]) / max(nxs, one)
             ahead[1, x] = (sums[2, hi] - sums[2, x]) / max(nys, one)
+
 
 
 @kernel(parallel=True)
@@ -287,6 +161,7 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
     return vert, horiz
 
 
+
 @_numba_called
 def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
                relative: float, y0: int, y1: int, vert: np.ndarray, horiz: np.ndarray
@@ -332,6 +207,7 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
                     vert[y - 1, x] = _jump(above[0, x], above[1, x], above[2, x],
                                            around[0, x], around[1, x], around[2, x],
                                            noise[y - 1, x], noise[y, x], rel, fhalf)
+
 
 
 @kernel(parallel=True)
@@ -463,6 +339,7 @@ def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
     return vert, horiz, keep
 
 
+
 @kernel()
 def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.ndarray,
              horiz: np.ndarray, passes: int) -> None:
@@ -532,6 +409,7 @@ def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.n
         n = m
 
 
+
 @kernel()
 def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -590,162 +468,50 @@ def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
     return (np.array(src, np.int64), np.array(dst, np.int64), np.array(step, np.int64))
 
 
-@kernel(parallel=True)
-def stair_turns(phi: np.ndarray, cos_t: np.ndarray, sin_t: np.ndarray, valid: np.ndarray,
-                noise: np.ndarray, step: float) -> np.ndarray:
-    """Horizontal links (H, W-1) where the stair phase (given by its cosine and sine) turns
-    by more than ``max(0.75 step, 4 spread)`` between the pairs of pixels either side of
-    the link, away from the phase jumps (see
-    :func:`bistair.codecs.bidirectional.stair_edges`).
-
-    Away from the phase jumps means the wrapped phase of the link's left pixel lies
-    between 15% and 85% of ``2*pi``; all four pixels must be valid.
-
-    Parameters
-    ----------
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    cos_t, sin_t : (H, W) float32 arrays
-        Cosine and sine of the stair phase.
-    valid : (H, W) bool array
-        Valid pixels.
-    noise : (H, W) float32 array
-        Per-pixel stair phase noise in radians (``spread`` combines those of the pairs).
-    step : float
-        The local stair step in radians (``2*pi / stairs``).
-
-    Returns
-    -------
-    (H, W-1) bool array
-        Links between each pixel and the one to its right where the stair phase turns.
-
-    Examples
-    --------
-    >>> theta = np.where(np.arange(12) < 6, -2.0, 1.0).astype(np.float32)[None].repeat(2, axis=0)
-    >>> phi = np.full((2, 12), np.pi, np.float32)
-    >>> edge = stair_turns(phi, np.cos(theta), np.sin(theta), np.ones((2, 12), bool),
-    ...                    np.full((2, 12), 0.01, np.float32), 2 * np.pi / 3)
-    >>> [np.flatnonzero(row).tolist() for row in edge]
-    [[5], [5]]
-    """
-    h, w = phi.shape
-    edge = np.zeros((h, w - 1), np.bool_)
-    lo = np.float32(0.15 * 2.0 * math.pi)
-    hi = np.float32(0.85 * 2.0 * math.pi)
-    base = 0.75 * step
-    cb, sb = math.cos(base), math.sin(base)
-    for y in prange(h):
-        for x in range(1, w - 2):
-            if not (valid[y, x - 1] and valid[y, x] and valid[y, x + 1] and valid[y, x + 2]):
-                continue
-            mid = phi[y, x]
-            if not (mid > lo and mid < hi):
-                continue
-            lr = cos_t[y, x - 1] + cos_t[y, x]
-            li = sin_t[y, x - 1] + sin_t[y, x]
-            rr = cos_t[y, x + 1] + cos_t[y, x + 2]
-            ri = sin_t[y, x + 1] + sin_t[y, x + 2]
-            re = rr * lr + ri * li
-            im = ri * lr - rr * li
-            # well inside the base angle: no edge, and no arctangent needed
-            if cb * abs(im) - sb * re < -1e-6 * (abs(im) + abs(re)):
-                continue
-            turn = abs(np.float32(math.atan2(im, re)))
-            a = max(noise[y, x - 1], noise[y, x + 2])
-            b = max(noise[y, x], noise[y, x + 1])
-            spread = np.float32(math.sqrt(a * a + b * b))
-            if turn > max(base, 4.0 * spread):
-                edge[y, x] = True
-    return edge
-
-
-@kernel(parallel=True)
-def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
-    """:func:`bistair.core.stair.quantize` of a float32 phase map, -1 where not ``valid``.
-
-    Parameters
-    ----------
-    theta : (H, W) float32 array
-        Stair phase in radians.
-    levels : int
-        Number of steps of the stair.
-    valid : (H, W) bool array
-        Pixels to quantise.
-
-    Returns
-    -------
-    (H, W) int32 array
-        Level ``floor((theta + pi) * levels / (2*pi)) mod levels``, -1 where not valid.
-
-    Examples
-    --------
-    >>> quantize32(np.float32([[-3.0, 0.0, 3.0]]), 4, np.array([[True, True, False]])).tolist()
-    [[0, 2, -1]]
-    """
-    h, w = theta.shape
-    scale = np.float32(levels / (2.0 * math.pi))
-    out = np.empty((h, w), np.int32)
-    for y in prange(h):
-        for x in range(w):
-            if valid[y, x]:
-                out[y, x] = np.int32(math.floor((theta[y, x] + PI32) * scale)) % levels
-            else:
-                out[y, x] = -1
-    return out
-
-
-@kernel(parallel=True)
-def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
-                  min_strong: int, min_size: int, min_region: int) -> np.ndarray:
-    """``strong | (weak & region kept)``, a region kept when it holds ``min_region`` pixels
-    and ``min_strong`` strong pixels or ``min_size`` pixels (see
-    :func:`bistair.core.measure.coherent_pixels`; ``min_region``: the regions
-    :func:`bistair.core.regions.fringe_regions` would drop as too small).
+@kernel()
+def drop_small(labels: np.ndarray, n: int, min_size: int) -> int:
+    """Set the labels of regions under ``min_size`` pixels to 0 and number the others
+    ``1..`` in their order, in place; returns how many are left.
 
     Parameters
     ----------
     labels : (H, W) int32 array
-        Fringe regions of the weak mask, 0 outside any (never kept).
-    weak : (H, W) bool array
-        Pixels with at least the lower modulation threshold.
-    strong : (H, W) bool array
-        Pixels with at least the full modulation threshold.
+        Region labels ``0..n`` (0: none), changed in place.
     n : int
         Highest label.
-    min_strong : int
-        Strong pixels that keep a region.
     min_size : int
-        Pixels in all that keep a region.
-    min_region : int
-        Pixels a region needs to be kept at all.
+        Smallest region kept, in pixels.
 
     Returns
     -------
-    (H, W) bool array
-        The pixels to count as valid.
+    int
+        The number of regions kept.
 
     Examples
     --------
-    >>> labels = np.int32([[1, 1, 1, 2, 2, 0]])
-    >>> strong = np.array([[True, False, False, False, False, False]])
-    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 1).tolist()
-    [[True, True, True, False, False, False]]
-    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 4).tolist()
-    [[True, False, False, False, False, False]]
+    >>> labels = np.array([[1, 1, 2, 3, 3, 3]], np.int32)
+    >>> drop_small(labels, 3, 2), labels.tolist()
+    (2, [[1, 1, 0, 2, 2, 2]])
     """
     h, w = labels.shape
     size = np.zeros(n + 1, np.int64)
-    bright = np.zeros(n + 1, np.int64)
     for y in range(h):
-        for x in range(w):
+        x = 0
+        while x < w:  # by runs of one label
             lab = labels[y, x]
-            size[lab] += 1
-            if strong[y, x]:
-                bright[lab] += 1
-    keep = ((bright >= min_strong) | (size >= min_size)) & (size >= min_region)
-    keep[0] = False
-    out = np.empty((h, w), np.bool_)
-    for y in prange(h):
-        for x in range(w):
-            out[y, x] = strong[y, x] or (weak[y, x] and keep[labels[y, x]])
-    return out
+            x1 = x + 1
+            while x1 < w and labels[y, x1] == lab:
+                x1 += 1
+            size[lab] += x1 - x
+            x = x1
+    remap = np.zeros(n + 1, np.int32)
+    kept = 0
+    for lab in range(1, n + 1):
+        if size[lab] >= min_size:
+            kept += 1
+            remap[lab] = kept
+    if kept < n:
+        for y in range(h):
+            for x in range(w):
+                labels[y, x] = remap[labels[y, x]]
+    return kept

@@ -1,6 +1,6 @@
-"""Compiled passes of the paper's column scan (:mod:`bistair.codecs.bidirectional.paper`):
-the median filter down the columns, the runs of equal code in each column and the mode of
-the runs' orders per fringe, bit for bit the SciPy and NumPy they replace.
+"""Compiled passes of the paper's column scan (:mod:`.paper`): the median filter down the
+columns, the runs of equal code in each column and the mode of the runs' orders per fringe,
+bit for bit the SciPy and NumPy they replace.
 
 The passes read the images row by row (each thread a block of columns, one state per
 column), so that no transposed copy is made.
@@ -21,9 +21,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .kernels import _numba_called, kernel
+from ...core.jit import _numba_called, kernel
 
-prange = range  # numba's prange once the first kernel compiles
+prange = range  # numba's prange once the first kernel of this module compiles
+
 
 _BLOCK = 64  # columns per thread block in the column scans
 
