@@ -1,0 +1,486 @@
+"""Compiled passes of binocular matching (:mod:`bistair.geometry.stereo`): where each raw
+pixel lands on the rectified grid, maps resampled without mixing surfaces, the row search
+for equal phase, the left-right check and the points on the left camera's own grid.
+
+Each runs over image rows on every core; none has a NumPy twin (the row search has no
+one-pass NumPy form), so ``tests/test_stereo_jit.py`` checks them against exact answers.
+
+Examples
+--------
+>>> import numpy as np
+>>> dst = np.tile(np.arange(20, dtype=np.float32), (2, 1))  # phase = column
+>>> src = dst + np.float32(5.25)  # each value lies 5.25 columns on in dst
+>>> offset, status = match_rows(src[:, :10], dst, 0.0, 19.0)
+>>> offset[0, :3].tolist(), status[0, :3].tolist()
+([5.25, 5.25, 5.25], [1, 1, 1])
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..core.jit import _numba_inline, kernel
+
+prange = range  # numba's prange once the first kernel of this module compiles
+
+# status codes of match_rows and check_matches
+NO_PHASE, MATCHED, UNMATCHED, AMBIGUOUS, NOT_MONOTONIC, INCONSISTENT, OTHER_AXIS = range(7)
+
+
+@_numba_inline
+def _bilinear(values: np.ndarray, sx: float, sy: float, max_step: float) -> float:
+    """``values`` at ``(sx, sy)`` from the 2 x 2 pixels around it, NaN when one of those it
+    needs is NaN or outside, or when they spread over more than ``max_step``."""
+    if not (sx >= 0.0 and sy >= 0.0):  # also NaN
+        return math.nan
+    h, w = values.shape
+    x0, y0 = int(sx), int(sy)
+    fx, fy = sx - x0, sy - y0
+    x1 = x0 + 1 if fx > 0.0 else x0
+    y1 = y0 + 1 if fy > 0.0 else y0
+    if x1 >= w or y1 >= h:
+        return math.nan
+    a, b = float(values[y0, x0]), float(values[y0, x1])
+    c, d = float(values[y1, x0]), float(values[y1, x1])
+    if a != a or b != b or c != c or d != d:
+        return math.nan
+    if max(max(a, b), max(c, d)) - min(min(a, b), min(c, d)) > max_step:
+        return math.nan
+    return (a * (1.0 - fx) + b * fx) * (1.0 - fy) + (c * (1.0 - fx) + d * fx) * fy
+
+
+@kernel(parallel=True)
+def _remap(values: np.ndarray, map_x: np.ndarray, map_y: np.ndarray,
+           max_step: float) -> np.ndarray:
+    h, w = map_x.shape
+    out = np.empty((h, w), np.float32)
+    for y in prange(h):
+        for x in range(w):
+            out[y, x] = _bilinear(values, map_x[y, x], map_y[y, x], max_step)
+    return out
+
+
+def remap_valid(values: np.ndarray, map_x: np.ndarray, map_y: np.ndarray,
+                max_step: float) -> np.ndarray:
+    """Resample ``values`` at ``(map_x, map_y)`` bilinearly, NaN where a needed neighbour is
+    NaN or off the image or where the 2 x 2 neighbours spread over more than ``max_step``
+    (two surfaces: never a value between them).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(H, W)`` float map, NaN where invalid.
+    map_x, map_y : numpy.ndarray
+        ``(h, w)`` float32 source positions (pixel centres at integers).
+    max_step : float
+        Largest spread of the neighbours interpolated between.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(h, w)`` float32.
+
+    Examples
+    --------
+    >>> v = np.float32([[0, 1, 2], [10, 11, np.nan]])
+    >>> remap_valid(v, np.float32([[0.5, 1.5]]), np.float32([[0.0, 0.0]]), 2.0).tolist()
+    [[0.5, 1.5]]
+    >>> remap_valid(v, np.float32([[0.5, 1.5]]), np.float32([[0.5, 0.5]]), 20.0).tolist()
+    [[5.5, nan]]
+    >>> remap_valid(v, np.float32([[0.5]]), np.float32([[0.5]]), 2.0).tolist()  # 0 .. 11
+    [[nan]]
+    """
+    return _remap(np.ascontiguousarray(values, np.float32), np.asarray(map_x, np.float32),
+                  np.asarray(map_y, np.float32), float(max_step))
+
+
+@kernel(parallel=True)
+def _positions(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, cx: float,
+               cy: float, h: int, w: int) -> tuple[np.ndarray, np.ndarray]:
+    u = np.empty((h, w), np.float32)
+    v = np.empty((h, w), np.float32)
+    k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
+    for row in prange(h):
+        yd = (row - k[1, 2]) / k[1, 1]
+        for col in range(w):
+            xd = (col - k[0, 2] - k[0, 1] * yd) / k[0, 0]
+            x, y = xd, yd
+            for _ in range(30):  # Newton on OpenCV's distortion
+                r2 = x * x + y * y
+                radial = 1.0 + r2 * (k1 + r2 * (k2 + r2 * k3))
+                drad = k1 + r2 * (2.0 * k2 + 3.0 * k3 * r2)
+                ex = x * radial + 2.0 * p1 * x * y + p2 * (r2 + 2.0 * x * x) - xd
+                ey = y * radial + p1 * (r2 + 2.0 * y * y) + 2.0 * p2 * x * y - yd
+                if abs(ex) < 1e-15 and abs(ey) < 1e-15:
+                    break
+                a = radial + 2.0 * x * x * drad + 2.0 * p1 * y + 6.0 * p2 * x
+                b = 2.0 * x * y * drad + 2.0 * p1 * x + 2.0 * p2 * y
+                d = radial + 2.0 * y * y * drad + 6.0 * p1 * y + 2.0 * p2 * x
+                det = a * d - b * b
+                x -= (d * ex - b * ey) / det
+                y -= (a * ey - b * ex) / det
+            rz = rot[2, 0] * x + rot[2, 1] * y + rot[2, 2]
+            if rz > 0.0:
+                u[row, col] = f * (rot[0, 0] * x + rot[0, 1] * y + rot[0, 2]) / rz + cx
+                v[row, col] = f * (rot[1, 0] * x + rot[1, 1] * y + rot[1, 2]) / rz + cy
+            else:
+                u[row, col] = np.nan
+                v[row, col] = np.nan
+    return u, v
+
+
+def rectified_positions(K: np.ndarray, dist: np.ndarray, rotation: np.ndarray, f: float,
+                        cx: float, cy: float, size: tuple[int, int]
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """Where every pixel of a camera image lands on its rectified grid: the pixel's ray
+    (undistorted exactly, Newton steps), turned by ``rotation`` and projected with focal
+    length ``f`` and principal point ``(cx, cy)``.
+
+    Parameters
+    ----------
+    K : numpy.ndarray
+        3 x 3 intrinsic matrix.
+    dist : numpy.ndarray
+        ``(k1, k2, p1, p2, k3)``.
+    rotation : numpy.ndarray
+        3 x 3 rectifying rotation (``R1`` or ``R2`` of ``cv2.stereoRectify``).
+    f, cx, cy : float
+        The rectified grid's focal length and principal point (pixels).
+    size : tuple of int
+        ``(width, height)`` of the camera image.
+
+    Returns
+    -------
+    u, v : numpy.ndarray
+        ``(height, width)`` float32 rectified coordinates (NaN behind the rectified view).
+
+    Examples
+    --------
+    >>> K = np.array([[100.0, 0, 2], [0, 100, 1], [0, 0, 1]])
+    >>> u, v = rectified_positions(K, np.zeros(5), np.eye(3), 200.0, 10.0, 5.0, (4, 3))
+    >>> u[1].tolist(), v[:, 0].tolist()
+    ([6.0, 8.0, 10.0, 12.0], [3.0, 5.0, 7.0])
+    """
+    width, height = size
+    return _positions(np.asarray(K, np.float64), np.asarray(dist, np.float64).ravel()[:5],
+                      np.asarray(rotation, np.float64), float(f), float(cx), float(cy),
+                      int(height), int(width))
+
+
+@_numba_inline
+def _first_at_least(arr: np.ndarray, a: int, b: int, q: float) -> int:
+    """The first index in ``[a, b)`` of the non-decreasing ``arr`` with ``arr >= q``
+    (``b`` if none)."""
+    lo, hi = a, b
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if arr[mid] >= q:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo
+
+
+@kernel(parallel=True)
+def _match(src: np.ndarray, dst: np.ndarray, lo: float, hi: float, gap: int,
+           wiggle: float) -> tuple[np.ndarray, np.ndarray]:
+    h, w = src.shape
+    wd = dst.shape[1]
+    offset = np.full((h, w), np.nan, np.float32)
+    status = np.zeros((h, w), np.int8)
+    for y in prange(h):
+        xs = np.empty(wd, np.int64)
+        vs = np.empty(wd, np.float64)
+        n = 0
+        for x in range(wd):
+            value = dst[y, x]
+            if value == value:
+                xs[n] = x
+                vs[n] = value
+                n += 1
+        # runs: valid samples at most `gap` columns apart; prefix max and suffix min
+        begins = np.empty(n // 2 + 1, np.int64)
+        ends = np.empty(n // 2 + 1, np.int64)
+        pmax = np.empty(n, np.float64)
+        smin = np.empty(n, np.float64)
+        runs = 0
+        k = 0
+        while k < n:
+            e = k + 1
+            while e < n and xs[e] - xs[e - 1] <= gap:
+                e += 1
+            if e - k >= 2:
+                begins[runs] = k
+                ends[runs] = e
+                runs += 1
+                pmax[k] = vs[k]
+                for i in range(k + 1, e):
+                    pmax[i] = max(pmax[i - 1], vs[i])
+                smin[e - 1] = vs[e - 1]
+                for i in range(e - 2, k - 1, -1):
+                    smin[i] = min(smin[i + 1], vs[i])
+            k = e
+        for x in range(w):
+            q = src[y, x]
+            if q != q:
+                continue
+            xlo, xhi = x + lo, x + hi
+            found, bad, best = 0, False, 0.0
+            for r in range(runs):
+                a, b = begins[r], ends[r]
+                if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] < q <= vs[b - 1]):
+                    continue
+                i = _first_at_least(pmax, a, b, q)  # first upward crossing in (i-1, i]
+                j = _first_at_least(smin, a, b, q) - 1  # last one in (j, j+1]
+                x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
+                x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
+                mid = 0.5 * (x1 + x2)
+                if mid < xlo or mid > xhi:
+                    continue
+                found += 1
+                best = mid
+                if x2 - x1 > wiggle:
+                    bad = True
+            if found == 0:
+                status[y, x] = UNMATCHED
+            elif found > 1:
+                status[y, x] = AMBIGUOUS
+            elif bad:
+                status[y, x] = NOT_MONOTONIC
+            else:
+                status[y, x] = MATCHED
+                offset[y, x] = best - x
+    return offset, status
+
+
+def match_rows(src: np.ndarray, dst: np.ndarray, lo: float, hi: float, gap: int = 3,
+               wiggle: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """For every valid pixel of ``src``, the position on the same row of ``dst`` where the
+    phase takes the pixel's value, as an offset ``x_dst - x_src`` within ``[lo, hi]``.
+
+    ``dst``'s row is read as runs of valid pixels at most ``gap`` columns apart (a longer
+    gap ends a run: no value is read across it). A run gives a match when its ends bracket
+    the value with the phase rising (first below it, last at or above it): the match lies
+    between the first and the last crossing of the value, linearly interpolated between
+    the two valid neighbours around each; they must lie within ``wiggle`` px of each other
+    (the phase runs monotonically there, up to noise) and the match is their midpoint. A
+    value that two runs give in the window is ambiguous: no match. Phases must rise along
+    the rows (negate both for phases that fall).
+
+    Parameters
+    ----------
+    src, dst : numpy.ndarray
+        ``(h, w_src)`` and ``(h, w_dst)`` float32 phases (or projector coordinates) on
+        rectified grids whose rows are the same epipolar lines; NaN where invalid.
+    lo, hi : float
+        The search window of offsets.
+    gap : int, optional
+        Largest column step between valid neighbours interpolated between.
+    wiggle : float, optional
+        Largest distance (px) between the first and last crossing of a run.
+
+    Returns
+    -------
+    offset : numpy.ndarray
+        ``(h, w_src)`` float32, NaN without a match.
+    status : numpy.ndarray
+        ``(h, w_src)`` int8: :data:`NO_PHASE`, :data:`MATCHED`, :data:`UNMATCHED`,
+        :data:`AMBIGUOUS` or :data:`NOT_MONOTONIC`.
+
+    Examples
+    --------
+    >>> dst = np.float32([[0, 1, 2, np.nan, np.nan, np.nan, np.nan, 3, 4, 5]])
+    >>> offset, status = match_rows(np.float32([[1.5, 2.5, 3.5]]), dst, -5.0, 10.0)
+    >>> offset.tolist(), status.tolist()  # 2.5 lies in a gap of 5 columns
+    ([[1.5, nan, 5.5]], [[1, 2, 1]])
+    >>> twice = np.float32([[0, 1, 2, 3, 0, 1, 2, 3]])  # the phase falls back in one run
+    >>> match_rows(np.float32([[1.5]]), twice, 0.0, 7.0)[1].tolist()  # NOT_MONOTONIC
+    [[4]]
+    >>> apart = np.float32([[0, 1, 2, 3] + [np.nan] * 4 + [0, 1, 2, 3]])  # two runs
+    >>> match_rows(np.float32([[1.5]]), apart, 0.0, 11.0)[1].tolist()  # AMBIGUOUS
+    [[3]]
+    """
+    return _match(np.ascontiguousarray(src, np.float32), np.ascontiguousarray(dst, np.float32),
+                  float(lo), float(hi), int(gap), float(wiggle))
+
+
+@_numba_inline
+def _along(row: np.ndarray, x: float) -> float:
+    """``row`` at ``x``, linear between its two neighbours (NaN if one it needs is)."""
+    if not x >= 0.0:
+        return math.nan
+    x0 = int(x)
+    f = x - x0
+    if f > 0.0:
+        if x0 + 1 >= row.shape[0]:
+            return math.nan
+        a, b = float(row[x0]), float(row[x0 + 1])
+        return a + f * (b - a)
+    if x0 >= row.shape[0]:
+        return math.nan
+    return float(row[x0])
+
+
+@kernel(parallel=True)
+def _check(offset: np.ndarray, status: np.ndarray, back: np.ndarray, other: np.ndarray,
+           other_back: np.ndarray, tolerance: float, other_tolerance: float,
+           shift: float) -> tuple[np.ndarray, np.ndarray]:
+    h, w = offset.shape
+    both = other.shape[0] > 0
+    disparity = np.full((h, w), np.nan, np.float32)
+    out = status.copy()
+    for y in prange(h):
+        for x in range(w):
+            if status[y, x] != MATCHED:
+                continue
+            xm = x + offset[y, x]
+            again = _along(back[y], xm)
+            if not abs(xm + again - x) <= tolerance:  # NaN included
+                out[y, x] = INCONSISTENT
+                continue
+            if both:
+                a, b = other[y, x], _along(other_back[y], xm)
+                if a == a and b == b and abs(a - b) > other_tolerance:
+                    out[y, x] = OTHER_AXIS
+                    continue
+            disparity[y, x] = -offset[y, x] - shift
+    return disparity, out
+
+
+def check_matches(offset: np.ndarray, status: np.ndarray, back: np.ndarray,
+                  tolerance: float = 1.0, other: np.ndarray | None = None,
+                  other_back: np.ndarray | None = None, other_tolerance: float = 2.0,
+                  shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Keep the matches of :func:`match_rows` that the match back confirms and, with a
+    second coordinate, that agree on it; return them as disparities.
+
+    A match from ``x`` to ``x' = x + offset`` holds when the match back from ``x'`` (the
+    offsets ``back`` of the other image, linear between its neighbours at ``x'``) returns
+    within ``tolerance`` px of ``x``, and, where both images have the second coordinate
+    (``other`` at ``x``, ``other_back`` at ``x'``), the two differ by at most
+    ``other_tolerance``.
+
+    Parameters
+    ----------
+    offset, status : numpy.ndarray
+        ``(h, w)`` from :func:`match_rows` (this image into the other).
+    back : numpy.ndarray
+        ``(h, w_other)`` offsets of the other image into this one.
+    tolerance : float, optional
+        Pixels the round trip may miss by.
+    other, other_back : numpy.ndarray or None, optional
+        The second coordinate on both rectified grids (NaN where not decoded).
+    other_tolerance : float, optional
+        Largest difference of the second coordinate.
+    shift : float, optional
+        ``disparity = -offset - shift`` (the difference of the grids' principal points).
+
+    Returns
+    -------
+    disparity : numpy.ndarray
+        ``(h, w)`` float32, NaN where there is no confirmed match.
+    status : numpy.ndarray
+        ``status`` with :data:`INCONSISTENT` and :data:`OTHER_AXIS` where matches failed.
+
+    Examples
+    --------
+    >>> offset = np.float32([[-2.0, -2.0]])
+    >>> ok = np.int8([[MATCHED, MATCHED]])
+    >>> back = np.float32([[2.0, 2.0, 2.0]])  # both come back from x - 2 ... off the image
+    >>> d, s = check_matches(offset + np.float32([[2.0, 1.0]]), ok, back)
+    >>> d.tolist(), s.tolist()
+    ([[nan, 1.0]], [[5, 1]])
+    """
+    empty = np.zeros((0, 0), np.float32)
+    return _check(np.ascontiguousarray(offset, np.float32), np.ascontiguousarray(status),
+                  np.ascontiguousarray(back, np.float32),
+                  empty if other is None else np.ascontiguousarray(other, np.float32),
+                  empty if other_back is None else np.ascontiguousarray(other_back,
+                                                                        np.float32),
+                  float(tolerance), float(other_tolerance), float(shift))
+
+
+@kernel(parallel=True)
+def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
+            cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
+            max_step: float) -> tuple[np.ndarray, int]:
+    h, w = u.shape
+    points = np.empty((h, w, 3), np.float32)
+    outside = np.zeros(h, np.int64)
+    for y in prange(h):
+        for x in range(w):
+            points[y, x, 0] = np.nan
+            points[y, x, 1] = np.nan
+            points[y, x, 2] = np.nan
+            if not valid[y, x]:
+                continue
+            d = _bilinear(disparity, u[y, x], v[y, x], max_step)
+            if not d * tx < 0.0:  # NaN, or behind the cameras
+                continue
+            zr = -f * tx / d
+            xr, yr = (u[y, x] - cx) * zr / f, (v[y, x] - cy) * zr / f
+            z = rt[2, 0] * xr + rt[2, 1] * yr + rt[2, 2] * zr
+            if not zmin <= z <= zmax:
+                outside[y] += 1
+                continue
+            points[y, x, 0] = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
+            points[y, x, 1] = rt[1, 0] * xr + rt[1, 1] * yr + rt[1, 2] * zr
+            points[y, x, 2] = z
+    return points, outside.sum()
+
+
+def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
+                f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
+                min_depth: float = 0.0, max_depth: float = math.inf,
+                max_step: float = 2.0) -> tuple[np.ndarray, int]:
+    """3-D points on a camera's own image grid from the disparity on its rectified grid.
+
+    Each valid pixel reads the disparity ``d`` at its rectified position ``(u, v)``
+    (bilinear between four confirmed disparities that spread by at most ``max_step``),
+    triangulates in the rectified frame (``Z = -f * tx / d``) and turns the point back into
+    the camera frame (``rotation`` is the rectifying rotation, ``R1``).
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(h, w)`` float32 on the rectified grid, NaN where unknown.
+    u, v : numpy.ndarray
+        ``(H, W)`` rectified positions of the camera's pixels
+        (:func:`rectified_positions`).
+    valid : numpy.ndarray
+        ``(H, W)`` bool: pixels that decoded (the others stay NaN).
+    f, cx, cy : float
+        The rectified grid's focal length and principal point.
+    tx : float
+        The other camera's x in the rectified frame (mm; ``-baseline`` for a camera to the
+        right).
+    rotation : numpy.ndarray
+        The rectifying rotation of this camera.
+    min_depth, max_depth : float, optional
+        Depths ``z`` (camera frame) kept.
+    max_step : float, optional
+        Largest spread of the disparities interpolated between.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(H, W, 3)`` float32 in the camera frame (mm), NaN where unknown.
+    outside : int
+        Pixels triangulated but outside the depth range.
+
+    Examples
+    --------
+    >>> d = np.full((3, 4), 20.0, np.float32)  # f = 100, baseline 60 mm: 300 mm away
+    >>> u, v = np.float32([[1.0, 2.5]]), np.float32([[1.0, 1.0]])
+    >>> pts, out = grid_points(d, u, v, np.ones((1, 2), bool), 100.0, 1.0, 1.0, -60.0,
+    ...                        np.eye(3))
+    >>> pts.round(3).tolist(), out
+    ([[[0.0, 0.0, 300.0], [4.5, 0.0, 300.0]]], 0)
+    """
+    return _points(np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
+                   np.asarray(v, np.float32), np.asarray(valid, np.bool_), float(f),
+                   float(cx), float(cy), float(tx),
+                   np.ascontiguousarray(np.asarray(rotation, np.float64).T),
+                   float(min_depth), float(max_depth), float(max_step))
