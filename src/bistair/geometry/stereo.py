@@ -52,6 +52,7 @@ from ..spec import BaseSpec
 from .calibration import Calibration, Device
 from .stereo_calibration import StereoCalibration, load_stereo_calibration
 from .stereo_jit import (
+    ALONE,
     AMBIGUOUS,
     INCONSISTENT,
     MATCHED,
@@ -63,6 +64,7 @@ from .stereo_jit import (
     match_rows,
     rectified_positions,
     remap_valid,
+    supported,
 )
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
@@ -226,7 +228,8 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                        rectification: Rectification | None = None, min_depth: float = 0.0,
                        max_depth: float = math.inf, tolerance: float = 1.0,
                        other_tolerance: float = 2.0, gap: int = 3, wiggle: float = 1.0,
-                       offset: float = 0.5, force: bool = False) -> StereoResult:
+                       support: float = 2.0, offset: float = 0.5,
+                       force: bool = False) -> StereoResult:
     """Match two cameras' decodes of the same patterns and triangulate (module docstring).
 
     Parameters
@@ -292,24 +295,27 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     low, high = rect.disparities(min_depth, max_depth)
     high = min(high, 4.0 * max(rect.size_left))  # farther than any image: same window
     low = max(low, -4.0 * max(rect.size_left))
-    off_l, st_l = match_rows(src, dst, -high - rect.shift, -low - rect.shift, gap, wiggle)
-    off_r, _ = match_rows(dst, src, low + rect.shift, high + rect.shift, gap, wiggle)
+    jump = spread[axis]
+    off_l, st_l = match_rows(src, dst, -high - rect.shift, -low - rect.shift, gap, wiggle, jump)
+    off_r, _ = match_rows(dst, src, low + rect.shift, high + rect.shift, gap, wiggle, jump)
     other = [name for name in on_grid if name != axis]
     pair = on_grid[other[0]] if other else (None, None)
     disparity, status = check_matches(off_l, st_l, off_r, tolerance, *pair,
                                       other_tolerance=other_tolerance, shift=rect.shift)
+    disparity, status = supported(disparity, status, support)
     decoded = np.isfinite(coords[axis][0])
     points, outside = grid_points(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
                                   rect.cy, rect.tx, rect.R1, min_depth, max_depth)
     depth = points[..., 2].copy()
     mask = np.isfinite(depth)
-    counts = np.bincount(status.ravel(), minlength=7)
+    counts = np.bincount(status.ravel(), minlength=8)
     info: dict[str, Any] = {
         "left_decoded": int(decoded.sum()), "matched": int(mask.sum()),
         "matched_fraction": round(float(mask.sum() / max(decoded.sum(), 1)), 6),
         "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
         "not_monotonic": int(counts[NOT_MONOTONIC]),
         "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
+        "alone": int(counts[ALONE]),
         "rectified_matches": int(counts[MATCHED]), "outside_range": int(outside),
         "matched_axis": axis,
         "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
@@ -317,7 +323,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                       "cx_right": rect.cx_right, "tx": rect.tx,
                       "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
         "tolerance_px": tolerance, "other_tolerance": other_tolerance, "gap_px": gap,
-        "wiggle_px": wiggle, "warnings": []}
+        "wiggle_px": wiggle, "support_px": support, "warnings": []}
     share = info["matched_fraction"]
     if share < MIN_MATCHED:
         message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
@@ -355,11 +361,11 @@ def _step(coord: np.ndarray) -> float:
     c = coord[:-1:4, :-1:4], coord[1::4, :-1:4], coord[:-1:4, 1::4], coord[1::4, 1::4]
     h = min(a.shape[0] for a in c)
     w = min(a.shape[1] for a in c)
-    block = np.stack([a[:h, :w] for a in c])
-    with np.errstate(invalid="ignore"):
-        spread = np.nanmax(block, axis=0) - np.nanmin(block, axis=0) if block.size else block
-    ok = np.isfinite(block).all(axis=0) if block.size else np.zeros(0, bool)
-    return max(1.0, 4.0 * float(np.median(spread[ok]))) if ok.any() else 1.0
+    block = np.stack([a[:h, :w] for a in c]).reshape(4, -1)
+    block = block[:, np.isfinite(block).all(axis=0)]
+    if not block.shape[1]:
+        return 1.0
+    return max(1.0, 4.0 * float(np.median(block.max(axis=0) - block.min(axis=0))))
 
 
 def _matched_axis(on_grid: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[str, float]:
