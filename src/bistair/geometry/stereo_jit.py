@@ -10,9 +10,9 @@ Examples
 >>> import numpy as np
 >>> dst = np.tile(np.arange(20, dtype=np.float32), (2, 1))  # phase = column
 >>> src = dst + np.float32(5.25)  # each value lies 5.25 columns on in dst
->>> offset, status = match_rows(src[:, :10], dst, 0.0, 19.0)
->>> offset[0, :3].tolist(), status[0, :3].tolist()
-([5.25, 5.25, 5.25], [1, 1, 1])
+>>> disparity, status = match_pair(src[:, :10], dst, 0.0, 19.0)
+>>> disparity[0, :3].tolist(), status[0, :3].tolist()
+([-5.25, -5.25, -5.25], [1, 1, 1])
 """
 
 from __future__ import annotations
@@ -170,10 +170,24 @@ def rectified_positions(K: np.ndarray, dist: np.ndarray, rotation: np.ndarray, f
 
 
 @_numba_inline
-def _first_at_least(arr: np.ndarray, a: int, b: int, q: float) -> int:
-    """The first index in ``[a, b)`` of the non-decreasing ``arr`` with ``arr >= q``
-    (``b`` if none)."""
-    lo, hi = a, b
+def _first_at_least(arr: np.ndarray, a: int, b: int, q: float, hint: int) -> int:
+    """The first index in ``[a, b)`` of the non-decreasing ``arr`` with ``arr >= q`` (``b``
+    if none), searched from ``hint`` outward in doubling steps (the answer is usually a
+    step or two from the last one), then by halving."""
+    lo, hi = a, b  # arr[lo - 1] < q (or lo == a), arr[hi] >= q (or hi == b)
+    step = 1
+    if hint < b and arr[hint] >= q:
+        hi = hint
+        while hi - step >= a and arr[hi - step] >= q:
+            hi -= step
+            step *= 2
+        lo = max(a, hi - step + 1)
+    else:
+        lo = hint + 1
+        while lo + step - 1 < b and arr[lo + step - 1] < q:
+            lo += step
+            step *= 2
+        hi = min(b, lo + step - 1)
     while lo < hi:
         mid = (lo + hi) // 2
         if arr[mid] >= q:
@@ -187,158 +201,19 @@ def _first_at_least(arr: np.ndarray, a: int, b: int, q: float) -> int:
 def _fit_crossing(xs: np.ndarray, vs: np.ndarray, a: int, b: int, q: float,
                   fallback: float) -> float:
     """Where the least-squares line through the samples ``[a, b)`` takes ``q``."""
+    x0 = float(xs[a])
+    sx, sv, sxx, sxv = 0.0, 0.0, 0.0, 0.0
+    for k in range(a, b):
+        dx, v = xs[k] - x0, vs[k]
+        sx += dx
+        sv += v
+        sxx += dx * dx
+        sxv += dx * v
     n = b - a
-    mx, mv = 0.0, 0.0
-    for k in range(a, b):
-        mx += xs[k]
-        mv += vs[k]
-    mx /= n
-    mv /= n
-    sxx, sxv = 0.0, 0.0
-    for k in range(a, b):
-        sxx += (xs[k] - mx) * (xs[k] - mx)
-        sxv += (xs[k] - mx) * (vs[k] - mv)
-    if not sxv > 0.0:
+    cov = n * sxv - sx * sv
+    if not cov > 0.0:
         return fallback
-    return mx + (q - mv) * sxx / sxv
-
-
-@kernel(parallel=True)
-def _match(src: np.ndarray, dst: np.ndarray, lo: float, hi: float, gap: int,
-           wiggle: float, jump: float, reach: int) -> tuple[np.ndarray, np.ndarray]:
-    h, w = src.shape
-    wd = dst.shape[1]
-    offset = np.full((h, w), np.nan, np.float32)
-    status = np.zeros((h, w), np.int8)
-    for y in prange(h):
-        xs = np.empty(wd, np.int64)
-        vs = np.empty(wd, np.float64)
-        n = 0
-        for x in range(wd):
-            value = dst[y, x]
-            if value == value:
-                xs[n] = x
-                vs[n] = value
-                n += 1
-        # runs: valid samples at most `gap` columns and `jump` per column apart; their
-        # prefix max and suffix min
-        begins = np.empty(n // 2 + 1, np.int64)
-        ends = np.empty(n // 2 + 1, np.int64)
-        pmax = np.empty(n, np.float64)
-        smin = np.empty(n, np.float64)
-        runs = 0
-        k = 0
-        while k < n:
-            e = k + 1
-            while e < n and xs[e] - xs[e - 1] <= gap and (
-                    abs(vs[e] - vs[e - 1]) <= jump * (xs[e] - xs[e - 1])):
-                e += 1
-            if e - k >= 2:
-                begins[runs] = k
-                ends[runs] = e
-                runs += 1
-                pmax[k] = vs[k]
-                for i in range(k + 1, e):
-                    pmax[i] = max(pmax[i - 1], vs[i])
-                smin[e - 1] = vs[e - 1]
-                for i in range(e - 2, k - 1, -1):
-                    smin[i] = min(smin[i + 1], vs[i])
-            k = e
-        for x in range(w):
-            q = src[y, x]
-            if q != q:
-                continue
-            xlo, xhi = x + lo, x + hi
-            found, bad, best = 0, False, 0.0
-            for r in range(runs):
-                a, b = begins[r], ends[r]
-                if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] < q <= vs[b - 1]):
-                    continue
-                i = _first_at_least(pmax, a, b, q)  # first upward crossing in (i-1, i]
-                j = _first_at_least(smin, a, b, q) - 1  # last one in (j, j+1]
-                x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
-                x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
-                mid = 0.5 * (x1 + x2)
-                if reach > 1 and i == j + 1 and i - reach >= a and j + reach < b:
-                    mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, mid)
-                if mid < xlo or mid > xhi:
-                    continue
-                found += 1
-                best = mid
-                if x2 - x1 > wiggle:
-                    bad = True
-            if found == 0:
-                status[y, x] = UNMATCHED
-            elif found > 1:
-                status[y, x] = AMBIGUOUS
-            elif bad:
-                status[y, x] = NOT_MONOTONIC
-            else:
-                status[y, x] = MATCHED
-                offset[y, x] = best - x
-    return offset, status
-
-
-def match_rows(src: np.ndarray, dst: np.ndarray, lo: float, hi: float, gap: int = 3,
-               wiggle: float = 1.0, jump: float = math.inf, reach: int = 2
-               ) -> tuple[np.ndarray, np.ndarray]:
-    """For every valid pixel of ``src``, the position on the same row of ``dst`` where the
-    phase takes the pixel's value, as an offset ``x_dst - x_src`` within ``[lo, hi]``.
-
-    ``dst``'s row is read as runs of valid pixels at most ``gap`` columns apart whose
-    values change by at most ``jump`` per column (a longer gap or a larger step, two
-    surfaces, ends a run: no value is read across it). A run gives a match when its ends bracket
-    the value with the phase rising (first below it, last at or above it): the match lies
-    between the first and the last crossing of the value, linearly interpolated between
-    the two valid neighbours around each; they must lie within ``wiggle`` px of each other
-    (the phase runs monotonically there, up to noise) and the match is their midpoint.
-    Where the phase rises through the value once and the run holds ``reach - 1`` more
-    samples on either side, the match is where the least-squares line through those
-    ``2 * reach`` samples takes the value (less noisy than two samples: ``reach = 2``
-    brings the disparity noise of a 4-step decode down by about 7%). A value that two runs
-    give in the window is ambiguous: no match. Phases must rise along
-    the rows (negate both for phases that fall).
-
-    Parameters
-    ----------
-    src, dst : numpy.ndarray
-        ``(h, w_src)`` and ``(h, w_dst)`` float32 phases (or projector coordinates) on
-        rectified grids whose rows are the same epipolar lines; NaN where invalid.
-    lo, hi : float
-        The search window of offsets.
-    gap : int, optional
-        Largest column step between valid neighbours interpolated between.
-    wiggle : float, optional
-        Largest distance (px) between the first and last crossing of a run.
-    jump : float, optional
-        Largest change of the value per column between neighbours of a run.
-    reach : int, optional
-        Samples on each side of a single crossing fitted with a line (1: the two
-        neighbours only, plain linear interpolation).
-
-    Returns
-    -------
-    offset : numpy.ndarray
-        ``(h, w_src)`` float32, NaN without a match.
-    status : numpy.ndarray
-        ``(h, w_src)`` int8: :data:`NO_PHASE`, :data:`MATCHED`, :data:`UNMATCHED`,
-        :data:`AMBIGUOUS` or :data:`NOT_MONOTONIC`.
-
-    Examples
-    --------
-    >>> dst = np.float32([[0, 1, 2, np.nan, np.nan, np.nan, np.nan, 3, 4, 5]])
-    >>> offset, status = match_rows(np.float32([[1.5, 2.5, 3.5]]), dst, -5.0, 10.0)
-    >>> offset.tolist(), status.tolist()  # 2.5 lies in a gap of 5 columns
-    ([[1.5, nan, 5.5]], [[1, 2, 1]])
-    >>> twice = np.float32([[0, 1, 2, 3, 0, 1, 2, 3]])  # the phase falls back in one run
-    >>> match_rows(np.float32([[1.5]]), twice, 0.0, 7.0)[1].tolist()  # NOT_MONOTONIC
-    [[4]]
-    >>> apart = np.float32([[0, 1, 2, 3] + [np.nan] * 4 + [0, 1, 2, 3]])  # two runs
-    >>> match_rows(np.float32([[1.5]]), apart, 0.0, 11.0)[1].tolist()  # AMBIGUOUS
-    [[3]]
-    """
-    return _match(np.ascontiguousarray(src, np.float32), np.ascontiguousarray(dst, np.float32),
-                  float(lo), float(hi), int(gap), float(wiggle), float(jump), int(reach))
+    return x0 + (sx + (n * q - sv) * (n * sxx - sx * sx) / cov) / n
 
 
 @_numba_inline
@@ -358,30 +233,209 @@ def _along(row: np.ndarray, x: float) -> float:
     return float(row[x0])
 
 
+
+@_numba_inline
+def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray,
+          begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
+          hints: np.ndarray) -> int:
+    """The runs of a row (valid samples at most ``gap`` columns and ``jump`` per column
+    apart, two samples at least): their samples ``xs, vs``, bounds, prefix maxima and
+    suffix minima; returns how many."""
+    n = 0
+    for x in range(row.shape[0]):
+        value = row[x]
+        if value == value:
+            xs[n] = x
+            vs[n] = value
+            n += 1
+    runs = 0
+    k = 0
+    while k < n:
+        e = k + 1
+        while e < n and xs[e] - xs[e - 1] <= gap and (
+                abs(vs[e] - vs[e - 1]) <= jump * (xs[e] - xs[e - 1])):
+            e += 1
+        if e - k >= 2:
+            begins[runs] = k
+            ends[runs] = e
+            hints[runs, 0] = k
+            hints[runs, 1] = k
+            runs += 1
+            pmax[k] = vs[k]
+            for i in range(k + 1, e):
+                pmax[i] = max(pmax[i - 1], vs[i])
+            smin[e - 1] = vs[e - 1]
+            for i in range(e - 2, k - 1, -1):
+                smin[i] = min(smin[i + 1], vs[i])
+        k = e
+    return runs
+
+
+@_numba_inline
+def _find(q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
+          begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
+          hints: np.ndarray, runs: int, wiggle: float, reach: int) -> tuple[int, float]:
+    """``(status, position)`` of the value ``q`` on a row's runs within ``[xlo, xhi]``."""
+    found, bad, best = 0, False, math.nan
+    for r in range(runs):
+        a, b = begins[r], ends[r]
+        if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] <= q <= vs[b - 1]):
+            continue
+        i = _first_at_least(pmax, a, b, q, hints[r, 0])  # first crossing in (i-1, i]
+        j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
+        hints[r, 0] = i
+        hints[r, 1] = j + 1
+        x1, x2 = float(xs[a]), float(xs[a])  # q is the run's first value
+        if i > a:
+            x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
+        if j >= a:
+            x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
+        mid = 0.5 * (x1 + x2)
+        if reach > 1 and i == j + 1 and i - reach >= a and j + reach < b:
+            mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, mid)
+        if mid < xlo or mid > xhi:
+            continue
+        found += 1
+        best = mid
+        if x2 - x1 > wiggle:
+            bad = True
+    if found == 0:
+        return UNMATCHED, math.nan
+    if found > 1:
+        return AMBIGUOUS, math.nan
+    return (NOT_MONOTONIC, math.nan) if bad else (MATCHED, best)
+
+
 @kernel(parallel=True)
-def _check(offset: np.ndarray, status: np.ndarray, back: np.ndarray, other: np.ndarray,
-           other_back: np.ndarray, tolerance: float, other_tolerance: float,
-           shift: float) -> tuple[np.ndarray, np.ndarray]:
-    h, w = offset.shape
+def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float,
+          tolerance: float, gap: int, wiggle: float, jump: float, reach: int,
+          other: np.ndarray, other_right: np.ndarray, other_tolerance: float
+          ) -> tuple[np.ndarray, np.ndarray]:
+    h, w = left.shape
+    wr = right.shape[1]
     both = other.shape[0] > 0
     disparity = np.full((h, w), np.nan, np.float32)
-    out = status.copy()
+    status = np.zeros((h, w), np.int8)
     for y in prange(h):
+        rxs, rvs = np.empty(wr, np.int64), np.empty(wr, np.float64)
+        rb, re = np.empty(wr // 2 + 1, np.int64), np.empty(wr // 2 + 1, np.int64)
+        rmax, rmin = np.empty(wr, np.float64), np.empty(wr, np.float64)
+        rhint = np.empty((wr // 2 + 1, 2), np.int64)
+        nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
+        lxs, lvs = np.empty(w, np.int64), np.empty(w, np.float64)
+        lb, le = np.empty(w // 2 + 1, np.int64), np.empty(w // 2 + 1, np.int64)
+        lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
+        lhint = np.empty((w // 2 + 1, 2), np.int64)
+        nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
         for x in range(w):
-            if status[y, x] != MATCHED:
+            q = left[y, x]
+            if q != q:
                 continue
-            xm = x + offset[y, x]
-            again = _along(back[y], xm)
-            if not abs(xm + again - x) <= tolerance:  # NaN included
-                out[y, x] = INCONSISTENT
+            found, xm = _find(q, x + lo, x + hi, rxs, rvs, rb, re, rmax, rmin, rhint, nr,
+                              wiggle, reach)
+            if found != MATCHED:
+                status[y, x] = found
+                continue
+            back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin, lhint, nl,
+                             wiggle, 1)
+            if back != MATCHED or not abs(xb - x) <= tolerance:
+                status[y, x] = INCONSISTENT
                 continue
             if both:
-                a, b = other[y, x], _along(other_back[y], xm)
+                a, b = other[y, x], _along(other_right[y], xm)
                 if a == a and b == b and abs(a - b) > other_tolerance:
-                    out[y, x] = OTHER_AXIS
+                    status[y, x] = OTHER_AXIS
                     continue
-            disparity[y, x] = -offset[y, x] - shift
-    return disparity, out
+            status[y, x] = MATCHED
+            disparity[y, x] = x - xm - shift
+    return disparity, status
+
+
+def match_pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float = 0.0,
+               tolerance: float = 1.0, gap: int = 3, wiggle: float = 1.0,
+               jump: float = math.inf, reach: int = 2, other: np.ndarray | None = None,
+               other_right: np.ndarray | None = None, other_tolerance: float = 2.0
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """For every valid pixel of the rectified ``left`` map, the position on the same row of
+    ``right`` where the value (phase, projector coordinate) is the pixel's own, checked by
+    the match back, as a disparity.
+
+    A row is read as runs of valid pixels at most ``gap`` columns apart whose values change
+    by at most ``jump`` per column (a longer gap or a larger step, two surfaces, ends a
+    run: no value is read across it). A run gives a match when its ends bracket the value
+    with the phase rising (first at or below it, last at or above it): the match lies
+    between the first and the last crossing of the value, linearly interpolated between the
+    two valid neighbours around each; they must lie within ``wiggle`` px of each other (the phase
+    runs monotonically there, up to noise) and the match is their midpoint. Where the
+    phase rises through the value once and the run holds ``reach - 1`` more samples on
+    either side, the match is where the least-squares line through those ``2 * reach``
+    samples takes the value (less noisy than two: ``reach = 2`` brings the disparity noise
+    of a 4-step decode down by about 7%). A value that two runs give in the search window
+    is ambiguous: no match.
+
+    The match ``x_r`` of a left pixel ``x`` (searched for in ``x_r - x`` in ``[lo, hi]``)
+    holds when searching the same value back on the left row (``x - x_r`` in
+    ``[-hi, -lo]``) finds one place, within ``tolerance`` px of ``x``; and where both maps
+    have a second coordinate (``other`` at ``x``, ``other_right`` at ``x_r``, linear
+    between neighbours), the two differ by at most ``other_tolerance``. Values must rise
+    along the rows (negate both maps for values that fall).
+
+    Parameters
+    ----------
+    left, right : numpy.ndarray
+        ``(h, w_left)`` and ``(h, w_right)`` float32 values on rectified grids whose rows are
+        the same epipolar lines; NaN where invalid.
+    lo, hi : float
+        The search window of ``x_r - x``.
+    shift : float, optional
+        ``disparity = x - x_r - shift`` (the difference of the grids' principal points).
+    tolerance : float, optional
+        Pixels the match back may miss ``x`` by.
+    gap : int, optional
+        Largest column step between valid neighbours interpolated between.
+    wiggle : float, optional
+        Largest distance (px) between the first and last crossing of a run.
+    jump : float, optional
+        Largest change of the value per column between neighbours of a run.
+    reach : int, optional
+        Samples on each side of a single crossing fitted with a line (1: the two
+        neighbours only, plain linear interpolation).
+    other, other_right : numpy.ndarray or None, optional
+        The second coordinate on both grids (NaN where not decoded).
+    other_tolerance : float, optional
+        Largest difference of the second coordinate.
+
+    Returns
+    -------
+    disparity : numpy.ndarray
+        ``(h, w_left)`` float32, NaN without a confirmed match.
+    status : numpy.ndarray
+        ``(h, w_left)`` int8: :data:`NO_PHASE`, :data:`MATCHED`, :data:`UNMATCHED`,
+        :data:`AMBIGUOUS`, :data:`NOT_MONOTONIC`, :data:`INCONSISTENT` or
+        :data:`OTHER_AXIS`.
+
+    Examples
+    --------
+    >>> right = np.float32([[0, 1, 2, np.nan, np.nan, np.nan, np.nan, 3, 4, 5]])
+    >>> left = np.float32([[1.5, 2.5, 3.5]])
+    >>> d, status = match_pair(left, right, -5.0, 10.0, reach=1)
+    >>> d.tolist(), status.tolist()  # 2.5 lies in a gap of 5 columns
+    ([[-1.5, nan, -5.5]], [[1, 2, 1]])
+    >>> twice = np.float32([[0, 1, 2, 3, 0, 1, 2, 3]])  # the phase falls back in one run
+    >>> match_pair(np.float32([[1.5]]), twice, 0.0, 7.0)[1].tolist()  # NOT_MONOTONIC
+    [[4]]
+    >>> apart = np.float32([[0, 1, 2, 3] + [np.nan] * 4 + [0, 1, 2, 3]])  # two runs
+    >>> match_pair(np.float32([[1.5]]), apart, 0.0, 11.0)[1].tolist()  # AMBIGUOUS
+    [[3]]
+    """
+    empty = np.zeros((0, 0), np.float32)
+    return _pair(np.ascontiguousarray(left, np.float32), np.ascontiguousarray(right, np.float32),
+                 float(lo), float(hi), float(shift), float(tolerance), int(gap), float(wiggle),
+                 float(jump), int(reach),
+                 empty if other is None else np.ascontiguousarray(other, np.float32),
+                 empty if other_right is None else np.ascontiguousarray(other_right,
+                                                                        np.float32),
+                 float(other_tolerance))
 
 
 @kernel(parallel=True)
@@ -434,59 +488,6 @@ def supported(disparity: np.ndarray, status: np.ndarray, support: float = 2.0
     """
     return _supported(np.ascontiguousarray(disparity, np.float32),
                       np.ascontiguousarray(status, np.int8), float(support))
-
-
-def check_matches(offset: np.ndarray, status: np.ndarray, back: np.ndarray,
-                  tolerance: float = 1.0, other: np.ndarray | None = None,
-                  other_back: np.ndarray | None = None, other_tolerance: float = 2.0,
-                  shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Keep the matches of :func:`match_rows` that the match back confirms and, with a
-    second coordinate, that agree on it; return them as disparities.
-
-    A match from ``x`` to ``x' = x + offset`` holds when the match back from ``x'`` (the
-    offsets ``back`` of the other image, linear between its neighbours at ``x'``) returns
-    within ``tolerance`` px of ``x``, and, where both images have the second coordinate
-    (``other`` at ``x``, ``other_back`` at ``x'``), the two differ by at most
-    ``other_tolerance``.
-
-    Parameters
-    ----------
-    offset, status : numpy.ndarray
-        ``(h, w)`` from :func:`match_rows` (this image into the other).
-    back : numpy.ndarray
-        ``(h, w_other)`` offsets of the other image into this one.
-    tolerance : float, optional
-        Pixels the round trip may miss by.
-    other, other_back : numpy.ndarray or None, optional
-        The second coordinate on both rectified grids (NaN where not decoded).
-    other_tolerance : float, optional
-        Largest difference of the second coordinate.
-    shift : float, optional
-        ``disparity = -offset - shift`` (the difference of the grids' principal points).
-
-    Returns
-    -------
-    disparity : numpy.ndarray
-        ``(h, w)`` float32, NaN where there is no confirmed match.
-    status : numpy.ndarray
-        ``status`` with :data:`INCONSISTENT` and :data:`OTHER_AXIS` where matches failed.
-
-    Examples
-    --------
-    >>> offset = np.float32([[-2.0, -2.0]])
-    >>> ok = np.int8([[MATCHED, MATCHED]])
-    >>> back = np.float32([[2.0, 2.0, 2.0]])  # both come back from x - 2 ... off the image
-    >>> d, s = check_matches(offset + np.float32([[2.0, 1.0]]), ok, back)
-    >>> d.tolist(), s.tolist()
-    ([[nan, 1.0]], [[5, 1]])
-    """
-    empty = np.zeros((0, 0), np.float32)
-    return _check(np.ascontiguousarray(offset, np.float32), np.ascontiguousarray(status),
-                  np.ascontiguousarray(back, np.float32),
-                  empty if other is None else np.ascontiguousarray(other, np.float32),
-                  empty if other_back is None else np.ascontiguousarray(other_back,
-                                                                        np.float32),
-                  float(tolerance), float(other_tolerance), float(shift))
 
 
 @kernel(parallel=True)
