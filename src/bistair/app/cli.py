@@ -275,22 +275,31 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
               help="with --count: processes of the local cluster [default: the cores]")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="with --count: run on an existing Dask cluster instead")
+@click.option("--cameras", type=click.IntRange(1, 2), default=1, show_default=True,
+              help="2: a second camera (OUT/<method>/L and R, stereo.json, truth/L and R)")
+@click.option("--baseline", type=float, default=200.0, show_default=True,
+              help="with --cameras 2: mm between the cameras (the projector between them)")
 @_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None,
-             quiet: bool) -> None:
+             vary: str | None, workers: int | None, scheduler: str | None, cameras: int,
+             baseline: float, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
-    of workers), each varied as --vary says."""
+    of workers), each varied as --vary says. With --cameras 2, two cameras and the
+    projector between them, for 'bistair stereo'."""
     from ..codecs import REGISTRY
 
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
     imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
                    bits=int(bits))
+    if cameras == 2:
+        _simulate_stereo(scene, chosen, out, camera, compensated, seed, count, baseline,
+                         quiet, imaging)
+        return
     if count is None:
         for name, value in (("--vary", vary), ("--workers", workers),
                             ("--scheduler", scheduler)):
@@ -332,6 +341,30 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                    f"{report.workers} worker{'s' if report.workers != 1 else ''}")
     if report.failed:
         raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
+
+
+def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
+                     camera: tuple[int, int] | None, compensated: bool, seed: int,
+                     count: int | None, baseline: float, quiet: bool,
+                     imaging: dict[str, Any]) -> None:
+    """``bistair simulate --cameras 2``."""
+    from .progress import Progress
+    from .stereo import simulate_stereo
+
+    if count is not None:
+        raise CliError("--cameras 2 renders one scene: leave out --count")
+    if scene is None:
+        raise CliError("name a --scene")
+    with Progress(quiet) as say:
+        simulate_stereo(scene, methods, out, camera_size=camera, baseline=baseline,
+                        compensated=compensated, progress=say, seed=seed, **imaging)
+    if quiet:
+        return
+    if scene == "calibration":
+        click.echo(f"wrote board pairs (8 poses, left and right) to {out}")
+    else:
+        click.echo(f"wrote {', '.join(methods)} captures of {scene} from two cameras "
+                   f"{baseline:g} mm apart (L/, R/), stereo.json and the truth to {out}")
 
 
 @cli.command()
@@ -384,23 +417,43 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--projector-size", required=True, metavar="WxH",
-              help="projector size WIDTHxHEIGHT")
+@click.option("--projector-size", default=None, metavar="WxH",
+              help="projector size WIDTHxHEIGHT (required without --stereo)")
 @click.option("--camera-size", default=None, metavar="WxH",
               help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
               "image_width + image_height, ... in the files]")
 @click.option("--keys", default=None, metavar="NAME=KEY,...",
               help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
-              "projector=M2,projector_dist=D2,R=R,T=T]; "
-              "camera_size=KEY names the size key")
+              "projector=M2,projector_dist=D2,R=R,T=T; with --stereo left=M1,left_dist=D1,"
+              "right=M2,right_dist=D2,R=R,T=T]; camera_size=KEY names the size key")
+@click.option("--stereo", is_flag=True, help="two cameras (left first) for 'bistair stereo', "
+              "not a camera and a projector")
 @reports_errors
-def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
-                       camera_size: str | None, keys: str | None) -> None:
+def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
+                       camera_size: str | None, keys: str | None, stereo: bool) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
-    R, T map the camera frame to the projector frame; T in millimetres."""
+    R, T map the camera frame to the projector frame; T in millimetres. With --stereo, two
+    cameras: R, T map the left camera's frame to the right one's."""
+    if stereo:
+        from .stereo import import_stereo_calibration
+
+        if projector_size is not None:
+            raise CliError("--projector-size does not apply to a stereo calibration (two "
+                           "cameras)")
+        pair = import_stereo_calibration(files, out, camera_size, keys)
+        click.echo(f"cameras {pair.left.width}x{pair.left.height}, baseline "
+                   f"{pair.baseline:.2f} mm; wrote {out}")
+        if pair.baseline < 10:
+            click.echo(f"Warning: a baseline of {pair.baseline:.3g} mm: T must be in "
+                       "millimetres (was the board's square given in metres or squares?)",
+                       err=True)
+        return
     from .jobs import import_calibration as run
 
+    if projector_size is None:
+        raise CliError("Missing option '--projector-size' (a projector's size is never in "
+                       "these files; or give --stereo for two cameras)")
     cal = run(files, out, projector_size, camera_size, keys)
     click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
                f"{cal.projector.width}x{cal.projector.height}, baseline {cal.baseline:.2f} mm; "
@@ -533,6 +586,106 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
         click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
     if not quiet:
         click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
+
+
+@cli.command("stereo")
+@click.argument("left")
+@click.argument("right")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set, for both cameras [default: spec.json beside "
+              "LEFT]")
+@click.option("--calibration", required=True, type=click.Path(path_type=Path),
+              help="the two cameras' calibration (bistair calibrate-stereo, or "
+              "import-calibration --stereo)")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="keep points with depth z in [MIN, MAX] mm (left camera frame); also "
+              "narrows the search")
+@click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
+              "matches; the decoder's checks where it offers this), as warnings in info.json")
+@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@click.option("--min-modulation", type=float, default=None,
+              help="modulation threshold as a fraction of full scale [default: from noise]")
+@click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
+@_threads
+@_quiet
+@reports_errors
+def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
+           depth_range: str | None, force: bool, strategy: str | None,
+           min_modulation: float | None, no_previews: bool, quiet: bool) -> None:
+    """Two cameras and a projector: decode both cameras' captures of one pattern set, match
+    equal absolute phase along rectified rows, triangulate.
+
+    LEFT, RIGHT: each camera's captures, a folder, a quoted glob pattern or a .npy stack.
+    Writes OUT/left/ and OUT/right/ (each decode), disparity.npy, depth.npy, depth.png,
+    cloud.ply (left camera frame, mm) and info.json. The projector needs no calibration."""
+    from .jobs import parse_depth_range
+    from .progress import Progress
+    from .stereo import stereo_folder, warnings
+
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
+               if v is not None}
+    with Progress(quiet) as say:
+        res = stereo_folder(left, right, out, calibration, spec_path, min_depth=low,
+                            max_depth=high, force=force, previews=not no_previews,
+                            progress=say, **options)
+    for message in warnings(res):
+        click.echo(f"Warning: {message}", err=True)
+    if quiet:
+        return
+    info = res.info
+    rejected = info["inconsistent"] + info["ambiguous"] + info["not_monotonic"] + \
+        info["other_axis"] + info["alone"]
+    range_note = f", {info['outside_range']} outside the depth range" if depth_range else ""
+    click.echo(f"{info['matched']} points from {info['left_decoded']} decoded left pixels "
+               f"({100 * info['matched_fraction']:.1f}%; {info['unmatched']} without a match "
+               f"in the right camera, {rejected} rejected by the checks{range_note}); "
+               f"wrote {out}")
+
+
+@cli.command("calibrate-stereo")
+@click.argument("poses", type=click.Path(path_type=Path))
+@click.option("--board", default=None, metavar="chessboard:COLSxROWS:SQUARE",
+              help="the board: inner corners and square size (mm), or a board.json "
+              "[default: POSES/board.json]")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="stereo calibration file to write (JSON)")
+@click.option("--min-poses", type=int, default=3, show_default=True,
+              help="fewest poses with the board found in both images (3 or more)")
+@_quiet
+@reports_errors
+def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
+                     quiet: bool) -> None:
+    """Calibrate two cameras from image pairs of a board.
+
+    POSES: one folder per pose holding a left and a right image (named left/right, else in
+    name order), or left/ and right/ folders whose images pair up in name order. Poses
+    where the board is not found in both images are skipped."""
+    from .progress import Progress
+    from .stereo import calibrate_stereo_folder
+
+    with Progress(quiet) as say:
+        cal, skipped = calibrate_stereo_folder(poses, out, board, min_poses, progress=say)
+    for name in skipped:
+        click.echo(f"Warning: pose {name} skipped: the board is not found in both images",
+                   err=True)
+    if quiet:
+        return
+    click.echo(f"stereo RMS {cal.rms:.3f} px (left {cal.left.rms:.3f} px, right "
+               f"{cal.right.rms:.3f} px), baseline {cal.baseline:.2f} +/- "
+               f"{cal.uncertainty.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} "
+               f"poses; wrote {out}")
+    for name, dev, sd in (("left", cal.left, cal.uncertainty.camera),
+                          ("right", cal.right, cal.uncertainty.projector)):
+        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
+        click.echo(f"  {name + ':':7s} " + ", ".join(
+            f"{key} {v:.2f} +/- {s:.2f}"
+            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
+    for pose in cal.poses:
+        click.echo(f"  {pose['name']}: {pose['features']} corners, left "
+                   f"{pose['left_rms']:.3f} px, right {pose['right_rms']:.3f} px")
 
 
 def _terminated(signum: int, frame: Any) -> None:

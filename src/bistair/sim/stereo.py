@@ -57,13 +57,16 @@ class StereoRig:
                 camera_focal: float | None = None, projector_focal: float = 2000.0,
                 camera_dist: Sequence[float] = _NO_DIST,
                 right_dist: Sequence[float] | None = None,
-                projector_dist: Sequence[float] = _NO_DIST) -> StereoRig:
+                projector_dist: Sequence[float] = _NO_DIST, right_height: float = 0.0,
+                right_roll_deg: float = 0.0) -> StereoRig:
         """Two equal cameras ``baseline`` mm apart along x, both aimed at the scene centre,
         and the projector on the baseline between them (``projector_at`` = 0: at the left
         camera, 1: at the right one), aimed there too.
 
         ``camera_focal`` defaults to ``1.875 * width`` (2400 px at 1280 wide, as
         :meth:`~bistair.sim.Rig.default`); ``right_dist`` to ``camera_dist``.
+        ``right_height`` moves the right camera along y (mm) and ``right_roll_deg`` turns it
+        about its axis: a pair that is not level, as real ones are not quite.
         """
         cw, ch = check_size(camera_size, "camera")
         pw, ph = check_size(projector_size, "projector")
@@ -71,7 +74,7 @@ class StereoRig:
         left = Camera(cw, ch, fc, fc, (cw - 1) / 2, (ch - 1) / 2, tuple(camera_dist))
         right = _aimed(Camera, (cw, ch, fc, fc, (cw - 1) / 2, (ch - 1) / 2,
                                 tuple(camera_dist if right_dist is None else right_dist)),
-                       baseline, working_distance)
+                       baseline, working_distance, right_height, right_roll_deg)
         projector = _aimed(Projector, (pw, ph, projector_focal, projector_focal, (pw - 1) / 2,
                                        (ph - 1) / 2, tuple(projector_dist)),
                            projector_at * baseline, working_distance)
@@ -87,10 +90,12 @@ class StereoRig:
         return float(np.linalg.norm(self.right.center - self.left.center))
 
 
-def _aimed(kind: type, intrinsics: tuple, x: float, distance: float) -> Camera | Projector:
-    """A device at ``(x, 0, 0)`` turned about y toward ``(0, 0, distance)``."""
-    rot = look_rotation(float(np.rad2deg(np.arctan2(x, distance))))
-    return kind(*intrinsics, rot, -rot @ np.array([x, 0.0, 0.0]))
+def _aimed(kind: type, intrinsics: tuple, x: float, distance: float, y: float = 0.0,
+           roll: float = 0.0) -> Camera | Projector:
+    """A device at ``(x, y, 0)`` turned about y toward ``(0, 0, distance)``, then rolled
+    by ``roll`` degrees about its axis."""
+    rot = look_rotation(float(np.rad2deg(np.arctan2(x, distance))), roll)
+    return kind(*intrinsics, rot, -rot @ np.array([x, y, 0.0]))
 
 
 def render_stereo(patterns: np.ndarray, srig: StereoRig, scene: Scene,
