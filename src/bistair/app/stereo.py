@@ -35,7 +35,7 @@ from ..codecs import encode
 from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
 from ..geometry.board import BOARD_TYPES, Board
-from ..geometry.calibration import Calibration, save_calibration
+from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.stereo import StereoResult, stereo
 from ..geometry.stereo_calibrate import calibrate_stereo_images
 from ..geometry.stereo_calibration import (
@@ -139,6 +139,11 @@ def stereo_pair(captures: str | Path) -> tuple[Path, Path] | None:
 def is_stereo_calibration(path: str | Path | None) -> bool:
     """Whether ``path`` names a stereo calibration file (``False`` for ``None``)."""
     return path is not None and is_stereo_file(path)
+
+
+def check_calibration_file(path: str | Path) -> StereoCalibration | Calibration:
+    """Read a calibration file of either kind (one-line error if it is neither)."""
+    return load_stereo_calibration(path) if is_stereo_file(path) else load_calibration(path)
 
 
 # -- calibrate -------------------------------------------------------------------------------

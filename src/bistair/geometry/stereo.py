@@ -202,24 +202,30 @@ class StereoResult:
     ``disparity``: float32 on the rectified left grid (``x_l - x_r`` with both grids'
     principal points removed; ``Z = -f * tx / d`` in the rectified frame), NaN where
     unmatched. ``depth`` (float32 ``z``, mm), ``points`` (``(H, W, 3)`` float32, mm) and
-    ``mask``: on the left camera's own image grid, in its frame. ``colors``: ``(H, W, 3)``
-    uint8 grey from the white frame (else the fringes' average). ``left``, ``right``: each
-    camera's decode. ``info``: counts and settings (see :func:`reconstruct_stereo`).
+    ``mask``: on the left camera's own image grid, in its frame. ``grey``: ``(H, W)`` uint8
+    from the white frame (else the fringes' average), ``colors`` the same as RGB.
+    ``left``, ``right``: each camera's decode. ``info``: counts and settings (see
+    :func:`reconstruct_stereo`).
     """
 
     disparity: np.ndarray
     depth: np.ndarray
     points: np.ndarray
-    colors: np.ndarray
+    grey: np.ndarray
     mask: np.ndarray
     left: DecodeResult | AxesResult
     right: DecodeResult | AxesResult
     rectification: Rectification
     info: dict[str, Any] = field(default_factory=dict)
 
+    @property
+    def colors(self) -> np.ndarray:
+        """``(H, W, 3)`` uint8 RGB (grey)."""
+        return np.repeat(self.grey[..., None], 3, axis=2)
+
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
-        return self.points[self.mask], self.colors[self.mask]
+        return self.points[self.mask], np.repeat(self.grey[self.mask][:, None], 3, axis=1)
 
 
 def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
@@ -290,7 +296,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                       remap_valid(rc, *rect.maps_right, spread[name]))
                for name, (lc, rc) in coords.items()}
     axis, sign = _matched_axis(on_grid)
-    src, dst = (sign * m for m in on_grid[axis])
+    src, dst = on_grid[axis] if sign > 0 else (-m for m in on_grid[axis])
     low, high = rect.disparities(min_depth, max_depth)
     high = min(high, 4.0 * max(rect.size_left))  # farther than any image: same window
     low = max(low, -4.0 * max(rect.size_left))
@@ -302,9 +308,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                                    other_tolerance=other_tolerance)
     disparity, status = supported(disparity, status, support)
     decoded = np.isfinite(coords[axis][0])
-    points, outside = grid_points(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
-                                  rect.cy, rect.tx, rect.R1, min_depth, max_depth)
-    depth = points[..., 2].copy()
+    points, depth, outside = grid_points(disparity, *rect.positions, decoded, rect.f,
+                                         rect.cx_left, rect.cy, rect.tx, rect.R1, min_depth,
+                                         max_depth)
     mask = np.isfinite(depth)
     counts = np.bincount(status.ravel(), minlength=8)
     info: dict[str, Any] = {
@@ -330,7 +336,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         if not force:
             raise BistairError(message)
         info["warnings"].append(message)
-    return StereoResult(disparity, depth, points, _colors(left, offset), mask, left, right,
+    return StereoResult(disparity, depth, points, _grey(left, offset), mask, left, right,
                         rect, info)
 
 
@@ -355,15 +361,15 @@ def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResu
 
 def _step(coord: np.ndarray) -> float:
     """The largest spread of 2 x 2 neighbours taken as one surface: four times the median
-    spread of the decode (every fourth row and column), at least one projector pixel."""
-    c = coord[:-1:4, :-1:4], coord[1::4, :-1:4], coord[:-1:4, 1::4], coord[1::4, 1::4]
-    h = min(a.shape[0] for a in c)
-    w = min(a.shape[1] for a in c)
-    block = np.stack([a[:h, :w] for a in c]).reshape(4, -1)
-    block = block[:, np.isfinite(block).all(axis=0)]
-    if not block.shape[1]:
-        return 1.0
-    return max(1.0, 4.0 * float(np.median(block.max(axis=0) - block.min(axis=0))))
+    spread of the decode (blocks at every fourth row and column), at least one projector
+    pixel."""
+    h, w = coord.shape
+    c = [coord[dy:h - 1 + dy:4, dx:w - 1 + dx:4] for dy in (0, 1) for dx in (0, 1)]
+    with np.errstate(invalid="ignore"):
+        spread = (np.maximum(np.maximum(c[0], c[1]), np.maximum(c[2], c[3]))
+                  - np.minimum(np.minimum(c[0], c[1]), np.minimum(c[2], c[3])))
+    spread = spread[np.isfinite(spread)]
+    return max(1.0, 4.0 * float(np.median(spread))) if spread.size else 1.0
 
 
 def _matched_axis(on_grid: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[str, float]:
@@ -394,16 +400,15 @@ def _row_slope(coord: np.ndarray) -> float:
     return float(np.median(steps)) if steps.size >= 10 else math.nan
 
 
-def _colors(result: DecodeResult | AxesResult, offset: float) -> np.ndarray:
-    """Grey RGB per pixel: the white frame, else the fringes' average over the patterns'
-    mean."""
+def _grey(result: DecodeResult | AxesResult, offset: float) -> np.ndarray:
+    """Grey per pixel (uint8): the white frame, else the fringes' average over the
+    patterns' mean."""
     first = result.x if isinstance(result, AxesResult) else result
     if first.texture is not None:
-        grey = np.asarray(first.texture, np.float32)
+        grey = np.asarray(first.texture, np.float32) * np.float32(255)
     else:
-        grey = np.asarray(first.average, np.float32) / np.float32(offset or 0.5)
-    grey = np.round(np.clip(np.nan_to_num(grey), 0.0, 1.0) * 255).astype(np.uint8)
-    return np.repeat(grey[..., None], 3, axis=2)
+        grey = np.asarray(first.average, np.float32) * np.float32(255 / (offset or 0.5))
+    return np.clip(np.nan_to_num(grey), 0, 255).round().astype(np.uint8)
 
 
 def decode_options(method: str, force: bool, options: dict[str, Any]) -> dict[str, Any]:

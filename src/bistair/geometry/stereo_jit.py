@@ -493,15 +493,17 @@ def supported(disparity: np.ndarray, status: np.ndarray, support: float = 2.0
 @kernel(parallel=True)
 def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
             cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
-            max_step: float) -> tuple[np.ndarray, int]:
+            max_step: float) -> tuple[np.ndarray, np.ndarray, int]:
     h, w = u.shape
     points = np.empty((h, w, 3), np.float32)
+    depth = np.empty((h, w), np.float32)
     outside = np.zeros(h, np.int64)
     for y in prange(h):
         for x in range(w):
             points[y, x, 0] = np.nan
             points[y, x, 1] = np.nan
             points[y, x, 2] = np.nan
+            depth[y, x] = np.nan
             if not valid[y, x]:
                 continue
             d = _bilinear(disparity, u[y, x], v[y, x], max_step)
@@ -516,13 +518,14 @@ def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarr
             points[y, x, 0] = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
             points[y, x, 1] = rt[1, 0] * xr + rt[1, 1] * yr + rt[1, 2] * zr
             points[y, x, 2] = z
-    return points, outside.sum()
+            depth[y, x] = z
+    return points, depth, outside.sum()
 
 
 def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
                 f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
                 min_depth: float = 0.0, max_depth: float = math.inf,
-                max_step: float = 2.0) -> tuple[np.ndarray, int]:
+                max_step: float = 2.0) -> tuple[np.ndarray, np.ndarray, int]:
     """3-D points on a camera's own image grid from the disparity on its rectified grid.
 
     Each valid pixel reads the disparity ``d`` at its rectified position ``(u, v)``
@@ -555,6 +558,8 @@ def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.n
     -------
     points : numpy.ndarray
         ``(H, W, 3)`` float32 in the camera frame (mm), NaN where unknown.
+    depth : numpy.ndarray
+        ``(H, W)`` float32, their ``z``.
     outside : int
         Pixels triangulated but outside the depth range.
 
@@ -562,8 +567,8 @@ def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.n
     --------
     >>> d = np.full((3, 4), 20.0, np.float32)  # f = 100, baseline 60 mm: 300 mm away
     >>> u, v = np.float32([[1.0, 2.5]]), np.float32([[1.0, 1.0]])
-    >>> pts, out = grid_points(d, u, v, np.ones((1, 2), bool), 100.0, 1.0, 1.0, -60.0,
-    ...                        np.eye(3))
+    >>> pts, z, out = grid_points(d, u, v, np.ones((1, 2), bool), 100.0, 1.0, 1.0, -60.0,
+    ...                           np.eye(3))
     >>> pts.round(3).tolist(), out
     ([[[0.0, 0.0, 300.0], [4.5, 0.0, 300.0]]], 0)
     """
