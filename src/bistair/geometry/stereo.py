@@ -295,8 +295,13 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     on_grid = {name: (remap_valid(lc, *rect.maps_left, spread[name]),
                       remap_valid(rc, *rect.maps_right, spread[name]))
                for name, (lc, rc) in coords.items()}
-    axis, sign = _matched_axis(on_grid)
-    src, dst = on_grid[axis] if sign > 0 else (-m for m in on_grid[axis])
+    axis, slope = _matched_axis(on_grid)
+    src, dst = on_grid[axis] if slope > 0 else (-m for m in on_grid[axis])
+    # the thresholds grow with the noise: the phase's own (a row's second differences)
+    # as a position along the row
+    noise = max(_noise(src), _noise(dst)) / abs(slope)
+    wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
+    support = max(support, 4.0 * math.sqrt(2.0) * noise)
     low, high = rect.disparities(min_depth, max_depth)
     high = min(high, 4.0 * max(rect.size_left))  # farther than any image: same window
     low = max(low, -4.0 * max(rect.size_left))
@@ -326,8 +331,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                       "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
                       "cx_right": rect.cx_right, "tx": rect.tx,
                       "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
-        "tolerance_px": tolerance, "other_tolerance": other_tolerance, "gap_px": gap,
-        "wiggle_px": wiggle, "support_px": support, "warnings": []}
+        "noise_px": round(noise, 4), "tolerance_px": round(tolerance, 4),
+        "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(wiggle, 4),
+        "support_px": round(support, 4), "warnings": []}
     share = info["matched_fraction"]
     if share < MIN_MATCHED:
         message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
@@ -373,7 +379,8 @@ def _step(coord: np.ndarray) -> float:
 
 
 def _matched_axis(on_grid: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[str, float]:
-    """The coded axis that changes along the rectified rows, and the sign of its change."""
+    """The coded axis that changes along the rectified rows, and its change per pixel
+    there (its sign: the way the phase runs)."""
     slopes = {}
     for name, (lc, rc) in on_grid.items():
         slopes[name] = tuple(_row_slope(m) for m in (lc, rc))
@@ -389,7 +396,18 @@ def _matched_axis(on_grid: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[st
     if sl * sr <= 0:
         raise BistairError("the projector coordinate runs one way along the rows in the left "
                            "camera and the other way in the right one: is one image mirrored?")
-    return axis, math.copysign(1.0, sl)
+    return axis, sl
+
+
+def _noise(values: np.ndarray) -> float:
+    """The noise (standard deviation) of a map along its rows, from second differences of
+    every fourth row (a robust spread: 1.4826 MAD / sqrt(6)); 0 without data."""
+    rows = values[::4]
+    second = (rows[:, 2:] - 2 * rows[:, 1:-1] + rows[:, :-2]).ravel()
+    second = second[np.isfinite(second)]
+    if second.size < 10:
+        return 0.0
+    return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
 
 
 def _row_slope(coord: np.ndarray) -> float:
