@@ -338,7 +338,7 @@ def _stereo_set(job: SetJob, options: Options, prefix: str, start: float) -> dic
                                previews=options.previews, **options.decode)
         row = _row(job.name, "ok", valid_fraction=round(float(result.mask.mean()), 6),
                    noise=_noise(result.left), seconds=round(time.perf_counter() - start, 3))
-        files = sorted(p.name for p in tmp.iterdir())
+        files = sorted(str(p.relative_to(tmp)) for p in tmp.rglob("*") if p.is_file())
         write_json(tmp / MARKER, {"format": MARKER_FORMAT, "version": 1,
                                   **_inputs(job, options), "files": files, "row": row,
                                   "warnings": result.info.get("warnings", []), "run": prefix})
