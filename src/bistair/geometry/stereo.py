@@ -59,6 +59,7 @@ from .stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
+    drop_kinks,
     grid_points,
     match_pair,
     rectified_positions,
@@ -68,6 +69,7 @@ from .stereo_jit import (
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
 MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
+KINK, KINK_REACH = 4.0, 2  # a row's kinks: second differences over 4 noise, dropped +-2 px
 
 
 @dataclass(frozen=True, eq=False)
@@ -299,7 +301,10 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     src, dst = on_grid[axis] if slope > 0 else (-m for m in on_grid[axis])
     # the thresholds grow with the noise: the phase's own (a row's second differences)
     # as a position along the row
-    noise = max(_noise(src), _noise(dst)) / abs(slope)
+    noise_l, noise_r = _noise(src), _noise(dst)
+    noise = max(noise_l, noise_r) / abs(slope)
+    src, dst = (drop_kinks(m, max(KINK * n * math.sqrt(6.0), 0.5 * abs(slope)), KINK_REACH)
+                for m, n in ((src, noise_l), (dst, noise_r)))
     wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
     support = max(support, 4.0 * math.sqrt(2.0) * noise)
     low, high = rect.disparities(min_depth, max_depth)

@@ -439,6 +439,49 @@ def match_pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift:
 
 
 @kernel(parallel=True)
+def _kinks(values: np.ndarray, limit: float, reach: int) -> np.ndarray:
+    h, w = values.shape
+    out = values.copy()
+    for y in prange(h):
+        row = values[y]
+        for x in range(1, w - 1):
+            a, b, c = row[x - 1], row[x], row[x + 1]
+            if a == a and b == b and c == c and abs(a - 2.0 * b + c) > limit:
+                for k in range(max(0, x - reach), min(w, x + reach + 1)):
+                    out[y, k] = np.nan
+    return out
+
+
+def drop_kinks(values: np.ndarray, limit: float, reach: int = 2) -> np.ndarray:
+    """``values`` with NaN within ``reach`` columns of every kink along the rows, where the
+    second difference exceeds ``limit``: the blurred step between two surfaces, whose
+    pixels mix both (a value between them, which could match a place on neither).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(h, w)`` float32 map (projector coordinates on a rectified grid), NaN where
+        invalid.
+    limit : float
+        Largest ``|v[x-1] - 2 v[x] + v[x+1]|`` of one surface.
+    reach : int, optional
+        Columns on each side of a kink dropped too.
+
+    Returns
+    -------
+    numpy.ndarray
+        A float32 copy with the kinks dropped.
+
+    Examples
+    --------
+    >>> row = np.float32([[0, 1, 2, 3, 4, 8, 12, 13, 14, 15, 16, 17]])  # a blurred step
+    >>> drop_kinks(row, 2.0, reach=1).tolist()
+    [[0.0, 1.0, 2.0, nan, nan, nan, nan, nan, 14.0, 15.0, 16.0, 17.0]]
+    """
+    return _kinks(np.ascontiguousarray(values, np.float32), float(limit), int(reach))
+
+
+@kernel(parallel=True)
 def _supported(disparity: np.ndarray, status: np.ndarray, support: float
                ) -> tuple[np.ndarray, np.ndarray]:
     h, w = disparity.shape
