@@ -18,7 +18,7 @@ absolute relative error, wrong (points off by more than 1%), median absolute err
 matched >= 95%, RMS <= 0.05%, p99 <= 0.2%, wrong <= 0.05%; hard optics within twice those.
 
     python benchmarks/stereo_accuracy.py [--scenes sphere,mugs,far] [--baselines 100,175,250]
-        [--optics default,hard] [--camera 1280x1024] [--method graycode]
+        [--optics default,hard] [--camera 1280x1024] [--method graycode] [--smooth 0]
 """
 
 from __future__ import annotations
@@ -60,12 +60,15 @@ def main() -> None:
     parser.add_argument("--optics", default="default,hard")
     parser.add_argument("--camera", default="1280x1024")
     parser.add_argument("--method", default="graycode", choices=sorted(PARAMS))
+    parser.add_argument("--smooth", type=float, default=0.0,
+                        help="bistair.stereo's smoothing sigma (px)")
     args = parser.parse_args()
     camera = tuple(int(v) for v in args.camera.split("x"))
     spec = bistair.make_spec(args.method, width=1920, height=1080, gamma=2.2,
                              **PARAMS[args.method])
     patterns = bistair.encode(spec)
-    print(f"{args.method} {spec.frame_count} frames, cameras {camera[0]}x{camera[1]}")
+    print(f"{args.method} {spec.frame_count} frames, cameras {camera[0]}x{camera[1]}, "
+          f"smoothing {args.smooth:g} px")
     print(f"{'scene':7s} {'base':>5s} {'optics':8s} {'depths mm':>10s} {'matched':>8s} "
           f"{'RMS':>8s} {'RMS in':>8s} {'p99':>7s} {'wrong':>8s} {'median':>8s} {'time':>6s}")
     worst: dict[str, dict[str, float]] = {}
@@ -79,7 +82,7 @@ def main() -> None:
                 imaging = Imaging(**(HARD if optics == "hard" else {}), seed=7)
                 left, right, lt, rt = render_stereo(patterns, rig, make(), imaging)
                 start = time.perf_counter()
-                res = stereo(left, right, spec, cal)
+                res = stereo(left, right, spec, cal, smooth=args.smooth)
                 seconds = time.perf_counter() - start
                 s = score_stereo(res, rig, lt, rt)
                 near, far = np.nanpercentile(lt.depth[lt.mask], [2, 98])

@@ -68,16 +68,18 @@ def _silent(stage: str) -> None:
 def stereo_folder(left: Any, right: Any, out: str | Path,
                   calibration: StereoCalibration | str | Path,
                   spec: BaseSpec | str | Path | None = None, min_depth: float = 0.0,
-                  max_depth: float = np.inf, force: bool = False, previews: bool = True,
-                  progress: Say | None = None, **options: Any) -> StereoResult:
+                  max_depth: float = np.inf, force: bool = False, smooth: float = 0.0,
+                  previews: bool = True, progress: Say | None = None,
+                  **options: Any) -> StereoResult:
     """Decode two cameras' captures (each a folder, image files, a glob pattern or a ``.npy``
     stack, as for ``bistair decode``) of one pattern set, match and triangulate, and write
     the files of the module docstring into ``out``.
 
     ``spec`` defaults to ``spec.json`` beside the left captures and is used for both;
     ``calibration`` must be a stereo calibration (``"kind": "stereo"``). ``force`` goes to
-    the decoder when it takes it and keeps a reconstruction with few matches.
-    ``options`` are decoder options. Nothing is written on error.
+    the decoder when it takes it and keeps a reconstruction with few matches; ``smooth``:
+    see :func:`~bistair.geometry.stereo.reconstruct_stereo`. ``options`` are decoder
+    options. Nothing is written on error.
     """
     say = progress or _silent
     for side in (left, right):
@@ -99,7 +101,7 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
         f"({used.method}) and matching")
     result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
-                    max_depth=max_depth, force=force, **options)
+                    max_depth=max_depth, force=force, smooth=smooth, **options)
     say(f"writing {int(result.mask.sum())} points")
     with output_folder(out) as tmp:
         write_stereo(result, tmp, previews)

@@ -64,12 +64,14 @@ from .stereo_jit import (
     match_pair,
     rectified_positions,
     remap_valid,
+    smooth_runs,
     supported,
 )
+from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
 MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
-KINK, KINK_REACH = 4.0, 2  # a row's kinks: second differences over 4 noise, dropped +-2 px
+KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
 
 
 @dataclass(frozen=True, eq=False)
@@ -235,7 +237,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                        rectification: Rectification | None = None, min_depth: float = 0.0,
                        max_depth: float = math.inf, tolerance: float = 1.0,
                        other_tolerance: float = 2.0, gap: int = 3, wiggle: float = 1.0,
-                       support: float = 2.0, offset: float = 0.5,
+                       support: float = 2.0, smooth: float = 0.0, offset: float = 0.5,
                        force: bool = False) -> StereoResult:
     """Match two cameras' decodes of the same patterns and triangulate (module docstring).
 
@@ -259,6 +261,14 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         Largest step (px) between valid neighbours on a rectified row interpolated across.
     wiggle : float, optional
         Pixels the phase may run back by (noise) where a value is matched.
+    support : float, optional
+        Pixels a disparity may differ by from the row above or below (one of them must
+        confirm it).
+    smooth : float, optional
+        Gaussian sigma (px) of a smoothing of both cameras' projector coordinates on the
+        rectified grids before matching (:func:`~.stereo_jit.smooth_runs`: never across
+        two surfaces); 0 (the default) matches the decoded values as they are. Smoothing
+        trades lateral resolution for depth noise (sigma 1 px: about a third of it).
     offset : float, optional
         The patterns' mean (the spec's ``offset``): scales the fringes' average to grey
         when there is no white frame.
@@ -277,8 +287,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     Raises
     ------
     BistairError
-        Decodes of different kinds or sizes, sizes other than the calibration's, a coded
-        axis that does not change along the baseline, phases that run opposite ways in the
+        A bad depth range, tolerance or smoothing, decodes of different kinds or sizes,
+        sizes other than the calibration's, a coded axis that does not change along the
+        baseline, phases that run opposite ways in the
         two cameras, or (without ``force``) too few matches.
 
     Examples
@@ -291,6 +302,13 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     >>> float(np.abs(rec.depth[rec.mask] - 500.0).max()) < 1e-3, rec.info["matched_fraction"]
     (True, 0.990872)
     """
+    check_depth_range(min_depth, max_depth)
+    if not 0 <= smooth <= 10:
+        raise BistairError(f"the smoothing must be 0 to 10 px, got {smooth}")
+    for name, value in (("tolerance", tolerance), ("other tolerance", other_tolerance),
+                        ("wiggle", wiggle), ("support", support)):
+        if not value > 0:
+            raise BistairError(f"the {name} must be positive, got {value}")
     rect = rectification or rectify(calibration)
     coords = _coordinates(left, right, calibration, orientation)
     spread = {name: _step(pair[0]) for name, pair in coords.items()}
@@ -305,6 +323,8 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     noise = max(noise_l, noise_r) / abs(slope)
     src, dst = (drop_kinks(m, max(KINK * n * math.sqrt(6.0), 0.5 * abs(slope)), KINK_REACH)
                 for m, n in ((src, noise_l), (dst, noise_r)))
+    if smooth > 0:
+        src, dst = (smooth_runs(m, smooth, spread[axis]) for m in (src, dst))
     wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
     support = max(support, 4.0 * math.sqrt(2.0) * noise)
     low, high = rect.disparities(min_depth, max_depth)
@@ -338,7 +358,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                       "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
         "noise_px": round(noise, 4), "tolerance_px": round(tolerance, 4),
         "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(wiggle, 4),
-        "support_px": round(support, 4), "warnings": []}
+        "support_px": round(support, 4), "smooth_px": smooth, "warnings": []}
     share = info["matched_fraction"]
     if share < MIN_MATCHED:
         message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
@@ -466,7 +486,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
            calibration: StereoCalibration | str | Path, *,
            rectification: Rectification | None = None, min_depth: float = 0.0,
            max_depth: float = math.inf, force: bool = False, tolerance: float = 1.0,
-           other_tolerance: float = 2.0, **options: Any) -> StereoResult:
+           other_tolerance: float = 2.0, smooth: float = 0.0, **options: Any) -> StereoResult:
     """Decode two cameras' captures of the same patterns and reconstruct by matching equal
     absolute phase along rectified rows (:func:`reconstruct_stereo`).
 
@@ -485,7 +505,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
     force : bool, optional
         Passed to the decoder when it takes it; keeps a reconstruction with few matches
         (a warning in ``info``).
-    tolerance, other_tolerance : float, optional
+    tolerance, other_tolerance, smooth : float, optional
         See :func:`reconstruct_stereo`.
     **options
         Decoder options (``strategy``, ``min_modulation``, ...).
@@ -533,7 +553,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         results.append(res)
     return reconstruct_stereo(*results, calibration, spec.orientation, rectification,
                               min_depth, max_depth, tolerance, other_tolerance,
-                              offset=spec.offset, force=force)
+                              smooth=smooth, offset=spec.offset, force=force)
 
 
 def _toy_stereo() -> StereoCalibration:

@@ -481,6 +481,91 @@ def drop_kinks(values: np.ndarray, limit: float, reach: int = 2) -> np.ndarray:
     return _kinks(np.ascontiguousarray(values, np.float32), float(limit), int(reach))
 
 
+@_numba_inline
+def _local_line(line: np.ndarray, x: int, radius: int, weights: np.ndarray,
+                jump: float) -> float:
+    """The weighted least-squares line through ``line`` around ``x`` (within ``radius``,
+    up to the first invalid sample or step over ``jump`` on each side), at ``x``."""
+    n = line.shape[0]
+    sw, swk, swkk, swv, swkv = 0.0, 0.0, 0.0, 0.0, 0.0
+    for direction in (-1, 1):
+        prev = float(line[x])
+        for k in range(0 if direction < 0 else 1, radius + 1):
+            j = x + direction * k
+            if j < 0 or j >= n:
+                break
+            v = float(line[j])
+            if v != v or abs(v - prev) > jump:
+                break
+            prev = v
+            w = weights[k]
+            off = direction * k
+            sw += w
+            swk += w * off
+            swkk += w * off * off
+            swv += w * v
+            swkv += w * off * v
+    det = sw * swkk - swk * swk
+    if not det > 1e-12:
+        return float(line[x])
+    return (swkk * swv - swk * swkv) / det
+
+
+@kernel(parallel=True)
+def _smooth(values: np.ndarray, radius: int, weights: np.ndarray, jump: float) -> np.ndarray:
+    h, w = values.shape
+    rows = values.copy()
+    for y in prange(h):
+        for x in range(w):
+            if values[y, x] == values[y, x]:
+                rows[y, x] = _local_line(values[y], x, radius, weights, jump)
+    out = rows.copy()
+    for x in prange(w):
+        column = np.ascontiguousarray(rows[:, x])
+        for y in range(h):
+            if column[y] == column[y]:
+                out[y, x] = _local_line(column, y, radius, weights, jump)
+    return out
+
+
+def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
+    """Smooth a map along its rows, then its columns: each valid value becomes that of the
+    Gaussian-weighted (``sigma`` px, to 3 sigma) least-squares line through its neighbours,
+    taken only up to the first invalid one or step over ``jump`` (never across two
+    surfaces; a line, not a mean, so a window cut short on one side is not biased by the
+    slope).
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(h, w)`` float32, NaN where invalid.
+    sigma : float
+        Gaussian sigma (px); 0 returns a copy.
+    jump : float
+        Largest step between neighbours of one surface.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(h, w)`` float32, NaN where ``values`` is.
+
+    Examples
+    --------
+    >>> ramp = np.float32([[0, 1, 2, 3, 4, 20, 21, 22]])  # two surfaces, exact ramps
+    >>> smooth_runs(ramp, 1.0, 5.0).tolist()
+    [[0.0, 1.0, 2.0, 3.0, 4.0, 20.0, 21.0, 22.0]]
+    >>> noisy = np.float32([[0, 1, 2, 3, 4, 5, 6]]) + np.float32([[0, 0, 0, 0.7, 0, 0, 0]])
+    >>> round(float(smooth_runs(noisy, 1.0, 5.0)[0, 3]), 3)  # the spike mostly averaged out
+    3.279
+    """
+    values = np.ascontiguousarray(values, np.float32)
+    if not sigma > 0:
+        return values.copy()
+    radius = max(1, int(math.ceil(3 * sigma)))
+    weights = np.exp(-0.5 * (np.arange(radius + 1) / sigma) ** 2)
+    return _smooth(values, radius, weights, float(jump))
+
+
 @kernel(parallel=True)
 def _supported(disparity: np.ndarray, status: np.ndarray, support: float
                ) -> tuple[np.ndarray, np.ndarray]:
