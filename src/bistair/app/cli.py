@@ -642,11 +642,10 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     info = res.info
     rejected = info["inconsistent"] + info["ambiguous"] + info["not_monotonic"] + \
         info["other_axis"] + info["alone"]
-    range_note = f", {info['outside_range']} outside the depth range" if depth_range else ""
+    within = f" at {low:g}-{high:g} mm" if depth_range else ""
     click.echo(f"{info['matched']} points from {info['left_decoded']} decoded left pixels "
                f"({100 * info['matched_fraction']:.1f}%; {info['unmatched']} without a match "
-               f"in the right camera, {rejected} rejected by the checks{range_note}); "
-               f"wrote {out}")
+               f"in the right camera{within}, {rejected} rejected by the checks); wrote {out}")
 
 
 @cli.command("calibrate-stereo")

@@ -327,6 +327,23 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
         lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
         lhint = np.empty((w // 2 + 1, 2), np.int64)
         nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
+        # a left run that rises strictly and shares no value with another left run
+        # gives each of its pixels back to itself: no search back needed there
+        alone = np.zeros(w, np.bool_)
+        for r in range(nl):
+            a, b = lb[r], le[r]
+            rising = True
+            for k in range(a + 1, b):
+                if not lvs[k] > lvs[k - 1]:
+                    rising = False
+                    break
+            for r2 in range(nl):
+                if r2 != r and rising and lvs[lb[r2]] <= lvs[b - 1] and (
+                        lvs[a] <= lvs[le[r2] - 1]):
+                    rising = False
+            if rising:
+                for k in range(a, b):
+                    alone[lxs[k]] = True
         for x in range(w):
             q = left[y, x]
             if q != q:
@@ -336,8 +353,10 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
             if found != MATCHED:
                 status[y, x] = found
                 continue
-            back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin, lhint, nl,
-                             wiggle, 1)
+            back, xb = MATCHED, float(x)
+            if not alone[x]:
+                back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin, lhint,
+                                 nl, wiggle, 1)
             if back != MATCHED or not abs(xb - x) <= tolerance:
                 status[y, x] = INCONSISTENT
                 continue
