@@ -316,58 +316,67 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
     both = other.shape[0] > 0
     disparity = np.full((h, w), np.nan, np.float32)
     status = np.zeros((h, w), np.int8)
-    for y in prange(h):
+    chunks = min(h, 64)
+    for c in prange(chunks):  # rows in chunks: the scratch arrays made once a chunk
         rxs, rvs = np.empty(wr, np.int64), np.empty(wr, np.float64)
         rb, re = np.empty(wr // 2 + 1, np.int64), np.empty(wr // 2 + 1, np.int64)
         rmax, rmin = np.empty(wr, np.float64), np.empty(wr, np.float64)
         rhint = np.empty((wr // 2 + 1, 2), np.int64)
-        nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
         lxs, lvs = np.empty(w, np.int64), np.empty(w, np.float64)
         lb, le = np.empty(w // 2 + 1, np.int64), np.empty(w // 2 + 1, np.int64)
         lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
         lhint = np.empty((w // 2 + 1, 2), np.int64)
-        nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
-        # a left run that rises strictly and shares no value with another left run
-        # gives each of its pixels back to itself: no search back needed there
-        alone = np.zeros(w, np.bool_)
-        for r in range(nl):
-            a, b = lb[r], le[r]
-            rising = True
-            for k in range(a + 1, b):
-                if not lvs[k] > lvs[k - 1]:
-                    rising = False
-                    break
-            for r2 in range(nl):
-                if r2 != r and rising and lvs[lb[r2]] <= lvs[b - 1] and (
-                        lvs[a] <= lvs[le[r2] - 1]):
-                    rising = False
-            if rising:
-                for k in range(a, b):
-                    alone[lxs[k]] = True
-        for x in range(w):
-            q = left[y, x]
-            if q != q:
-                continue
-            found, xm = _find(q, x + lo, x + hi, rxs, rvs, rb, re, rmax, rmin, rhint, nr,
-                              wiggle, reach)
-            if found != MATCHED:
-                status[y, x] = found
-                continue
-            back, xb = MATCHED, float(x)
-            if not alone[x]:
-                back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin, lhint,
-                                 nl, wiggle, 1)
-            if back != MATCHED or not abs(xb - x) <= tolerance:
-                status[y, x] = INCONSISTENT
-                continue
-            if both:
-                a, b = other[y, x], _along(other_right[y], xm)
-                if a == a and b == b and abs(a - b) > other_tolerance:
-                    status[y, x] = OTHER_AXIS
+        alone = np.empty(w, np.bool_)
+        for y in range(c * h // chunks, (c + 1) * h // chunks):
+            nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
+            nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
+            _alone(lxs, lvs, lb, le, nl, alone)
+            for x in range(w):
+                q = left[y, x]
+                if q != q:
                     continue
-            status[y, x] = MATCHED
-            disparity[y, x] = x - xm - shift
+                found, xm = _find(q, x + lo, x + hi, rxs, rvs, rb, re, rmax, rmin, rhint,
+                                  nr, wiggle, reach)
+                if found != MATCHED:
+                    status[y, x] = found
+                    continue
+                back, xb = MATCHED, float(x)
+                if not alone[x]:
+                    back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin,
+                                     lhint, nl, wiggle, 1)
+                if back != MATCHED or not abs(xb - x) <= tolerance:
+                    status[y, x] = INCONSISTENT
+                    continue
+                if both:
+                    a, b = other[y, x], _along(other_right[y], xm)
+                    if a == a and b == b and abs(a - b) > other_tolerance:
+                        status[y, x] = OTHER_AXIS
+                        continue
+                status[y, x] = MATCHED
+                disparity[y, x] = x - xm - shift
     return disparity, status
+
+
+@_numba_inline
+def _alone(xs: np.ndarray, vs: np.ndarray, begins: np.ndarray, ends: np.ndarray, runs: int,
+           alone: np.ndarray) -> None:
+    """Mark the columns of the runs that rise strictly and share no value with another
+    run: each of their pixels comes back to itself, no search back is needed there."""
+    alone[:] = False
+    for r in range(runs):
+        a, b = begins[r], ends[r]
+        rising = True
+        for k in range(a + 1, b):
+            if not vs[k] > vs[k - 1]:
+                rising = False
+                break
+        for r2 in range(runs):
+            if r2 != r and rising and vs[begins[r2]] <= vs[b - 1] and (
+                    vs[a] <= vs[ends[r2] - 1]):
+                rising = False
+        if rising:
+            for k in range(a, b):
+                alone[xs[k]] = True
 
 
 def match_pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float = 0.0,
@@ -538,13 +547,13 @@ def _smooth(values: np.ndarray, radius: int, weights: np.ndarray, jump: float) -
         for x in range(w):
             if values[y, x] == values[y, x]:
                 rows[y, x] = _local_line(values[y], x, radius, weights, jump)
-    out = rows.copy()
+    columns = np.ascontiguousarray(rows.T)
+    out = columns.copy()
     for x in prange(w):
-        column = np.ascontiguousarray(rows[:, x])
         for y in range(h):
-            if column[y] == column[y]:
-                out[y, x] = _local_line(column, y, radius, weights, jump)
-    return out
+            if columns[x, y] == columns[x, y]:
+                out[x, y] = _local_line(columns[x], y, radius, weights, jump)
+    return np.ascontiguousarray(out.T)
 
 
 def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
@@ -645,25 +654,23 @@ def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarr
     points = np.empty((h, w, 3), np.float32)
     depth = np.empty((h, w), np.float32)
     outside = np.zeros(h, np.int64)
+    nan = np.float32(np.nan)
     for y in prange(h):
         for x in range(w):
-            points[y, x, 0] = np.nan
-            points[y, x, 1] = np.nan
-            points[y, x, 2] = np.nan
-            depth[y, x] = np.nan
-            if not valid[y, x]:
-                continue
-            d = _bilinear(disparity, u[y, x], v[y, x], max_step)
-            if not d * tx < 0.0:  # NaN, or behind the cameras
-                continue
-            zr = -f * tx / d
-            xr, yr = (u[y, x] - cx) * zr / f, (v[y, x] - cy) * zr / f
-            z = rt[2, 0] * xr + rt[2, 1] * yr + rt[2, 2] * zr
-            if not zmin <= z <= zmax:
-                outside[y] += 1
-                continue
-            points[y, x, 0] = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
-            points[y, x, 1] = rt[1, 0] * xr + rt[1, 1] * yr + rt[1, 2] * zr
+            px, py, z = nan, nan, math.nan
+            d = _bilinear(disparity, u[y, x], v[y, x], max_step) if valid[y, x] else math.nan
+            if d * tx < 0.0:  # not NaN, and in front of the cameras
+                zr = -f * tx / d
+                xr, yr = (u[y, x] - cx) * zr / f, (v[y, x] - cy) * zr / f
+                z = rt[2, 0] * xr + rt[2, 1] * yr + rt[2, 2] * zr
+                if zmin <= z <= zmax:
+                    px = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
+                    py = rt[1, 0] * xr + rt[1, 1] * yr + rt[1, 2] * zr
+                else:
+                    outside[y] += 1
+                    z = math.nan
+            points[y, x, 0] = px
+            points[y, x, 1] = py
             points[y, x, 2] = z
             depth[y, x] = z
     return points, depth, outside.sum()
