@@ -285,14 +285,17 @@ def _find(q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
         j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
         hints[r, 0] = i
         hints[r, 1] = j + 1
-        x1, x2 = float(xs[a]), float(xs[a])  # q is the run's first value
-        if i > a:
-            x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
-        if j >= a:
-            x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
-        mid = 0.5 * (x1 + x2)
-        if reach > 1 and i == j + 1 and i - reach >= a and j + reach < b:
-            mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, mid)
+        if i == j + 1 and reach > 1 and i - reach >= a and j + reach < b:  # one crossing
+            x1 = x2 = mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, math.nan)
+            if mid != mid:  # no line (never for a rising run): between the neighbours
+                x1 = x2 = mid = xs[j] + (q - vs[j]) / (vs[i] - vs[j]) * (xs[i] - xs[j])
+        else:
+            x1, x2 = float(xs[a]), float(xs[a])  # q is the run's first value
+            if i > a:
+                x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
+            if j >= a:
+                x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
+            mid = 0.5 * (x1 + x2)
         if mid < xlo or mid > xhi:
             continue
         found += 1
@@ -655,13 +658,15 @@ def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarr
     depth = np.empty((h, w), np.float32)
     outside = np.zeros(h, np.int64)
     nan = np.float32(np.nan)
+    ftx = -f * tx
     for y in prange(h):
         for x in range(w):
             px, py, z = nan, nan, math.nan
             d = _bilinear(disparity, u[y, x], v[y, x], max_step) if valid[y, x] else math.nan
             if d * tx < 0.0:  # not NaN, and in front of the cameras
-                zr = -f * tx / d
-                xr, yr = (u[y, x] - cx) * zr / f, (v[y, x] - cy) * zr / f
+                zr = ftx / d
+                scale = -tx / d  # zr / f
+                xr, yr = (u[y, x] - cx) * scale, (v[y, x] - cy) * scale
                 z = rt[2, 0] * xr + rt[2, 1] * yr + rt[2, 2] * zr
                 if zmin <= z <= zmax:
                     px = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
