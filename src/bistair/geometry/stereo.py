@@ -11,16 +11,22 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    through ``cv2.initUndistortRectifyMap``. The projector coordinates are resampled there
    bilinearly, never between two surfaces (:func:`~.stereo_jit.remap_valid`: four valid
    neighbours whose spread is that of a surface).
-2. Matching (:func:`~.stereo_jit.match_rows`): for each valid left pixel, the right pixel
+2. Before matching, the kinks of each rectified row are dropped
+   (:func:`~.stereo_jit.drop_kinks`: second differences over four times the measured noise,
+   the blurred step between two surfaces whose pixels mix both), and with ``smooth`` both
+   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`).
+3. Matching (:func:`~.stereo_jit.match_pair`): for each valid left pixel, the right pixel
    of equal projector coordinate on the same rectified row, interpolated between the two
-   valid neighbours that bracket it, only where the coordinate rises along the row (up to
-   ``wiggle`` px of noise) without a gap of more than ``gap`` px, and only if one place in
-   the search window gives it. The coordinate along the cameras' baseline is matched (the
+   valid neighbours that bracket it (a line through four samples where it crosses once),
+   only where the coordinate rises along the row (up to ``wiggle`` px of noise) without a
+   gap of more than ``gap`` px or a step of two surfaces, and only if one place in the
+   search window gives it. The coordinate along the cameras' baseline is matched (the
    other carries nothing along a row); with both projector axes decoded, the other must
-   agree too.
-3. Left-right check (:func:`~.stereo_jit.check_matches`): the match back from the right
-   pixel must land within ``tolerance`` px of the left one. Occlusions and mismatches are
-   NaN, never a guess.
+   agree too. The same value searched back on the left row must come back within
+   ``tolerance`` px of the pixel, and a disparity must be confirmed by the row above or
+   below (:func:`~.stereo_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
+   with the measured noise (four, three and 5.7 times it, as a position along the row).
+   Occlusions and mismatches are NaN, never a guess.
 4. Points (:func:`~.stereo_jit.grid_points`): each decoded left pixel reads the disparity
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
@@ -30,8 +36,8 @@ Examples
 --------
 >>> cal = _toy_stereo()
 >>> rect = rectify(cal)
->>> rect.vertical, round(rect.f, 1), rect.size_left[1] == rect.size_right[1]
-(False, 800.0, True)
+>>> round(rect.f, 1), rect.size_left[1] == rect.size_right[1]
+(800.0, True)
 """
 
 from __future__ import annotations
@@ -94,7 +100,6 @@ class Rectification:
     maps_left: tuple[np.ndarray, np.ndarray]
     maps_right: tuple[np.ndarray, np.ndarray]
     positions: tuple[np.ndarray, np.ndarray]
-    vertical: bool = False
 
     @property
     def shift(self) -> float:
