@@ -19,7 +19,7 @@ from bistair.geometry.stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
-    grid_points,
+    grid_depth,
     match_pair,
     rectified_positions,
     remap_valid,
@@ -53,7 +53,7 @@ def test_rectified_positions_agree_with_opencv():
     K = np.array([[610.0, 0.0, 322.5], [0, 608.0, 241.0], [0, 0, 1]])  # OpenCV: no skew
     dist = np.array([-0.28, 0.11, 0.0012, -0.0008, -0.02])
     rot = cv2.Rodrigues(np.array([0.02, -0.15, 0.01]))[0]
-    u, v = rectified_positions(K, dist, rot, 600.0, 330.0, 250.0, (640, 480))
+    u, v, rx, ry = rectified_positions(K, dist, rot, 600.0, 330.0, 250.0, (640, 480))
     pix = np.stack(np.meshgrid(np.arange(0, 640, 7.0), np.arange(0, 480, 5.0)), -1).reshape(-1, 2)
     proj = np.array([[600.0, 0, 330.0], [0, 600.0, 250.0], [0, 0, 1]])
     want = cv2.undistortPoints(pix.reshape(-1, 1, 2), K, dist, R=rot, P=proj,
@@ -62,6 +62,10 @@ def test_rectified_positions_agree_with_opencv():
     rows, cols = pix[:, 1].astype(int), pix[:, 0].astype(int)
     np.testing.assert_allclose(u[rows, cols], want[:, 0], atol=2e-3)
     np.testing.assert_allclose(v[rows, cols], want[:, 1], atol=2e-3)
+    rays = cv2.undistortPoints(pix.reshape(-1, 1, 2), K, dist, criteria=(
+        cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-14)).reshape(-1, 2)
+    np.testing.assert_allclose(rx[rows, cols], rays[:, 0], atol=2e-6)
+    np.testing.assert_allclose(ry[rows, cols], rays[:, 1], atol=2e-6)
 
 
 def rising_row(rng: np.random.Generator, width: int) -> np.ndarray:
@@ -170,7 +174,7 @@ def test_a_match_one_row_thin_is_dropped():
     assert np.isfinite(np.delete(kept.ravel(), [9, 11, 15, 19])).all()
 
 
-def test_grid_points_triangulate_and_turn_back():
+def test_grid_depth_triangulates_and_turns_back():
     rot = cv2.Rodrigues(np.array([0.0, 0.1, 0.02]))[0]  # camera -> rectified frame
     f, cx, cy, tx = 500.0, 320.0, 240.0, -100.0
     point = np.array([30.0, -20.0, 700.0])  # camera frame
@@ -178,10 +182,10 @@ def test_grid_points_triangulate_and_turn_back():
     u, v = f * rect[0] / rect[2] + cx, f * rect[1] / rect[2] + cy
     d = -f * tx / rect[2]
     disparity = np.full((480, 640), d, np.float32)
-    pts, depth, outside = grid_points(disparity, np.float32([[u, 5.0]]), np.float32([[v, 5.0]]),
-                                      np.array([[True, False]]), f, cx, cy, tx, rot)
-    np.testing.assert_allclose(pts[0, 0], point, atol=2e-3)
-    assert depth[0, 0] == pts[0, 0, 2] and np.isnan(pts[0, 1]).all() and outside == 0
-    _, depth, outside = grid_points(disparity, np.float32([[u]]), np.float32([[v]]),
-                                    np.ones((1, 1), bool), f, cx, cy, tx, rot, max_depth=600.0)
+    depth, outside = grid_depth(disparity, np.float32([[u, 5.0]]), np.float32([[v, 5.0]]),
+                                np.array([[True, False]]), f, cx, cy, tx, rot)
+    assert depth[0, 0] == pytest.approx(700.0, abs=2e-3) and np.isnan(depth[0, 1])
+    assert outside == 0
+    depth, outside = grid_depth(disparity, np.float32([[u]]), np.float32([[v]]),
+                                np.ones((1, 1), bool), f, cx, cy, tx, rot, max_depth=600.0)
     assert np.isnan(depth).all() and outside == 1

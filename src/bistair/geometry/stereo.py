@@ -27,10 +27,11 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    below (:func:`~.stereo_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
    with the measured noise (four, three and 5.7 times it, as a position along the row).
    Occlusions and mismatches are NaN, never a guess.
-4. Points (:func:`~.stereo_jit.grid_points`): each decoded left pixel reads the disparity
+4. Points (:func:`~.stereo_jit.grid_depth`): each decoded left pixel reads the disparity
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
-   frame. Depth and points are on the left camera's own (distorted) image grid.
+   frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
+   on the left camera's own (distorted) image grid.
 
 Examples
 --------
@@ -66,7 +67,7 @@ from .stereo_jit import (
     OTHER_AXIS,
     UNMATCHED,
     drop_kinks,
-    grid_points,
+    grid_depth,
     match_pair,
     rectified_positions,
     remap_valid,
@@ -86,7 +87,8 @@ class Rectification:
     common focal length ``f`` and principal row ``cy``, each grid's ``cx`` and size
     ``(width, height)``, ``tx`` (the right camera's x in the rectified frame, mm), the
     remap tables (rectified pixel -> camera pixel) and where the left camera's own pixels
-    land on its grid (``positions``: ``u, v``)."""
+    land on its grid (``positions``: ``u, v``) with their rays in its frame (``rays``:
+    ``x, y``, the point at depth ``z`` being ``z * (x, y, 1)``)."""
 
     R1: np.ndarray
     R2: np.ndarray
@@ -100,6 +102,7 @@ class Rectification:
     maps_left: tuple[np.ndarray, np.ndarray]
     maps_right: tuple[np.ndarray, np.ndarray]
     positions: tuple[np.ndarray, np.ndarray]
+    rays: tuple[np.ndarray, np.ndarray]
 
     @property
     def shift(self) -> float:
@@ -179,9 +182,9 @@ def rectify(calibration: StereoCalibration) -> Rectification:
                                            cv2.CV_32FC1)
         grids.append((cx, (width, height), (maps[0], maps[1])))
     (cxl, size_l, maps_l), (cxr, size_r, maps_r) = grids
-    positions = rectified_positions(left.K, left.dist, r1, f, cxl, cy, left.size)
+    u, v, rx, ry = rectified_positions(left.K, left.dist, r1, f, cxl, cy, left.size)
     return Rectification(r1, r2, f, cy, cxl, cxr, size_l, size_r, float(t[0]), maps_l,
-                         maps_r, positions)
+                         maps_r, (u, v), (rx, ry))
 
 
 def _extent(device: Device, rot: np.ndarray) -> tuple[tuple[float, float], ...]:
@@ -210,16 +213,16 @@ class StereoResult:
 
     ``disparity``: float32 on the rectified left grid (``x_l - x_r`` with both grids'
     principal points removed; ``Z = -f * tx / d`` in the rectified frame), NaN where
-    unmatched. ``depth`` (float32 ``z``, mm), ``points`` (``(H, W, 3)`` float32, mm) and
-    ``mask``: on the left camera's own image grid, in its frame. ``grey``: ``(H, W)`` uint8
-    from the white frame (else the fringes' average), ``colors`` the same as RGB.
-    ``left``, ``right``: each camera's decode. ``info``: counts and settings (see
+    unmatched. ``depth`` (float32 ``z``, mm) and ``mask``: on the left camera's own image
+    grid; ``points``: ``(H, W, 3)`` float32 in its frame (mm, NaN where unknown), made
+    from the depth and each pixel's ray when asked for. ``grey``: ``(H, W)`` uint8 from the
+    white frame (else the fringes' average), ``colors`` the same as RGB. ``left``,
+    ``right``: each camera's decode. ``info``: counts and settings (see
     :func:`reconstruct_stereo`).
     """
 
     disparity: np.ndarray
     depth: np.ndarray
-    points: np.ndarray
     grey: np.ndarray
     mask: np.ndarray
     left: DecodeResult | AxesResult
@@ -228,13 +231,22 @@ class StereoResult:
     info: dict[str, Any] = field(default_factory=dict)
 
     @property
+    def points(self) -> np.ndarray:
+        """``(H, W, 3)`` float32, the left camera's frame (mm), NaN where unknown."""
+        x, y = self.rectification.rays
+        return np.stack([self.depth * x, self.depth * y, self.depth], axis=-1)
+
+    @property
     def colors(self) -> np.ndarray:
         """``(H, W, 3)`` uint8 RGB (grey)."""
         return np.repeat(self.grey[..., None], 3, axis=2)
 
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
-        return self.points[self.mask], np.repeat(self.grey[self.mask][:, None], 3, axis=1)
+        z = self.depth[self.mask]
+        x, y = (r[self.mask] for r in self.rectification.rays)
+        return (np.column_stack([z * x, z * y, z]),
+                np.repeat(self.grey[self.mask][:, None], 3, axis=1))
 
 
 def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
@@ -343,9 +355,8 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                                    other_tolerance=other_tolerance)
     disparity, status = supported(disparity, status, support)
     decoded = np.isfinite(coords[axis][0])
-    points, depth, outside = grid_points(disparity, *rect.positions, decoded, rect.f,
-                                         rect.cx_left, rect.cy, rect.tx, rect.R1, min_depth,
-                                         max_depth)
+    depth, outside = grid_depth(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
+                                rect.cy, rect.tx, rect.R1, min_depth, max_depth)
     mask = np.isfinite(depth)
     counts = np.bincount(status.ravel(), minlength=8)
     info: dict[str, Any] = {
@@ -372,8 +383,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         if not force:
             raise BistairError(message)
         info["warnings"].append(message)
-    return StereoResult(disparity, depth, points, _grey(left, offset), mask, left, right,
-                        rect, info)
+    return StereoResult(disparity, depth, _grey(left, offset), mask, left, right, rect, info)
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,

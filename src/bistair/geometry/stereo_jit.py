@@ -98,9 +98,12 @@ def remap_valid(values: np.ndarray, map_x: np.ndarray, map_y: np.ndarray,
 
 @kernel(parallel=True)
 def _positions(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, cx: float,
-               cy: float, h: int, w: int) -> tuple[np.ndarray, np.ndarray]:
+               cy: float, h: int, w: int
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     u = np.empty((h, w), np.float32)
     v = np.empty((h, w), np.float32)
+    rx = np.empty((h, w), np.float32)
+    ry = np.empty((h, w), np.float32)
     k1, k2, p1, p2, k3 = dist[0], dist[1], dist[2], dist[3], dist[4]
     for row in prange(h):
         yd = (row - k[1, 2]) / k[1, 1]
@@ -121,6 +124,8 @@ def _positions(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, cx: f
                 det = a * d - b * b
                 x -= (d * ex - b * ey) / det
                 y -= (a * ey - b * ex) / det
+            rx[row, col] = x
+            ry[row, col] = y
             rz = rot[2, 0] * x + rot[2, 1] * y + rot[2, 2]
             if rz > 0.0:
                 u[row, col] = f * (rot[0, 0] * x + rot[0, 1] * y + rot[0, 2]) / rz + cx
@@ -128,15 +133,15 @@ def _positions(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, cx: f
             else:
                 u[row, col] = np.nan
                 v[row, col] = np.nan
-    return u, v
+    return u, v, rx, ry
 
 
 def rectified_positions(K: np.ndarray, dist: np.ndarray, rotation: np.ndarray, f: float,
                         cx: float, cy: float, size: tuple[int, int]
-                        ) -> tuple[np.ndarray, np.ndarray]:
-    """Where every pixel of a camera image lands on its rectified grid: the pixel's ray
-    (undistorted exactly, Newton steps), turned by ``rotation`` and projected with focal
-    length ``f`` and principal point ``(cx, cy)``.
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Where every pixel of a camera image lands on its rectified grid, and its ray: the
+    pixel undistorted exactly (Newton steps), turned by ``rotation`` and projected with
+    focal length ``f`` and principal point ``(cx, cy)``.
 
     Parameters
     ----------
@@ -155,13 +160,16 @@ def rectified_positions(K: np.ndarray, dist: np.ndarray, rotation: np.ndarray, f
     -------
     u, v : numpy.ndarray
         ``(height, width)`` float32 rectified coordinates (NaN behind the rectified view).
+    x, y : numpy.ndarray
+        ``(height, width)`` float32 ray of each pixel in the camera's frame: the point at
+        depth ``z`` is ``z * (x, y, 1)``.
 
     Examples
     --------
     >>> K = np.array([[100.0, 0, 2], [0, 100, 1], [0, 0, 1]])
-    >>> u, v = rectified_positions(K, np.zeros(5), np.eye(3), 200.0, 10.0, 5.0, (4, 3))
-    >>> u[1].tolist(), v[:, 0].tolist()
-    ([6.0, 8.0, 10.0, 12.0], [3.0, 5.0, 7.0])
+    >>> u, v, x, y = rectified_positions(K, np.zeros(5), np.eye(3), 200.0, 10.0, 5.0, (4, 3))
+    >>> u[1].tolist(), v[:, 0].tolist(), [round(float(r), 4) for r in x[0]]
+    ([6.0, 8.0, 10.0, 12.0], [3.0, 5.0, 7.0], [-0.02, -0.01, 0.0, 0.01])
     """
     width, height = size
     return _positions(np.asarray(K, np.float64), np.asarray(dist, np.float64).ravel()[:5],
@@ -329,7 +337,7 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
         lb, le = np.empty(w // 2 + 1, np.int64), np.empty(w // 2 + 1, np.int64)
         lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
         lhint = np.empty((w // 2 + 1, 2), np.int64)
-        alone = np.empty(w, np.bool_)
+        alone = np.empty(w, np.uint8)  # not bool: numba reads bool arrays slowly
         for y in range(c * h // chunks, (c + 1) * h // chunks):
             nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
             nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
@@ -344,7 +352,7 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
                     status[y, x] = found
                     continue
                 back, xb = MATCHED, float(x)
-                if not alone[x]:
+                if alone[x] == 0:
                     back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin,
                                      lhint, nl, wiggle, 1)
                 if back != MATCHED or not abs(xb - x) <= tolerance:
@@ -365,7 +373,7 @@ def _alone(xs: np.ndarray, vs: np.ndarray, begins: np.ndarray, ends: np.ndarray,
            alone: np.ndarray) -> None:
     """Mark the columns of the runs that rise strictly and share no value with another
     run: each of their pixels comes back to itself, no search back is needed there."""
-    alone[:] = False
+    alone[:] = 0
     for r in range(runs):
         a, b = begins[r], ends[r]
         rising = True
@@ -379,7 +387,7 @@ def _alone(xs: np.ndarray, vs: np.ndarray, begins: np.ndarray, ends: np.ndarray,
                 rising = False
         if rising:
             for k in range(a, b):
-                alone[xs[k]] = True
+                alone[xs[k]] = 1
 
 
 def match_pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float = 0.0,
@@ -650,47 +658,39 @@ def supported(disparity: np.ndarray, status: np.ndarray, support: float = 2.0
 
 
 @kernel(parallel=True)
-def _points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
-            cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
-            max_step: float) -> tuple[np.ndarray, np.ndarray, int]:
+def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
+           cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
+           max_step: float) -> tuple[np.ndarray, int]:
     h, w = u.shape
-    points = np.empty((h, w, 3), np.float32)
     depth = np.empty((h, w), np.float32)
     outside = np.zeros(h, np.int64)
-    nan = np.float32(np.nan)
-    ftx = -f * tx
     for y in prange(h):
         for x in range(w):
-            px, py, z = nan, nan, math.nan
-            d = _bilinear(disparity, u[y, x], v[y, x], max_step) if valid[y, x] else math.nan
+            z = math.nan
+            d = math.nan
+            if valid[y, x] != 0:  # uint8: numba reads bool arrays slowly
+                d = _bilinear(disparity, u[y, x], v[y, x], max_step)
             if d * tx < 0.0:  # not NaN, and in front of the cameras
-                zr = ftx / d
-                scale = -tx / d  # zr / f
-                xr, yr = (u[y, x] - cx) * scale, (v[y, x] - cy) * scale
-                z = rt[2, 0] * xr + rt[2, 1] * yr + rt[2, 2] * zr
-                if zmin <= z <= zmax:
-                    px = rt[0, 0] * xr + rt[0, 1] * yr + rt[0, 2] * zr
-                    py = rt[1, 0] * xr + rt[1, 1] * yr + rt[1, 2] * zr
-                else:
+                scale = -tx / d  # Z / f in the rectified frame
+                z = ((u[y, x] - cx) * rt[2, 0] + (v[y, x] - cy) * rt[2, 1] + f * rt[2, 2]) * scale
+                if not zmin <= z <= zmax:
                     outside[y] += 1
                     z = math.nan
-            points[y, x, 0] = px
-            points[y, x, 1] = py
-            points[y, x, 2] = z
             depth[y, x] = z
-    return points, depth, outside.sum()
+    return depth, outside.sum()
 
 
-def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
-                f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
-                min_depth: float = 0.0, max_depth: float = math.inf,
-                max_step: float = 2.0) -> tuple[np.ndarray, np.ndarray, int]:
-    """3-D points on a camera's own image grid from the disparity on its rectified grid.
+def grid_depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
+               f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
+               min_depth: float = 0.0, max_depth: float = math.inf,
+               max_step: float = 2.0) -> tuple[np.ndarray, int]:
+    """Depth on a camera's own image grid from the disparity on its rectified grid.
 
     Each valid pixel reads the disparity ``d`` at its rectified position ``(u, v)``
     (bilinear between four confirmed disparities that spread by at most ``max_step``),
-    triangulates in the rectified frame (``Z = -f * tx / d``) and turns the point back into
-    the camera frame (``rotation`` is the rectifying rotation, ``R1``).
+    triangulates in the rectified frame (``Z = -f * tx / d``) and takes the point's ``z``
+    in the camera frame (``rotation`` is the rectifying rotation, ``R1``); the point is
+    ``z`` times the pixel's ray (:func:`rectified_positions`).
 
     Parameters
     ----------
@@ -715,10 +715,8 @@ def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.n
 
     Returns
     -------
-    points : numpy.ndarray
-        ``(H, W, 3)`` float32 in the camera frame (mm), NaN where unknown.
     depth : numpy.ndarray
-        ``(H, W)`` float32, their ``z``.
+        ``(H, W)`` float32 ``z`` in the camera frame (mm), NaN where unknown.
     outside : int
         Pixels triangulated but outside the depth range.
 
@@ -726,13 +724,12 @@ def grid_points(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.n
     --------
     >>> d = np.full((3, 4), 20.0, np.float32)  # f = 100, baseline 60 mm: 300 mm away
     >>> u, v = np.float32([[1.0, 2.5]]), np.float32([[1.0, 1.0]])
-    >>> pts, z, out = grid_points(d, u, v, np.ones((1, 2), bool), 100.0, 1.0, 1.0, -60.0,
-    ...                           np.eye(3))
-    >>> pts.round(3).tolist(), out
-    ([[[0.0, 0.0, 300.0], [4.5, 0.0, 300.0]]], 0)
+    >>> z, out = grid_depth(d, u, v, np.ones((1, 2), bool), 100.0, 1.0, 1.0, -60.0, np.eye(3))
+    >>> z.tolist(), out
+    ([[300.0, 300.0]], 0)
     """
-    return _points(np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
-                   np.asarray(v, np.float32), np.asarray(valid, np.bool_), float(f),
-                   float(cx), float(cy), float(tx),
-                   np.ascontiguousarray(np.asarray(rotation, np.float64).T),
-                   float(min_depth), float(max_depth), float(max_step))
+    return _depth(np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
+                  np.asarray(v, np.float32),
+                  np.ascontiguousarray(valid, np.bool_).view(np.uint8), float(f), float(cx),
+                  float(cy), float(tx), np.ascontiguousarray(np.asarray(rotation, np.float64).T),
+                  float(min_depth), float(max_depth), float(max_step))
