@@ -271,7 +271,7 @@ def test_refusals_of_the_command_line(simulated, tmp_path, monkeypatch, capfd):
         (["stereo", gray / "L", gray / "R", "--calibration", stereo_cal, "--depth-range",
           "9:1"], "--depth-range MIN:MAX needs MIN < MAX"),
         (["reconstruct", gray / "L", "--calibration", stereo_cal],
-         "a stereo calibration, not a camera-projector one"),
+         "a stereo calibration (two cameras: for bistair stereo), not a camera-projector one"),
     ]
     for args, message in cases:
         out = tmp_path / "out"

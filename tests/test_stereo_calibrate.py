@@ -19,10 +19,12 @@ from conftest import cli_run
 from bistair.app.stereo import parse_board
 from bistair.errors import BistairError
 from bistair.geometry.board import Board
+from bistair.geometry.calibration import Calibration, load_calibration, save_calibration
 from bistair.geometry.stereo_calibrate import calibrate_stereo_images
 from bistair.geometry.stereo_calibration import (
     StereoCalibration,
     load_stereo_calibration,
+    save_stereo_calibration,
 )
 from bistair.geometry.stereo_opencv import _example_stereo
 from bistair.io.read import read_image
@@ -231,3 +233,22 @@ def test_calibration_from_images_in_memory(boards):
         calibrate_stereo_images(left[:3], right[:2], Board())
     with pytest.raises(BistairError, match="the right image is 320x256, the right image of"):
         calibrate_stereo_images(left[:3], [*right[:2], right[2][::2, ::2]], Board())
+
+
+def test_the_two_kinds_of_calibration_file(tmp_path):
+    """A camera-projector file reads as before (no kind, or "kind": "camera-projector");
+    each reader refuses the other kind with one line."""
+    pair = _example_stereo()
+    mono = save_calibration(Calibration(pair.left, pair.right, pair.R, pair.T),
+                            tmp_path / "mono.json")
+    data = json.loads(mono.read_text())
+    assert "kind" not in data and load_calibration(mono).baseline == pytest.approx(150)
+    (tmp_path / "kind.json").write_text(json.dumps({**data, "kind": "camera-projector"}))
+    assert load_calibration(tmp_path / "kind.json").baseline == pytest.approx(150)
+    stereo = save_stereo_calibration(pair, tmp_path / "stereo.json")
+    assert_same(load_stereo_calibration(stereo), pair)
+    with pytest.raises(BistairError, match="a stereo calibration .two cameras: for bistair "
+                                           "stereo., not a camera-projector one"):
+        load_calibration(stereo)
+    with pytest.raises(BistairError, match="a camera-projector calibration, not a stereo one"):
+        load_stereo_calibration(mono)
