@@ -123,6 +123,11 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
         from .jobs import read_gamma, save_patterns
 
         values = {key: coerce_field(fields[key], value) for key, value in values.items()}
+        ctx = click.get_current_context()
+        given = {key: value for key, value in values.items()
+                 if ctx.get_parameter_source(key) is not click.core.ParameterSource.DEFAULT}
+        values.update({key: value for key, value in spec_class.defaults(given).items()
+                       if key not in given})
         if gamma_file is not None:
             values["gamma"] = read_gamma(gamma_file)
         spec = spec_class(**values)

@@ -124,6 +124,7 @@ def make_spec(method: str, **params: Any) -> BaseSpec:
     bistair.errors.BistairError: bad parameters for graycode: ...
     """
     codec = get_codec(method)
+    params = {**codec.spec_class.defaults(params), **params}
     try:
         return codec.spec_class(**params)
     except TypeError as exc:
