@@ -72,6 +72,31 @@ def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     return levels
 
 
+def covers(period: float, length: int) -> bool:
+    """Whether a period (or beat) spans ``length`` projector pixels, to within float
+    rounding: the beat of ``1920/58`` and ``1920/53`` computes as 1919.99999999998.
+
+    Parameters
+    ----------
+    period : float
+        A period or beat in projector pixels.
+    length : int
+        The coded axis in projector pixels.
+
+    Returns
+    -------
+    bool
+        ``period >= length`` up to a relative 1e-9.
+
+    Examples
+    --------
+    >>> top = beat_tree((1920 / 64, 1920 / 58, 1920 / 53))[-1][0]
+    >>> top < 1920, covers(top, 1920), covers(1919.0, 1920)
+    (True, True, False)
+    """
+    return period >= length * (1.0 - 1e-9)
+
+
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class MultiFreqSpec(BaseSpec):
     method = "multifreq"
@@ -85,7 +110,8 @@ class MultiFreqSpec(BaseSpec):
     def __post_init__(self) -> None:
         if (self.unwrap == "auto" and self.periods and self.orientation != "both"
                 and all(math.isfinite(t) for t in self.periods)):
-            rule = "hierarchical" if max(self.periods) >= self.coded_length else "heterodyne"
+            rule = "hierarchical" if covers(max(self.periods), self.coded_length) \
+                else "heterodyne"
             object.__setattr__(self, "unwrap", rule)
         super().__post_init__()
 
@@ -103,14 +129,14 @@ class MultiFreqSpec(BaseSpec):
             raise BistairError(f"periods must differ, got {self.periods}")
         if self.unwrap not in ("hierarchical", "heterodyne"):
             raise BistairError(f"unwrap must be hierarchical or heterodyne, got {self.unwrap!r}")
-        if self.unwrap == "hierarchical" and max(self.periods) < self.coded_length:
+        if self.unwrap == "hierarchical" and not covers(max(self.periods), self.coded_length):
             raise BistairError(
                 f"hierarchical unwrapping needs a period covering the {self.coded_length}-px "
                 f"axis; the longest is {max(self.periods)} (use heterodyne)"
             )
         if self.unwrap == "heterodyne":
             top = beat_tree(self.periods)[-1][0]
-            if top < self.coded_length:
+            if not covers(top, self.coded_length):
                 raise BistairError(
                     f"the beat of periods {self.periods} is {top:.0f} px, narrower than the "
                     f"{self.coded_length}-px coded axis"
