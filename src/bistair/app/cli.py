@@ -48,6 +48,15 @@ def _quiet(func: Callable) -> Callable:
                         help="print only errors and warnings (no progress, no summary)")(func)
 
 
+def _force(func: Callable) -> Callable:
+    """``--force``: decode where a thresholded check would refuse."""
+    return click.option("--force", is_flag=True,
+                        help="decode where a thresholded check would refuse the captures: its "
+                        "reasons are printed as warnings and kept in info.json ('forced'); "
+                        "hard errors (frame count, unreadable files, no valid pixel) stay "
+                        "errors")(func)
+
+
 def _threads(func: Callable) -> Callable:
     """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
 
@@ -188,11 +197,12 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@_force
 @_threads
 @_quiet
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
-           min_modulation: float | None, no_previews: bool, quiet: bool) -> None:
+           min_modulation: float | None, no_previews: bool, force: bool, quiet: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order.
 
     CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
@@ -201,8 +211,8 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     from .jobs import decode_folder
     from .progress import Progress
 
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
-               if v is not None}
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
+                                 ("force", force or None)) if v is not None}
     with Progress(quiet) as say:
         result = decode_folder(list(captures), out, spec_path, previews=not no_previews,
                                progress=say, **options)
@@ -427,12 +437,13 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="specs of both axes: drop pixels whose projector column and "
               "row lie farther than this (projector pixels) from the camera ray's projection")
+@_force
 @_threads
 @_quiet
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
                 depth: Path | None, strategy: str | None, depth_range: str | None,
-                epipolar_tolerance: float, quiet: bool) -> None:
+                epipolar_tolerance: float, force: bool, quiet: bool) -> None:
     """Decode, triangulate with a calibration, write a coloured PLY and a depth map.
 
     With a spec of both axes (orientation both), each point fits both projector
@@ -443,11 +454,14 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 
     depth = depth or out.with_name(out.stem + "-depth")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {} if strategy is None else {"strategy": strategy}
+    options = {k: v for k, v in (("strategy", strategy), ("force", force or None))
+               if v is not None}
     with Progress(quiet) as say:
         rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
                                  min_depth=low, max_depth=high,
                                  epipolar_tolerance=epipolar_tolerance, progress=say, **options)
+    for message in rec.info.get("warnings", []):
+        click.echo(f"Warning: {message}", err=True)
     if quiet:
         return
     notes = []
@@ -505,12 +519,13 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="with --calibration and specs of both axes: see "
               "'bistair reconstruct --help'")
+@_force
 @_quiet
 @reports_errors
 def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
           workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
           min_modulation: float | None, no_previews: bool, depth_range: str | None,
-          epipolar_tolerance: float, quiet: bool) -> None:
+          epipolar_tolerance: float, force: bool, quiet: bool) -> None:
     """Decode (with --calibration also reconstruct) many capture sets on Dask.
 
     ROOT: a folder whose sub-folders are the capture sets, or a CSV manifest with the
@@ -522,8 +537,8 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     from .jobs import parse_depth_range
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
-               if v is not None}
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
+                                 ("force", force or None)) if v is not None}
     try:
         report = run_batch(root, out, spec_path, calibration, workers=workers,
                            scheduler=scheduler, resume=resume, previews=not no_previews,

@@ -244,6 +244,12 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     say("triangulating")
     rec = reconstruct(decoded, calibration, spec, orientation, min_depth, max_depth,
                       epipolar_tolerance)
+    infos = [decoded.x.info, decoded.y.info] if isinstance(decoded, AxesResult) \
+        else [decoded.info]
+    for key in ("warnings", "forced"):  # the decode's, passed on to the caller
+        found = [m for info in infos for m in info.get(key, [])]
+        if found:
+            rec.info[key] = found
     pts, cols = rec.cloud()
     say(f"writing {len(pts)} points")
     if depth_dir is None:

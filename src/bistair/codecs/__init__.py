@@ -77,7 +77,7 @@ def get_codec(method: str) -> Codec:
     --------
     >>> codec = get_codec("graycode")
     >>> codec.name, codec.options
-    ('graycode', ('min_modulation', 'strategy'))
+    ('graycode', ('min_modulation', 'force', 'strategy'))
     >>> get_codec("fourier")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...

@@ -38,6 +38,7 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
+from ..core.checks import refuse
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, order_from_reference
 from ..errors import BistairError
@@ -403,8 +404,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
         if spec.unwrap == "heterodyne" and abs(turn) > 0.5:
             hint = f"; the shortest period is {turn:+.2f} rad off its beats: phase_offset " \
                    f"{(spec.phase_offset + turn + np.pi) % TWO_PI - np.pi:.3f}?"
-        raise BistairError(
-            f"the captures do not fit the spec: the periods agree on {100 * share:.0f}% of "
+        refuse(
+            f"the periods agree on {100 * share:.0f}% of "
             f"the modulated pixels (check the periods, the frame order, phase_offset and "
             f"shift_sign{hint})")
     if falling:

@@ -23,14 +23,88 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import BistairError
 from .checks_jit import code_steps, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 
 MIN_EDGES = 50  # code steps needed before the check says anything
+_FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
+
+
+def refuse(problem: str | None) -> None:
+    """Refuse captures that a thresholded check finds not to fit the spec: raise
+    ``BistairError("the captures do not fit the spec: <problem>")``, or inside
+    :func:`forcing` record the problem and go on.
+
+    Only the thresholded checks (a share of pixels, steps or windows past a limit) go
+    through here; hard errors (frame count, unreadable captures, no valid pixel) always
+    raise.
+
+    Parameters
+    ----------
+    problem : str or None
+        The check's one-line reason, or ``None`` when the check passed.
+
+    Raises
+    ------
+    BistairError
+        ``problem`` is not ``None`` and no :func:`forcing` is active.
+
+    Examples
+    --------
+    >>> refuse(None)
+    >>> refuse("half the windows are unknown")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: half the windows are unknown
+    >>> with forcing(True) as forced:
+    ...     refuse("half the windows are unknown")
+    >>> forced
+    ['half the windows are unknown']
+    """
+    if problem is None:
+        return
+    forced = _FORCED.get()
+    if forced is None:
+        raise BistairError(f"the captures do not fit the spec: {problem}")
+    forced.append(problem)
+
+
+@contextlib.contextmanager
+def forcing(force: bool = True) -> Iterator[list[str]]:
+    """Within the block, :func:`refuse` records problems instead of raising (``force``
+    True); yields the list it records them in (empty when ``force`` is False).
+
+    Parameters
+    ----------
+    force : bool
+        Decode where a thresholded check would refuse.
+
+    Yields
+    ------
+    list of str
+        The problems found, in the order the checks ran.
+
+    Examples
+    --------
+    >>> with forcing(False) as forced:
+    ...     pass
+    >>> forced
+    []
+    """
+    forced: list[str] = []
+    token = _FORCED.set(forced if force else None)
+    try:
+        yield forced
+    finally:
+        _FORCED.reset(token)
 
 
 @dataclass(frozen=True)

@@ -44,7 +44,7 @@ import math
 import numpy as np
 
 from ...core.captures import Prepared
-from ...core.checks import stair_misfit, wrap_steps
+from ...core.checks import refuse, stair_misfit, wrap_steps
 from ...core.measure import FringeSet
 from ...core.regions import core_weight, fringe_direction, fringe_regions
 from ...core.resolve import orders_from_regions
@@ -216,9 +216,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     theta, stair_mod = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
-        raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
-                           "between the levels of the code: are stair-cos and stair-sin "
-                           "swapped (or partitions and stairs wrong)?")
+        refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
+               "and stair-sin swapped (or partitions and stairs wrong)?")
     return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod}, cycle=spec.stairs)
 
 
@@ -291,8 +290,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
     info["stair_misfit"] = round(misfit, 4)
     if misfit > 0.1:
-        raise BistairError(
-            f"the captures do not fit the spec: at {100 * misfit:.0f}% of the decoded pixels "
+        refuse(
+            f"at {100 * misfit:.0f}% of the decoded pixels "
             "the stair phase is nearer a level other than the local or partition level of the "
             "decoded order: are partitions, stairs and period right, and stair-cos and "
             "stair-sin in the spec's order?")
