@@ -60,6 +60,7 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
+from ..core.checks import cell_steps, direction_problem, refuse
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, wrap
 from ..core.regions import core_weight, fringe_regions
@@ -401,6 +402,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
             "bits": spec.code_bits + spec.complementary}
     k = code.code
     if strategy == "pixel":
+        if spec.steps == 0:  # no phase to check the cells against: their direction
+            against, steps = cell_steps(k)
+            info.update(cell_steps=steps, cell_steps_against=against)
+            refuse(direction_problem(against, steps))
         return Orders(k, info)
     labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))

@@ -421,6 +421,71 @@ def jump_problem(violations: int, links: int, limit: float = 0.1,
             "too much noise or blur for this code?")
 
 
+def cell_steps(order: np.ndarray) -> tuple[int, int]:
+    """How a per-pixel code's cells (or orders) step between neighbouring decoded pixels
+    along the rows (the coded axis of the column layout): ``(against, steps)``, the steps
+    against the majority direction and all steps.
+
+    On a surface the cells grow one way along the coded axis (the other way on a mirrored
+    rig); steps against it happen only at occlusions and depth edges. A code read with a bit
+    inverted (a code frame exchanged with its inverse) runs backwards inside every block of
+    that bit, a low bit making half the steps go against the rest.
+
+    Parameters
+    ----------
+    order : (H, W) int array
+        Cells or orders, -1 where not decoded.
+
+    Returns
+    -------
+    (against, steps) : tuple of int
+
+    Examples
+    --------
+    >>> cells = np.tile(np.arange(40) // 2, (4, 1))
+    >>> cell_steps(cells)
+    (0, 76)
+    >>> cell_steps(cells ^ 1)  # the lowest bit read inverted
+    (36, 76)
+    """
+    a, b = order[:, :-1], order[:, 1:]
+    step = (b - a)[(a >= 0) & (b >= 0) & (a != b)]
+    up = int(np.count_nonzero(step > 0))
+    return min(up, step.size - up), int(step.size)
+
+
+def direction_problem(against: int, steps: int, limit: float = 0.25) -> str | None:
+    """A one-line reason to refuse when more than ``limit`` of a per-pixel code's steps run
+    against the rest (:func:`cell_steps`): a code frame exchanged with its inverse, or bits
+    in another order than the spec's.
+
+    Parameters
+    ----------
+    against : int
+        Steps against the majority direction.
+    steps : int
+        All steps; with fewer than 200, nothing is said.
+    limit : float
+        Share of steps against the rest above which to refuse (right decodes of the real
+        captures in ../shared/data: at most 7.5%, at occlusions).
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None``.
+
+    Examples
+    --------
+    >>> direction_problem(36, 76) is None, direction_problem(360, 760)[:30]
+    (True, 'the decoded cells run backwards')
+    """
+    if steps < 200 or against <= limit * steps:
+        return None
+    return (f"the decoded cells run backwards at {100 * against / steps:.0f}% of their steps "
+            "along the coded axis: are code frames exchanged with their inverses, or the bits "
+            "in another order than the spec's (frames, orientation)?")
+
+
 def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> float:
     """Median distance of the stair phases from the nearest level, in halves of that
     level's distance to its neighbour (0: on the levels, 1: halfway between two).
