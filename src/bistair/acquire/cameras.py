@@ -1,0 +1,481 @@
+"""Cameras that grab what the projector shows.
+
+- :class:`OpenCVCamera` (``opencv:INDEX|URL``): ``cv2.VideoCapture`` of a USB/UVC camera
+  (``INDEX``), a stream, a video file or an image sequence (``URL``, e.g. ``f%03d.png``).
+  Exposure and gain where the backend takes them (in the backend's own units).
+- :class:`GenicamCamera` (``genicam:PRODUCER.cti[:SERIAL]``): a GenICam camera through
+  ``harvesters`` (``pip install 'bistair[genicam]'``) and the vendor's GenTL producer;
+  exposure (``ExposureTime``, microseconds), gain (``Gain``) and pixel format
+  (``Mono8``, ``Mono12``, ``Mono16``).
+- :class:`ScreenCamera` (``screen[:MONITOR]``): screenshots of a monitor (mss), a camera
+  that looks at the screen itself, for tests and demonstrations.
+- :class:`SimCamera` (``sim[:SCENE[:WxH]]``): the virtual rig (:mod:`bistair.sim`)
+  renders what its camera sees of the pattern the display shows, with the imaging of
+  ``bistair simulate``'s defaults, frame ``k`` with the noise of frame ``k`` of
+  ``bistair simulate``.
+
+A camera is a context manager: leaving the ``with`` block (also by Ctrl-C or an error)
+releases the device. :meth:`Camera.grab` returns one :class:`Frame`, 2-D grey in the
+camera's own dtype (``uint8``; ``uint16`` for deeper pixel formats).
+
+Examples
+--------
+>>> import numpy as np
+>>> from bistair.acquire.displays import NoDisplay
+>>> with NoDisplay() as display, SimCamera("plane", (32, 24)) as camera:
+...     camera.attach(display)
+...     _ = display.show(np.full((1080, 1920), 255, np.uint8))
+...     frame = camera.grab()
+>>> frame.image.shape, frame.image.dtype
+((24, 32), dtype('uint8'))
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any, NamedTuple
+
+import cv2
+import mss
+import numpy as np
+
+from ..errors import BistairError
+from ..sim import Imaging, expose, preset, scene_names, trace
+from .displays import Display
+
+try:  # the optional extra bistair[genicam]
+    from harvesters.core import Harvester
+except ImportError:
+    Harvester = None
+
+GENICAM_EXTRA = "pip install 'bistair[genicam]'"
+PIXEL_FORMATS = ("Mono8", "Mono12", "Mono16")
+# the virtual camera's imaging: bistair simulate's defaults, so that a sim scan is its render
+SIM_IMAGING = dict(read_noise=0.01, camera_blur=1.0, gamma=2.2, ambient=0.05, bits=8, seed=0)
+FETCH_TIMEOUT = 5.0  # seconds a camera may take to deliver a frame
+
+
+class Frame(NamedTuple):
+    """One grabbed frame: the image, ``time.monotonic()`` when the grab returned and the
+    device's own timestamp in seconds (None where it has none)."""
+
+    image: np.ndarray
+    time: float
+    stamp: float | None = None
+
+
+class Camera:
+    """What every camera does; subclasses open, grab and close."""
+
+    kind = "camera"
+    settings: tuple[str, ...] = ()  # the settings it takes: exposure, gain, pixel_format
+    settle_ms: float | None = None  # its own settle time (None: measure it)
+
+    def __init__(self, exposure: float | None = None, gain: float | None = None,
+                 pixel_format: str | None = None) -> None:
+        asked = {"exposure": exposure, "gain": gain, "pixel_format": pixel_format}
+        for key, value in asked.items():
+            if value is not None and key not in self.settings:
+                raise BistairError(f"the {self.kind} camera has no {key.replace('_', ' ')} "
+                                   f"setting ({_takes(self.kind)})")
+        if pixel_format is not None and pixel_format not in PIXEL_FORMATS:
+            raise BistairError(f"pixel format must be one of {', '.join(PIXEL_FORMATS)}, got "
+                               f"{pixel_format!r}")
+        self.exposure, self.gain, self.pixel_format = exposure, gain, pixel_format
+        self.drop = 0  # frames a flush drops (set when open)
+        self.grabs = 0
+
+    @property
+    def name(self) -> str:
+        """The device string that opens this camera again."""
+        return self.kind
+
+    def __enter__(self) -> Camera:
+        self.open()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def open(self) -> None:
+        """Open the device and apply the settings."""
+
+    def close(self) -> None:
+        """Release the device; safe to call twice."""
+
+    def attach(self, display: Display) -> None:
+        """The display whose patterns the camera looks at (the simulated camera renders
+        them)."""
+
+    def check(self, width: int, height: int) -> None:
+        """Refuse patterns of ``width x height`` the camera cannot see whole."""
+
+    def grab(self) -> Frame:
+        """The next frame."""
+        raise NotImplementedError
+
+    def flush(self, count: int | None = None) -> int:
+        """Drop the frames buffered before now (``count`` of them, or the camera's own
+        number); returns how many were dropped."""
+        count = self.drop if count is None else count
+        for _ in range(count):
+            self.grab()
+        return count
+
+    def describe(self) -> dict[str, Any]:
+        """The camera as ``scan.json`` records it."""
+        return {"kind": self.kind, "name": self.name, "exposure": self.exposure,
+                "gain": self.gain, "pixel_format": self.pixel_format, "drop": self.drop}
+
+
+def _takes(kind: str) -> str:
+    return {"opencv": "opencv cameras take exposure and gain",
+            "genicam": "genicam cameras take exposure, gain and pixel format",
+            "sim": "the sim camera takes exposure, its response to white from 0 to 1"}.get(
+        kind, "it takes none")
+
+
+def grey(image: np.ndarray) -> np.ndarray:
+    """A camera frame as 2-D grey in its own dtype: a colour frame (BGR or BGRA) whose
+    channels agree gives one of them, else OpenCV's BGR-to-grey weights.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W)``, ``(H, W, 1)``, ``(H, W, 3)`` BGR or ``(H, W, 4)`` BGRA.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)``, contiguous.
+
+    Raises
+    ------
+    BistairError
+        If the frame is not an image of those shapes.
+
+    Examples
+    --------
+    >>> bgr = np.zeros((1, 2, 3), np.uint8); bgr[0, 1] = 200
+    >>> grey(bgr).tolist()
+    [[0, 200]]
+    """
+    image = np.asarray(image)
+    if image.ndim == 3 and image.shape[2] == 1:
+        image = image[:, :, 0]
+    if image.ndim == 2:
+        return np.ascontiguousarray(image)
+    if image.ndim != 3 or image.shape[2] not in (3, 4):
+        raise BistairError(f"the camera delivered an array of shape {image.shape}, not an "
+                           "image")
+    colour = image[:, :, :3]
+    if (colour[:, :, 0] == colour[:, :, 1]).all() and (colour[:, :, 0] == colour[:, :, 2]).all():
+        return np.ascontiguousarray(colour[:, :, 0])
+    return cv2.cvtColor(np.ascontiguousarray(colour), cv2.COLOR_BGR2GRAY)
+
+
+class OpenCVCamera(Camera):
+    """``opencv:INDEX|URL``: ``cv2.VideoCapture``. A device (``INDEX``) drops its buffered
+    frames after each pattern (the backend's buffer size, else 4); a file or stream none
+    unless told."""
+
+    kind = "opencv"
+    settings = ("exposure", "gain")
+
+    def __init__(self, source: int | str, **settings: Any) -> None:
+        super().__init__(**settings)
+        self.source = source
+        self._cap: Any = None
+        self.backend: str | None = None
+
+    @property
+    def name(self) -> str:
+        return f"opencv:{self.source}"
+
+    def open(self) -> None:
+        level = cv2.getLogLevel()
+        cv2.setLogLevel(0)  # OpenCV's own warnings would spoil the one-line error
+        try:
+            cap = cv2.VideoCapture(self.source)
+            opened = cap.isOpened()
+        finally:
+            cv2.setLogLevel(level)
+        if not opened:
+            cap.release()
+            what = "no such device or it is busy" if isinstance(self.source, int) else \
+                "no such file, or a stream or format OpenCV cannot read"
+            raise BistairError(f"cannot open camera {self.name}: {what}")
+        self._cap, self.backend = cap, cap.getBackendName()
+        for key, prop in (("exposure", cv2.CAP_PROP_EXPOSURE), ("gain", cv2.CAP_PROP_GAIN)):
+            value = getattr(self, key)
+            if value is None:
+                continue
+            if key == "exposure":
+                cap.set(cv2.CAP_PROP_AUTO_EXPOSURE, 0.25)  # manual, as V4L2 names it in OpenCV
+            if not cap.set(prop, float(value)):
+                self.close()
+                raise BistairError(f"camera {self.name} does not take the {key} {value:g} "
+                                   f"(its {self.backend} backend refused it)")
+        if isinstance(self.source, int):
+            buffered = cap.get(cv2.CAP_PROP_BUFFERSIZE)
+            self.drop = int(buffered) if buffered > 0 else 4
+
+    def close(self) -> None:
+        if self._cap is not None:
+            self._cap.release()
+            self._cap = None
+
+    def grab(self) -> Frame:
+        ok, image = self._cap.read()
+        now = time.monotonic()
+        if not ok or image is None:
+            raise BistairError(f"camera {self.name} delivered no frame after {self.grabs} "
+                               "(end of the stream, or the device was disconnected)")
+        self.grabs += 1
+        position = self._cap.get(cv2.CAP_PROP_POS_MSEC)
+        return Frame(grey(image), now, position / 1000.0 if position > 0 else None)
+
+    def describe(self) -> dict[str, Any]:
+        out = {**super().describe(), "backend": self.backend}
+        if self._cap is not None:
+            out["reported_exposure"] = self._cap.get(cv2.CAP_PROP_EXPOSURE)
+            out["reported_gain"] = self._cap.get(cv2.CAP_PROP_GAIN)
+        return out
+
+
+class GenicamCamera(Camera):
+    """``genicam:PRODUCER.cti[:SERIAL]``: the first camera the GenTL producer finds, or
+    the one with that serial number, through harvesters. Calls used: ``Harvester()``,
+    ``add_file(path, check_existence=True, check_validity=True)``, ``update()``,
+    ``device_info_list`` (``property_dict["serial_number"]``), ``create(index)``,
+    ``remote_device.node_map.<Node>.value``, ``start()``, ``try_fetch(timeout=)`` (a buffer
+    or None; ``payload.components[0]`` with ``data``, ``width``, ``height``; the buffer's
+    ``timestamp_ns``; ``queue()``), ``stop()``, ``destroy()`` and ``reset()``."""
+
+    kind = "genicam"
+    settings = ("exposure", "gain", "pixel_format")
+
+    def __init__(self, producer: str | Path, serial: str | None = None,
+                 **settings: Any) -> None:
+        super().__init__(**settings)
+        self.producer, self.serial = Path(producer), serial
+        self._harvester: Any = None
+        self._acquirer: Any = None
+        self.model: str | None = None
+
+    @property
+    def name(self) -> str:
+        return f"genicam:{self.producer}" + (f":{self.serial}" if self.serial else "")
+
+    def open(self) -> None:
+        if Harvester is None:
+            raise BistairError(f"genicam cameras need harvesters: {GENICAM_EXTRA}")
+        if not self.producer.is_file():
+            raise BistairError(f"GenTL producer file {self.producer} not found")
+        harvester = Harvester()
+        self._harvester = harvester
+        try:
+            harvester.add_file(str(self.producer), check_existence=True, check_validity=True)
+            harvester.update()
+        except (OSError, FileNotFoundError) as exc:
+            self.close()
+            raise BistairError(f"cannot load GenTL producer {self.producer}: "
+                               f"{_one_line(exc)}") from None
+        infos = [dict(getattr(info, "property_dict", {}) or {})
+                 for info in harvester.device_info_list]
+        serials = [str(info.get("serial_number")) for info in infos]
+        if not infos:
+            self.close()
+            raise BistairError(f"no GenICam camera found through {self.producer}")
+        index = 0
+        if self.serial is not None:
+            if self.serial not in serials:
+                self.close()
+                raise BistairError(f"no GenICam camera with serial {self.serial} through "
+                                   f"{self.producer} (found: {', '.join(serials)})")
+            index = serials.index(self.serial)
+        try:
+            self._acquirer = harvester.create(index)
+        except Exception as exc:  # harvesters raises GenTL's own exceptions
+            self.close()
+            raise BistairError(f"cannot open camera {self.name}: {_one_line(exc)}") from None
+        self.model = infos[index].get("model")
+        self.serial = self.serial or serials[index]
+        nodes = self._acquirer.remote_device.node_map
+        for names, value in ((("PixelFormat",), self.pixel_format),
+                             (("ExposureTime", "ExposureTimeAbs"), self.exposure),
+                             (("Gain", "GainRaw"), self.gain)):
+            if value is not None:
+                self._set(nodes, names, value)
+        self._acquirer.start()
+
+    def _set(self, nodes: Any, names: tuple[str, ...], value: Any) -> None:
+        for name in names:
+            node = getattr(nodes, name, None)
+            if node is None:
+                continue
+            try:
+                node.value = value
+            except Exception as exc:  # GenApi's own exceptions: out of range, not writable
+                self.close()
+                raise BistairError(f"camera {self.name} refused {name} = {value}: "
+                                   f"{_one_line(exc)}") from None
+            return
+        self.close()
+        raise BistairError(f"camera {self.name} has no {' or '.join(names)} node")
+
+    def close(self) -> None:
+        acquirer, harvester = self._acquirer, self._harvester
+        self._acquirer = self._harvester = None
+        if acquirer is not None:
+            acquirer.stop()
+            acquirer.destroy()
+        if harvester is not None:
+            harvester.reset()
+
+    def _fetch(self, timeout: float) -> Frame | None:
+        buffer = self._acquirer.try_fetch(timeout=timeout)
+        now = time.monotonic()
+        if buffer is None:
+            return None
+        try:
+            part = buffer.payload.components[0]
+            image = np.array(part.data, copy=True).reshape(int(part.height), int(part.width))
+            stamp = getattr(buffer, "timestamp_ns", None)
+        finally:
+            buffer.queue()
+        return Frame(image, now, stamp * 1e-9 if stamp else None)
+
+    def grab(self) -> Frame:
+        frame = self._fetch(FETCH_TIMEOUT)
+        if frame is None:
+            raise BistairError(f"camera {self.name} delivered no frame within "
+                               f"{FETCH_TIMEOUT:g} s (is it waiting for a trigger?)")
+        self.grabs += 1
+        return frame
+
+    def flush(self, count: int | None = None) -> int:
+        """Drop every frame already delivered (or ``count`` frames)."""
+        if count is not None:
+            return super().flush(count)
+        dropped = 0
+        while self._fetch(0.001) is not None:
+            dropped += 1
+        return dropped
+
+    def describe(self) -> dict[str, Any]:
+        return {**super().describe(), "producer": str(self.producer), "serial": self.serial,
+                "model": self.model}
+
+
+class ScreenCamera(Camera):
+    """``screen[:MONITOR]``: a screenshot of monitor ``MONITOR`` (from 0, as mss lists the
+    monitors after the union of all of them) for every frame; 8-bit grey."""
+
+    kind = "screen"
+
+    def __init__(self, monitor: int = 0, **settings: Any) -> None:
+        super().__init__(**settings)
+        self.monitor = monitor
+        self._shots: Any = None
+        self._area: dict[str, int] | None = None
+
+    @property
+    def name(self) -> str:
+        return f"screen:{self.monitor}"
+
+    def open(self) -> None:
+        try:
+            shots = mss.MSS()
+        except Exception as exc:  # mss raises ScreenShotError without a window system
+            raise BistairError(f"cannot open camera {self.name}: {_one_line(exc)}"
+                               f"{'' if 'DISPLAY' in str(exc) else ' (is DISPLAY set?)'}") \
+                from None
+        monitors = shots.monitors[1:]
+        if self.monitor >= len(monitors):
+            shots.close()
+            raise BistairError(f"cannot open camera {self.name}: there "
+                               f"{'is' if len(monitors) == 1 else 'are'} {len(monitors)} "
+                               f"monitor{'s' if len(monitors) != 1 else ''}")
+        self._shots, self._area = shots, dict(monitors[self.monitor])
+
+    def close(self) -> None:
+        if self._shots is not None:
+            self._shots.close()
+            self._shots = None
+
+    def grab(self) -> Frame:
+        shot = np.asarray(self._shots.grab(self._area))
+        self.grabs += 1
+        return Frame(grey(shot), time.monotonic())
+
+    def describe(self) -> dict[str, Any]:
+        return {**super().describe(), "area": self._area}
+
+
+class SimCamera(Camera):
+    """``sim[:SCENE[:WxH]]``: the virtual rig of a preset scene (``paper-sim`` by default;
+    camera size ``WxH``, by default the preset's) renders the pattern the display shows,
+    placed at the top-left of its projector as a screen shows it. Exposure: the response to
+    full white (0.8 by default, :class:`~bistair.sim.Imaging`)."""
+
+    kind = "sim"
+    settings = ("exposure",)
+    settle_ms = 0.0  # it sees the pattern the moment it is shown
+
+    def __init__(self, scene: str = "paper-sim", size: tuple[int, int] | None = None,
+                 **settings: Any) -> None:
+        super().__init__(**settings)
+        if scene not in scene_names():
+            raise BistairError(f"unknown sim scene {scene!r} (known: "
+                               f"{', '.join(scene_names())})")
+        extra = {} if self.exposure is None else {"exposure": self.exposure}
+        self.imaging = Imaging(**SIM_IMAGING, **extra)
+        self.scene, self.size = scene, size
+        self._trace: Any = None
+        self._display: Display | None = None
+
+    @property
+    def name(self) -> str:
+        return f"sim:{self.scene}" + (f":{self.size[0]}x{self.size[1]}" if self.size else "")
+
+    def open(self) -> None:
+        rig, geometry = preset(self.scene, **({} if self.size is None
+                                               else {"camera_size": self.size}))
+        self._trace = trace(rig, geometry, self.imaging)
+
+    def close(self) -> None:
+        self._trace = None
+
+    def attach(self, display: Display) -> None:
+        self._display = display
+
+    def check(self, width: int, height: int) -> None:
+        projector = self._trace.rig.projector
+        if width > projector.width or height > projector.height:
+            raise BistairError(f"the spec's {width}x{height} patterns do not fit the "
+                               f"{projector.width}x{projector.height} projector of "
+                               f"{self.name}")
+
+    def grab(self) -> Frame:
+        shown = None if self._display is None else self._display.current
+        if shown is None:
+            raise BistairError(f"camera {self.name} sees no pattern: nothing was shown")
+        projector = self._trace.rig.projector
+        self.check(shown.shape[1], shown.shape[0])
+        screen = np.zeros((projector.height, projector.width), np.float32)
+        screen[:shown.shape[0], :shown.shape[1]] = shown
+        image = expose(self._trace, screen[None], self.imaging, first_frame=self.grabs)[0]
+        self.grabs += 1
+        return Frame(image, time.monotonic())
+
+    def describe(self) -> dict[str, Any]:
+        camera = self._trace.rig.camera if self._trace is not None else None
+        return {**super().describe(), "scene": self.scene,
+                "size": [camera.width, camera.height] if camera else None,
+                "imaging": {**SIM_IMAGING, "exposure": self.imaging.exposure}}
+
+
+def _one_line(exc: BaseException) -> str:
+    return " ".join(str(exc).split()) or type(exc).__name__
