@@ -109,7 +109,8 @@ class Camera:
         them)."""
 
     def check(self, width: int, height: int) -> None:
-        """Refuse patterns of ``width x height`` the camera cannot see whole."""
+        """Refuse patterns of ``width x height`` the camera cannot see whole (before it
+        opens)."""
 
     def grab(self) -> Frame:
         """The next frame."""
@@ -194,13 +195,14 @@ class OpenCVCamera(Camera):
         return f"opencv:{self.source}"
 
     def open(self) -> None:
-        level = cv2.getLogLevel()
-        cv2.setLogLevel(0)  # OpenCV's own warnings would spoil the one-line error
+        level = cv2.utils.logging.getLogLevel()
+        # OpenCV's own warnings would spoil the one-line error
+        cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_SILENT)
         try:
             cap = cv2.VideoCapture(self.source)
             opened = cap.isOpened()
         finally:
-            cv2.setLogLevel(level)
+            cv2.utils.logging.setLogLevel(level)
         if not opened:
             cap.release()
             what = "no such device or it is busy" if isinstance(self.source, int) else \
@@ -433,6 +435,9 @@ class SimCamera(Camera):
         extra = {} if self.exposure is None else {"exposure": self.exposure}
         self.imaging = Imaging(**SIM_IMAGING, **extra)
         self.scene, self.size = scene, size
+        # the rig and scene are quick to make; the ray casting waits for open()
+        self._rig, self._geometry = preset(scene, **({} if size is None
+                                                     else {"camera_size": size}))
         self._trace: Any = None
         self._display: Display | None = None
 
@@ -441,9 +446,7 @@ class SimCamera(Camera):
         return f"sim:{self.scene}" + (f":{self.size[0]}x{self.size[1]}" if self.size else "")
 
     def open(self) -> None:
-        rig, geometry = preset(self.scene, **({} if self.size is None
-                                               else {"camera_size": self.size}))
-        self._trace = trace(rig, geometry, self.imaging)
+        self._trace = trace(self._rig, self._geometry, self.imaging)
 
     def close(self) -> None:
         self._trace = None
@@ -452,7 +455,7 @@ class SimCamera(Camera):
         self._display = display
 
     def check(self, width: int, height: int) -> None:
-        projector = self._trace.rig.projector
+        projector = self._rig.projector
         if width > projector.width or height > projector.height:
             raise BistairError(f"the spec's {width}x{height} patterns do not fit the "
                                f"{projector.width}x{projector.height} projector of "
@@ -471,9 +474,8 @@ class SimCamera(Camera):
         return Frame(image, time.monotonic())
 
     def describe(self) -> dict[str, Any]:
-        camera = self._trace.rig.camera if self._trace is not None else None
-        return {**super().describe(), "scene": self.scene,
-                "size": [camera.width, camera.height] if camera else None,
+        camera = self._rig.camera
+        return {**super().describe(), "scene": self.scene, "size": [camera.width, camera.height],
                 "imaging": {**SIM_IMAGING, "exposure": self.imaging.exposure}}
 
 

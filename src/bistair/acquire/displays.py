@@ -24,6 +24,7 @@ Examples
 from __future__ import annotations
 
 import os
+import sys
 import time
 from typing import Any
 
@@ -37,6 +38,7 @@ from ..errors import BistairError  # noqa: E402
 # SDL's defaults that would spoil a scan: a full-screen window minimised when another
 # window (the terminal on the other screen) takes the focus
 _SDL_HINTS = {"SDL_VIDEO_MINIMIZE_ON_FOCUS_LOSS": "0"}
+_NO_SCREEN = ("dummy", "offscreen")  # SDL's drivers that show nothing
 
 
 class Display:
@@ -129,14 +131,24 @@ class WindowDisplay(Display):
         return f"window:{self.screen}"
 
     def open(self) -> None:
+        chosen = os.environ.get("SDL_VIDEODRIVER")  # e.g. kmsdrm on a box without X
+        if sys.platform.startswith("linux") and not chosen and not (
+                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise BistairError(f"cannot open display {self.name}: no window system (DISPLAY "
+                               "and WAYLAND_DISPLAY are not set)")
         for key, value in _SDL_HINTS.items():
             os.environ.setdefault(key, value)
         try:
             pygame.display.init()
             sizes = pygame.display.get_desktop_sizes()
+            driver = pygame.display.get_driver()
         except pygame.error as exc:
             pygame.display.quit()
             raise BistairError(f"cannot open display {self.name}: {_sdl_message(exc)}") from None
+        if driver in _NO_SCREEN and driver != chosen:
+            pygame.display.quit()
+            raise BistairError(f"cannot open display {self.name}: SDL found no window system "
+                               f"(only its {driver} driver, which shows nothing)")
         if self.screen >= len(sizes):
             pygame.display.quit()
             known = "window:0" + (f" to window:{len(sizes) - 1}" if len(sizes) > 1 else "")
@@ -155,7 +167,7 @@ class WindowDisplay(Display):
                                f"{surface.get_height()} window on a {size[0]}x{size[1]} screen "
                                "(scaled desktop?): set the screen's scaling to 100%")
         self._surface, self.size = surface, (int(size[0]), int(size[1]))
-        self.driver = pygame.display.get_driver()
+        self.driver = driver
         pygame.display.set_caption("bistair scan")
         pygame.mouse.set_visible(False)
         surface.fill((0, 0, 0))

@@ -127,27 +127,35 @@ def scan(spec: BaseSpec | str | Path, display: Display | str, camera: Camera | s
     say = progress or (lambda text: None)
     patterns = pattern_images(spec)
     settle, source = settle_time(display, camera, settle_ms, latency_file)
+    camera.check(spec.width, spec.height)
     say(f"opening {display.name} and {camera.name}")
-    with display, camera:
-        display.check(spec.width, spec.height)
-        camera.attach(display)
-        camera.check(spec.width, spec.height)
-        started = datetime.now(UTC).isoformat(timespec="milliseconds")
-        start = time.monotonic()
-        frames, records = [], []
-        for index, (name, pattern) in enumerate(zip(spec.frames, patterns, strict=True)):
-            say(f"pattern {index + 1} of {len(patterns)} ({name})")
-            image, record = _one_pattern(display, camera, pattern, settle, drop, average,
-                                         frames[0] if frames else None)
-            frames.append(image)
-            records.append({"index": index, "name": name,
-                            **{k: _since(v, start) if k in _TIMES else v
-                               for k, v in record.items()}})
-        seconds = time.monotonic() - start
-        info = {"started": started, "seconds": round(seconds, 3),
-                "display": display.describe(), "camera": camera.describe(),
-                "settle_ms": settle, "settle_source": source, "average": average,
-                "drop": drop, "warnings": _warnings(display, camera, source, settle)}
+    with display:
+        display.check(spec.width, spec.height)  # its size is known once it is open
+        with camera:
+            camera.attach(display)
+            return _run(spec, display, camera, patterns, settle, source, drop, average, say)
+
+
+def _run(spec: BaseSpec, display: Display, camera: Camera, patterns: np.ndarray,
+         settle: float, source: str, drop: int | None, average: int,
+         say: Callable[[str], None]) -> Scan:
+    """The loop over the patterns, with both devices open."""
+    started = datetime.now(UTC).isoformat(timespec="milliseconds")
+    start = time.monotonic()
+    frames, records = [], []
+    for index, (name, pattern) in enumerate(zip(spec.frames, patterns, strict=True)):
+        say(f"pattern {index + 1} of {len(patterns)} ({name})")
+        image, record = _one_pattern(display, camera, pattern, settle, drop, average,
+                                     frames[0] if frames else None)
+        frames.append(image)
+        records.append({"index": index, "name": name,
+                        **{k: _since(v, start) if k in _TIMES else v
+                           for k, v in record.items()}})
+    seconds = time.monotonic() - start
+    info = {"started": started, "seconds": round(seconds, 3),
+            "display": display.describe(), "camera": camera.describe(),
+            "settle_ms": settle, "settle_source": source, "average": average,
+            "drop": drop, "warnings": _warnings(display, camera, source, settle)}
     return Scan(np.stack(frames), spec, records, info)
 
 
