@@ -19,10 +19,12 @@ from conftest import cli_run
 from support.scan_devices import Screen
 
 from bistair.acquire import scan
-from bistair.acquire.cameras import OpenCVCamera
+from bistair.acquire.cameras import SIM_BOARD, OpenCVCamera
 from bistair.acquire.devices import parse_camera, parse_display
 from bistair.acquire.latency import Latency, save_latency
 from bistair.acquire.loop import DEFAULT_SETTLE_MS, pattern_images, settle_time
+from bistair.app.jobs import calibrate_folder
+from bistair.app.scan import scan_folder
 from bistair.codecs import make_spec
 from bistair.errors import BistairError
 from bistair.evaluation.benchmark import method_specs
@@ -261,3 +263,21 @@ def test_a_signal_mid_scan_leaves_nothing(tmp_path, sig):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode != 0 and "Traceback" not in err
     assert list(runs.iterdir()) == []
+
+
+def test_calibration_workflow_one_scan_per_board_pose(tmp_path):
+    """Scan each board pose in both orientations (the virtual rig's board), then calibrate:
+    the scan folders are the pose folders 'bistair calibrate' reads."""
+    calib = tmp_path / "calib"
+    calib.mkdir()
+    (calib / "board.json").write_text(json.dumps(SIM_BOARD.to_dict()))
+    for pose in range(3):
+        for orientation in ("columns", "rows"):
+            spec = make_spec("graycode", width=1920, height=1080, period=30, white=1,
+                             orientation=orientation)
+            scan_folder(spec, "none", f"sim:board-{pose}:640x512",
+                        calib / f"pose-{pose:02d}" / orientation)
+    cal = calibrate_folder(calib)
+    assert len(cal.poses) == 3 and cal.rms < 0.5
+    assert abs(cal.baseline - 200.0) < 2.0  # the rig's: 200 mm (201.3 +- 0.5 from 3 poses)
+    assert abs(cal.camera.K[0, 0] / 1200.0 - 1) < 0.03  # the rig's: 1.875 * 640 px

@@ -12,7 +12,7 @@
 - :class:`SimCamera` (``sim[:SCENE[:WxH]]``): the virtual rig (:mod:`bistair.sim`)
   renders what its camera sees of the pattern the display shows, with the imaging of
   ``bistair simulate``'s defaults, frame ``k`` with the noise of frame ``k`` of
-  ``bistair simulate``.
+  ``bistair simulate``; a preset scene or a calibration board in one of eight poses.
 
 A camera is a context manager: leaving the ``with`` block (also by Ctrl-C or an error)
 releases the device. :meth:`Camera.grab` returns one :class:`Frame`, 2-D grey in the
@@ -41,7 +41,9 @@ import mss
 import numpy as np
 
 from ..errors import BistairError
-from ..sim import Imaging, expose, preset, scene_names, trace
+from ..geometry.board import Board
+from ..sim import Imaging, Rig, Scene, expose, preset, scene_names, trace
+from ..sim.boards import POSES, board_plane
 from .displays import Display
 
 try:  # the optional extra bistair[genicam]
@@ -54,6 +56,7 @@ PIXEL_FORMATS = ("Mono8", "Mono12", "Mono16")
 # the virtual camera's imaging: bistair simulate's defaults, so that a sim scan is its render
 SIM_IMAGING = dict(read_noise=0.01, camera_blur=1.0, gamma=2.2, ambient=0.05, bits=8, seed=0)
 FETCH_TIMEOUT = 5.0  # seconds a camera may take to deliver a frame
+SIM_BOARD = Board("checkerboard", 9, 6, 20.0)  # the board of the sim:board-N scenes
 
 
 class Frame(NamedTuple):
@@ -419,8 +422,10 @@ class ScreenCamera(Camera):
 class SimCamera(Camera):
     """``sim[:SCENE[:WxH]]``: the virtual rig of a preset scene (``paper-sim`` by default;
     camera size ``WxH``, by default the preset's) renders the pattern the display shows,
-    placed at the top-left of its projector as a screen shows it. Exposure: the response to
-    full white (0.8 by default, :class:`~bistair.sim.Imaging`)."""
+    placed at the top-left of its projector as a screen shows it. ``board-N`` (N from 0 to
+    7) is the 9 x 6 checkerboard of 20 mm of ``bistair simulate --scene calibration`` in its
+    pose N, on the default rig (1920 x 1080 projector). Exposure: the response to full
+    white (0.8 by default, :class:`~bistair.sim.Imaging`)."""
 
     kind = "sim"
     settings = ("exposure",)
@@ -429,15 +434,20 @@ class SimCamera(Camera):
     def __init__(self, scene: str = "paper-sim", size: tuple[int, int] | None = None,
                  **settings: Any) -> None:
         super().__init__(**settings)
-        if scene not in scene_names():
+        boards = [f"board-{i}" for i in range(len(POSES))]
+        if scene not in (*scene_names(), *boards):
             raise BistairError(f"unknown sim scene {scene!r} (known: "
-                               f"{', '.join(scene_names())})")
+                               f"{', '.join(scene_names())}, board-0 to {boards[-1]})")
         extra = {} if self.exposure is None else {"exposure": self.exposure}
         self.imaging = Imaging(**SIM_IMAGING, **extra)
         self.scene, self.size = scene, size
         # the rig and scene are quick to make; the ray casting waits for open()
-        self._rig, self._geometry = preset(scene, **({} if size is None
-                                                     else {"camera_size": size}))
+        sized = {} if size is None else {"camera_size": size}
+        if scene in boards:  # the board of 'bistair simulate --scene calibration' in a pose
+            self._rig = Rig.default(**sized)
+            self._geometry = Scene([board_plane(SIM_BOARD, *POSES[boards.index(scene)])])
+        else:
+            self._rig, self._geometry = preset(scene, **sized)
         self._trace: Any = None
         self._display: Display | None = None
 
