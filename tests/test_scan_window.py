@@ -138,7 +138,7 @@ def test_every_method_decodes_to_the_screen_pixels(x11, tmp_path, monkeypatch, c
     info = json.loads((out / "scan.json").read_text())
     assert info["display"]["size"] == list(SCREEN) and info["settle_ms"] == 20
     shown = [f["shown"] for f in info["frames"]]
-    assert all(f["settled"] - f["shown"] >= 0.02 for f in info["frames"])
+    assert all(f["settled"] - f["shown"] >= 0.0199 for f in info["frames"])  # 0.1-ms steps
     assert all(f["grabbed"][0] >= f["settled"] for f in info["frames"])
     assert shown == sorted(shown)
 

@@ -39,6 +39,7 @@ from ..errors import BistairError  # noqa: E402
 # window (the terminal on the other screen) takes the focus
 _SDL_HINTS = {"SDL_VIDEO_MINIMIZE_ON_FOCUS_LOSS": "0"}
 _NO_SCREEN = ("dummy", "offscreen")  # SDL's drivers that show nothing
+_SETTLE_WINDOW = 2.0  # seconds a new window may take to be shown
 
 
 class Display:
@@ -96,10 +97,12 @@ class Display:
         """Sleep until ``time.monotonic()`` reaches ``until``, keeping the window alive."""
         while (left := until - time.monotonic()) > 0:
             time.sleep(min(left, 0.01))
-            self._events()
+            self.poll()
 
-    def _events(self) -> None:
-        """Handle the window system's events (Esc or a closed window: KeyboardInterrupt)."""
+    def poll(self) -> bool:
+        """Handle the window system's events, so that the window stays alive (Esc or a
+        closed window: KeyboardInterrupt)."""
+        return False
 
     def describe(self) -> dict[str, Any]:
         """The display as ``scan.json`` records it."""
@@ -172,7 +175,11 @@ class WindowDisplay(Display):
         pygame.mouse.set_visible(False)
         surface.fill((0, 0, 0))
         pygame.display.flip()
-        self._events()
+        # the window system maps, resizes and exposes a new window for a moment
+        deadline, exposed = time.monotonic() + _SETTLE_WINDOW, False
+        while not exposed and time.monotonic() < deadline:
+            exposed = self.poll()
+            time.sleep(0.01)
 
     def close(self) -> None:
         if self._surface is not None:
@@ -189,15 +196,22 @@ class WindowDisplay(Display):
         self._surface.fill((0, 0, 0))
         self._surface.blit(picture, (0, 0))
         pygame.display.flip()
-        self._events()
+        self.poll()
 
-    def _events(self) -> None:
+    def poll(self) -> bool:
+        """Also draws the pattern again where the window system lost it (an exposed
+        window); returns whether it did."""
         if self._surface is None:
-            return
+            return False
+        exposed = False
         for event in pygame.event.get():
             if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN
                                              and event.key == pygame.K_ESCAPE):
                 raise KeyboardInterrupt
+            exposed |= event.type in (pygame.VIDEOEXPOSE, pygame.WINDOWEXPOSED)
+        if exposed:
+            pygame.display.flip()
+        return exposed
 
     def describe(self) -> dict[str, Any]:
         return {**super().describe(), "screen": self.screen, "driver": self.driver,

@@ -174,6 +174,7 @@ def _one_pattern(display: Display, camera: Camera, pattern: np.ndarray, settle: 
     grabs: list[Frame] = []
     for _ in range(average):
         frame = camera.grab()
+        display.poll()  # a window answers its window system while the camera works
         _check_frame(camera, frame.image, first if first is not None else
                      (grabs[0].image if grabs else None))
         grabs.append(frame)
