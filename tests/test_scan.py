@@ -70,6 +70,12 @@ def test_settings_a_camera_does_not_take(text, settings, message):
         parse_camera(text, **settings)
 
 
+def test_the_package_names_scan():
+    import bistair
+
+    assert bistair.scan is scan and "scan" in dir(bistair)
+
+
 def test_display_strings():
     assert parse_display("window").name == "window:0"
     assert parse_display("window:2").screen == 2

@@ -14,7 +14,7 @@ import pytest
 from conftest import cli_run
 from support import scan_devices
 
-from bistair.acquire import cameras, scan
+from bistair.acquire import genicam, scan
 from bistair.acquire.loop import pattern_images
 from bistair.app import scan as scan_job
 from bistair.codecs import decode, make_spec
@@ -41,7 +41,7 @@ def harvester(monkeypatch):
     """The stand-in Harvester class, watching a screen the loop drives."""
     stand_in = type("StandIn", (scan_devices.Harvester,),
                     {"screen": scan_devices.Screen(SIZE), "made": []})
-    monkeypatch.setattr(cameras, "Harvester", stand_in)
+    monkeypatch.setattr(genicam, "Harvester", stand_in)
     monkeypatch.setattr(scan_job, "parse_display", lambda text: stand_in.screen)
     return stand_in
 
@@ -132,7 +132,7 @@ def test_bad_cameras_one_line_exit_2_nothing_written(monkeypatch, capsys, spec, 
 
 def test_without_harvesters_the_error_names_the_extra(monkeypatch, capsys, spec, tmp_path,
                                                       producer):
-    monkeypatch.setattr(cameras, "Harvester", None)
+    monkeypatch.setattr(genicam, "Harvester", None)
     code, _, err = _scan(monkeypatch, capsys, spec, tmp_path, f"genicam:{producer}",
                          display="none")
     assert code == 2

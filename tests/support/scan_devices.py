@@ -1,6 +1,6 @@
 """Stand-ins for the scan tests: a display bistair drives that shows nothing (so the loop
 waits and drops frames without a window system), and a GenICam camera with the shape of the
-harvesters API (the calls :class:`bistair.acquire.cameras.GenicamCamera` makes).
+harvesters API (the calls :class:`bistair.acquire.genicam.GenicamCamera` makes).
 
 The stand-in camera looks at a :class:`Screen`: every frame it delivers shows the pattern
 last shown, as 16-bit codes (``Mono16``: code * 257, ``Mono8``: the code) plus an

@@ -24,8 +24,9 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import BistairError
-from .cameras import Camera, GenicamCamera, OpenCVCamera, ScreenCamera, SimCamera
+from .cameras import Camera, OpenCVCamera, ScreenCamera, SimCamera
 from .displays import Display, NoDisplay, WindowDisplay
+from .genicam import GenicamCamera
 
 DISPLAYS = "window[:SCREEN], none"
 CAMERAS = ("opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR], "
