@@ -12,7 +12,8 @@ import pytest
 from conftest import cli_run
 
 import bistair
-from bistair.app.jobs import calibrate_folder, reconstruct_folder
+from bistair.app.calibrate import calibrate_folder
+from bistair.app.jobs import reconstruct_folder
 from bistair.errors import BistairError
 from bistair.evaluation.metrics import fit_sphere
 from bistair.geometry.board import Board

@@ -353,46 +353,39 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--board", type=click.Path(path_type=Path), default=None,
-              help="board description [default: CAPTURES/board.json]")
+@click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
+              help="board.json, or e.g. chessboard:9x7:25 (inner corners, square in mm) "
+              "[default: CAPTURES/board.json]")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec of both axes for pose folders of captures [default: each "
+              "folder's spec.json, else CAPTURES/spec.json]")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found and mapped (3 or more)")
+@click.option("--corner-fit", type=click.Choice(["homography", "quadratic"]),
+              default="homography", show_default=True,
+              help="how a board feature is mapped to the projector")
 @_quiet
 @reports_errors
-def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
-              quiet: bool) -> None:
-    """Calibrate camera and projector from board captures (both orientations per pose).
+def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | None,
+              min_poses: int, corner_fit: str, quiet: bool) -> None:
+    """Calibrate camera and projector from board captures (both projector axes per pose:
+    columns/ and rows/ folders, or captures of both axes with one spec).
 
-    Prints the reprojection errors and one standard deviation of every parameter."""
+    Prints the reprojection errors and one standard deviation of every parameter; a pose
+    that does not decode or does not show the board is skipped with a warning."""
     from ..geometry.calibrate import MIN_POSES
-    from .jobs import calibrate_folder
+    from .calibrate import calibrate_folder, summary_lines
     from .progress import Progress
 
     if min_poses < MIN_POSES:
         raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
                        f"needs at least {MIN_POSES} board poses")
     with Progress(quiet) as say:
-        cal = calibrate_folder(captures, out, board=board, min_poses=min_poses, progress=say)
-    if quiet:
-        return
-    sigma = cal.uncertainty
-    click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
-               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} +/- "
-               f"{sigma.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} poses; "
-               f"wrote {out}")
-    for name in ("camera", "projector"):
-        dev, sd = getattr(cal, name), getattr(sigma, name)
-        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
-        click.echo(f"  {name + ':':10s} " + ", ".join(
-            f"{key} {v:.2f} +/- {s:.2f}"
-            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
-    click.echo(f"  rotation +/- {sigma.angle:.3f} deg, T +/- "
-               f"({', '.join(f'{v:.2f}' for v in sigma.T)}) mm (one standard deviation, from "
-               f"correspondence noise of {sigma.noise[0]:.3f} px in the camera and "
-               f"{sigma.noise[1]:.3f} px in the projector per coordinate)")
-    for pose in cal.poses:
-        click.echo(f"  {pose['name']}: {pose['features']} features, camera "
-                   f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
+        cal = calibrate_folder(captures, out, board=board, spec=spec_path, min_poses=min_poses,
+                               corner_fit=corner_fit, progress=say,
+                               skipped=lambda name, why: say.warn(f"skipped {name}: {why}"))
+    if not quiet:
+        click.echo("\n".join(summary_lines(cal, out)))
 
 
 @cli.command("import-calibration")
