@@ -290,13 +290,17 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
               help="with --count: processes of the local cluster [default: the cores]")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="with --count: run on an existing Dask cluster instead")
+@click.option("--no-white", is_flag=True,
+              help="--scene calibration: no white frame (the board is found in the mean image)")
+@click.option("--both-axes", is_flag=True,
+              help="--scene calibration: one capture set of both axes per pose")
 @_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None,
-             quiet: bool) -> None:
+             vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
+             both_axes: bool, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
@@ -318,7 +322,7 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-                progress=say, **imaging)
+                progress=say, white=not no_white, both_axes=both_axes, **imaging)
         if quiet:
             return
         if scene == "calibration":
@@ -328,6 +332,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
             click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
                        f"to {out}")
         return
+    if no_white or both_axes:
+        raise CliError("--no-white and --both-axes are for --scene calibration")
     from .simulate import simulate_many
 
     try:
