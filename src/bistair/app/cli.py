@@ -398,17 +398,18 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--projector-size", required=True, metavar="WxH",
-              help="projector size WIDTHxHEIGHT")
+@click.option("--projector-size", default=None, metavar="WxH",
+              help="projector size WIDTHxHEIGHT [default: from projector_size, screenResX + "
+              "screenResY, ... in the files]")
 @click.option("--camera-size", default=None, metavar="WxH",
               help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
-              "image_width + image_height, ... in the files]")
+              "image_width + image_height, frameWidth + frameHeight, S, ... in the files]")
 @click.option("--keys", default=None, metavar="NAME=KEY,...",
               help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
               "projector=M2,projector_dist=D2,R=R,T=T]; "
-              "camera_size=KEY names the size key")
+              "camera_size=KEY and projector_size=KEY name the size keys")
 @reports_errors
-def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
+def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
                        camera_size: str | None, keys: str | None) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.

@@ -261,14 +261,15 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
 
 
 def import_calibration(files: Sequence[str | Path], out: str | Path,
-                       projector_size: tuple[int, int] | str,
+                       projector_size: tuple[int, int] | str | None,
                        camera_size: tuple[int, int] | str | None = None,
                        keys: Mapping[str, str] | str | None = None) -> Calibration:
     """Read an OpenCV FileStorage calibration (YAML or XML, keys of several files merged)
     and write it as a bistair calibration file ``out`` (atomically).
 
-    Sizes are ``(width, height)`` or ``"WxH"``; ``keys`` renames parts (a mapping or
-    ``"camera=M1,T=T"``), see :func:`~bistair.geometry.opencv.read_opencv_calibration`.
+    Sizes are ``(width, height)`` or ``"WxH"``, or ``None`` to read them from the files;
+    ``keys`` renames parts (a mapping or ``"camera=M1,T=T"``), see
+    :func:`~bistair.geometry.opencv.read_opencv_calibration`.
     Nothing is written on error.
     """
     if isinstance(projector_size, str):
