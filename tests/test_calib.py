@@ -453,7 +453,8 @@ def test_other_layout_errors(tmp_path):
     reason = "rows: the multifreq spec needs 8 frames, the captures have 9"
     assert one_line(exc) == ("board found in 0 of 2 poses, need at least 3; 1 not decoded "
                              f"(pose-01: {reason})")
-    assert skipped == [("pose-00", "board not found in its white frame"), ("pose-01", reason)]
+    assert skipped == [("pose-00", "board not found in its white frame nor in its mean image"),
+                       ("pose-01", reason)]
     (tmp_path / "board.json").unlink()
     with pytest.raises(BistairError, match="board description .* not found"):
         calibrate_folder(tmp_path)

@@ -11,8 +11,9 @@ pose, in one of two layouts::
 
 The board is the ``--board`` description (a ``board.json`` file or
 ``chessboard:COLUMNSxROWS:SQUARE``), by default ``calib/board.json``. It is found in the
-pose's white frame, or for a spec without one in the mean image of the captures (the
-decode's average: the mean of the phase shifts, or of each Gray code bit and its inverse),
+pose's white frame, or for a spec without one (or when it is not found there) in the mean
+image of the captures (the decode's average: the mean of the phase shifts, or of each Gray
+code bit and its inverse),
 and each feature is mapped to the projector by a local homography of the decoded
 coordinates around it (:func:`~bistair.geometry.calibrate.board_view`). A pose whose
 captures do not decode, or whose board is not found or not mapped, is skipped (the
@@ -23,8 +24,11 @@ folder, projector sizes or camera images that differ, stop the job.
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from ..codecs import decode
 from ..core.result import AxesResult, DecodeResult
@@ -92,10 +96,12 @@ def pose_specs(folder: Path, root: Path, spec: BaseSpec | None) -> dict[str, Bas
     return {"both": spec}
 
 
-def read_pose(folder: Path, specs: dict[str, BaseSpec]) -> tuple[PoseCapture, str]:
+def read_pose(folder: Path, specs: dict[str, BaseSpec]
+              ) -> tuple[PoseCapture, np.ndarray | None]:
     """Decode one pose: its :class:`~bistair.geometry.calibrate.PoseCapture` (the board
-    image, the projector column and row per camera pixel) and which image the board is
-    looked for in (``"white frame"`` or ``"mean image"``)."""
+    image: the white frame, else the mean image; the projector column and row per camera
+    pixel) and, when the board image is the white frame, the mean image (a second place to
+    look for the board)."""
     if "both" in specs:
         stack, spec = read_with_spec(folder, specs["both"])
         result = decode(stack, spec)
@@ -109,10 +115,10 @@ def read_pose(folder: Path, specs: dict[str, BaseSpec]) -> tuple[PoseCapture, st
                              f"{y.coord.shape[0]}, earlier ones {x.coord.shape[1]}x"
                              f"{x.coord.shape[0]}")
     white = x.texture if x.texture is not None else y.texture
-    image = "white frame" if white is not None else "mean image"
+    mean = (x.average + y.average) / 2
     if white is None:
-        white = (x.average + y.average) / 2
-    return PoseCapture(folder.name, white, x.coord, y.coord), image
+        return PoseCapture(folder.name, mean, x.coord, y.coord), None
+    return PoseCapture(folder.name, white, x.coord, y.coord), mean
 
 
 class _SizeError(BistairError):
@@ -198,16 +204,20 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
                                    f"specs for {proj_size[0]}x{proj_size[1]}")
         say(f"decoding pose {number} of {len(folders)} ({sub.name})")
         try:
-            pose, image = read_pose(sub, specs)
+            pose, mean = read_pose(sub, specs)
         except _SizeError:
             raise
         except BistairError as exc:
             failed.append(f"{sub.name}: {exc}")
             skip(sub.name, str(exc))
             continue
+        say(f"finding the board in pose {number} of {len(folders)} ({sub.name})")
         view = board_view(pose, board, corner_fit)
+        if not view.found and mean is not None:  # e.g. a white frame with clipped squares
+            view = board_view(replace(pose, white=mean), board, corner_fit)
         if not view.usable:
-            skip(sub.name, f"{view.why} in its {image}" if not view.found else view.why)
+            where = "mean image" if mean is None else "white frame nor in its mean image"
+            skip(sub.name, f"{view.why} in its {where}" if not view.found else view.why)
         elif cam_size is None:
             cam_size = pose.white.shape
         elif pose.white.shape != cam_size:
