@@ -395,15 +395,27 @@ def test_too_few_boards(tmp_path):
 
 
 def test_too_few_boards_in_real_poses(captures, tmp_path):
+    """A white frame that misses the board: found in the mean image instead; a pose of the
+    projected patterns themselves (no board in either image): skipped, and two poses are too
+    few."""
     root, _ = captures
     shutil.copy(root / "board.json", tmp_path)
     for i in range(3):
         shutil.copytree(root / f"pose-0{i}", tmp_path / f"pose-0{i}")
     white = sorted((tmp_path / "pose-02" / "columns").glob("*.tif"))[-1]
     write_image(white, np.full((512, 640), 128, np.uint8))  # a white frame without the board
+    cal = calibrate_folder(tmp_path)
+    assert [pose["name"] for pose in cal.poses] == ["pose-00", "pose-01", "pose-02"]
+    shutil.rmtree(tmp_path / "pose-02")
+    for o in ("columns", "rows"):
+        images = np.round(bistair.encode(sim_spec(o)) * 255).astype(np.uint8)
+        write_pose(tmp_path / "pose-02" / o, images, sim_spec(o))
+    skipped: list[tuple[str, str]] = []
     with pytest.raises(BistairError) as exc:
-        calibrate_folder(tmp_path, out=tmp_path / "calib.json")
+        calibrate_folder(tmp_path, out=tmp_path / "calib.json",
+                         skipped=lambda *pose: skipped.append(pose))
     assert one_line(exc) == "board found in 2 of 3 poses, need at least 3"
+    assert skipped == [("pose-02", "board not found in its white frame nor in its mean image")]
     assert not (tmp_path / "calib.json").exists()
     with pytest.raises(BistairError) as exc:  # two poses are too few whatever one asks for
         calibrate_folder(tmp_path, out=tmp_path / "calib.json", min_poses=2)
