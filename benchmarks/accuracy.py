@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 import bistair
-from bistair.app.jobs import calibrate_folder
+from bistair.app.calibrate import calibrate_folder
 from bistair.app.simulate import simulate
 from bistair.evaluation.benchmark import method_specs
 from bistair.evaluation.metrics import fit_plane, fit_sphere

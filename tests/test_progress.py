@@ -93,3 +93,20 @@ def test_an_error_after_progress_is_still_one_line(captures: Path, tmp_path: Pat
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and done.stderr.startswith("Error: ")
     assert not (tmp_path / "d").exists()
+
+
+def test_warnings_are_printed_also_when_quiet_and_above_the_live_line() -> None:
+    log = io.StringIO()
+    with Progress(quiet=True, stream=log) as say:
+        say("not shown")
+        say.warn("skipped pose-03: board not found")
+    assert log.getvalue() == "Warning: skipped pose-03: board not found\n"
+    tty = _Terminal()
+    with Progress(stream=tty, delay=0.0) as say:
+        say("decoding pose 1 of 2")
+        say.warn("skipped pose-01: board not found")
+    text = tty.getvalue()
+    line = "bistair: decoding pose 1 of 2 ... 0 s"
+    # the live line is erased, the warning written on a line of its own
+    assert text.startswith(f"\r{line}\r{' ' * len(line)}\rWarning: skipped pose-01: board "
+                           "not found\n")

@@ -290,13 +290,17 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
               help="with --count: processes of the local cluster [default: the cores]")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="with --count: run on an existing Dask cluster instead")
+@click.option("--no-white", is_flag=True,
+              help="--scene calibration: no white frame (the board is found in the mean image)")
+@click.option("--both-axes", is_flag=True,
+              help="--scene calibration: one capture set of both axes per pose")
 @_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None,
-             quiet: bool) -> None:
+             vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
+             both_axes: bool, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
@@ -318,7 +322,7 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-                progress=say, **imaging)
+                progress=say, white=not no_white, both_axes=both_axes, **imaging)
         if quiet:
             return
         if scene == "calibration":
@@ -328,6 +332,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
             click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
                        f"to {out}")
         return
+    if no_white or both_axes:
+        raise CliError("--no-white and --both-axes are for --scene calibration")
     from .simulate import simulate_many
 
     try:
@@ -353,63 +359,57 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--board", type=click.Path(path_type=Path), default=None,
-              help="board description [default: CAPTURES/board.json]")
+@click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
+              help="board.json, or e.g. chessboard:9x7:25 (inner corners, square in mm) "
+              "[default: CAPTURES/board.json]")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec of both axes for pose folders of captures [default: each "
+              "folder's spec.json, else CAPTURES/spec.json]")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found and mapped (3 or more)")
+@click.option("--corner-fit", type=click.Choice(["homography", "quadratic"]),
+              default="homography", show_default=True,
+              help="how a board feature is mapped to the projector")
 @_quiet
 @reports_errors
-def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
-              quiet: bool) -> None:
-    """Calibrate camera and projector from board captures (both orientations per pose).
+def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | None,
+              min_poses: int, corner_fit: str, quiet: bool) -> None:
+    """Calibrate camera and projector from board captures (both projector axes per pose:
+    columns/ and rows/ folders, or captures of both axes with one spec).
 
-    Prints the reprojection errors and one standard deviation of every parameter."""
+    Prints the reprojection errors and one standard deviation of every parameter; a pose
+    that does not decode or does not show the board is skipped with a warning."""
     from ..geometry.calibrate import MIN_POSES
-    from .jobs import calibrate_folder
+    from .calibrate import calibrate_folder, summary_lines
     from .progress import Progress
 
     if min_poses < MIN_POSES:
         raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
                        f"needs at least {MIN_POSES} board poses")
     with Progress(quiet) as say:
-        cal = calibrate_folder(captures, out, board=board, min_poses=min_poses, progress=say)
-    if quiet:
-        return
-    sigma = cal.uncertainty
-    click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
-               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} +/- "
-               f"{sigma.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} poses; "
-               f"wrote {out}")
-    for name in ("camera", "projector"):
-        dev, sd = getattr(cal, name), getattr(sigma, name)
-        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
-        click.echo(f"  {name + ':':10s} " + ", ".join(
-            f"{key} {v:.2f} +/- {s:.2f}"
-            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
-    click.echo(f"  rotation +/- {sigma.angle:.3f} deg, T +/- "
-               f"({', '.join(f'{v:.2f}' for v in sigma.T)}) mm (one standard deviation, from "
-               f"correspondence noise of {sigma.noise[0]:.3f} px in the camera and "
-               f"{sigma.noise[1]:.3f} px in the projector per coordinate)")
-    for pose in cal.poses:
-        click.echo(f"  {pose['name']}: {pose['features']} features, camera "
-                   f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
+        cal = calibrate_folder(captures, out, board=board, spec=spec_path, min_poses=min_poses,
+                               corner_fit=corner_fit, progress=say,
+                               skipped=lambda name, why: say.warn(f"skipped {name}: {why}"))
+    if not quiet:
+        click.echo("\n".join(summary_lines(cal, out)))
 
 
 @cli.command("import-calibration")
 @click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--projector-size", required=True, metavar="WxH",
-              help="projector size WIDTHxHEIGHT")
+@click.option("--projector-size", default=None, metavar="WxH",
+              help="projector size WIDTHxHEIGHT [default: from projector_size, screenResX + "
+              "screenResY, ... in the files]")
 @click.option("--camera-size", default=None, metavar="WxH",
               help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
-              "image_width + image_height, ... in the files]")
+              "image_width + image_height, frameWidth + frameHeight, S, ... in the files]")
 @click.option("--keys", default=None, metavar="NAME=KEY,...",
               help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
               "projector=M2,projector_dist=D2,R=R,T=T]; "
-              "camera_size=KEY names the size key")
+              "camera_size=KEY and projector_size=KEY name the size keys")
 @reports_errors
-def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str,
+def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
                        camera_size: str | None, keys: str | None) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
