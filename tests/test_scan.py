@@ -23,7 +23,7 @@ from bistair.acquire.cameras import SIM_BOARD, OpenCVCamera
 from bistair.acquire.devices import parse_camera, parse_display
 from bistair.acquire.latency import Latency, save_latency
 from bistair.acquire.loop import DEFAULT_SETTLE_MS, pattern_images, settle_time
-from bistair.app.jobs import calibrate_folder
+from bistair.app.calibrate import calibrate_folder
 from bistair.app.scan import scan_folder
 from bistair.codecs import make_spec
 from bistair.errors import BistairError
