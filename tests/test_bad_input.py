@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -176,9 +177,25 @@ def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, cap
     # a run slower than the progress delay (a cold numba cache compiles for seconds) prints
     # progress lines before the refusal: they are not what this test is about
     monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
+    cwd = tmp_path / "cwd"  # where a relative (or empty) output path would land
+    cwd.mkdir()
+    monkeypatch.chdir(cwd)
+    before = _tree(inputs)
     code, _, err = cli_run(monkeypatch, capsys, *(a.format(**paths) for a in args))
-    lines = [line for line in err.splitlines() if line.strip()]
+    # a calibration names each pose it leaves out (a warning) before it refuses
+    lines = [line for line in err.splitlines()
+             if line.strip() and not line.startswith("Warning: skipped pose-0")]
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith("Error: "), err
     assert message in lines[0], lines[0]
+    # nothing written: not the output, not beside the inputs (an output path that is an
+    # input folder), not in the working directory (an empty or relative output path)
     assert not out.exists()
+    assert _tree(inputs) == before, "files written or changed among the inputs"
+    assert list(cwd.iterdir()) == [], "files written in the working directory"
+
+
+def _tree(root: Path) -> dict[str, tuple[int, int]]:
+    """Every file and folder under ``root``: (size, mtime in ns), hidden ones included."""
+    return {str(p.relative_to(root)): (p.stat().st_size, p.stat().st_mtime_ns)
+            for p in sorted(root.rglob("*"))}

@@ -14,11 +14,12 @@ from conftest import score, warped_scene
 from scipy import ndimage
 
 import bistair
+from bistair.codecs import decode, encode, make_spec
 from bistair.codecs.graycode import gray_to_binary
 from bistair.codecs.lv import code_sequence
 from bistair.codecs.multifreq import beat_tree
 from bistair.errors import BistairError
-from bistair.sim.warp import Blob, WarpScene
+from bistair.sim.warp import Blob, WarpScene, render_warp
 
 EXACT = [
     ("multifreq", dict(periods=(1080, 180, 30))),
@@ -170,3 +171,30 @@ def test_multifreq_background_is_invalid():
     res, truth, _ = score(spec, warped_scene(2, noise=0.01, blur=1.0))
     far = ~ndimage.binary_dilation(truth.object_id > 0, iterations=6)
     assert not res.mask[far].any() and (res.order[far] == -1).all()
+
+
+def test_classic_heterodyne_design_decodes():
+    """64, 58 and 53 fringes over 1920 px: beats of 320 and 384 px, and a top beat of
+    exactly the coded axis (1919.99999999998 in floats, accepted)."""
+    spec = make_spec("multifreq", width=1920, height=64,
+                     periods=(1920 / 64, 1920 / 58, 1920 / 53), steps=4)
+    assert spec.unwrap == "heterodyne"
+    scene = warped_scene(0, noise=0.01, blur=1.0, size=(240, 640))
+    images, truth = render_warp(spec, scene)
+    res = decode(images, spec)
+    known = res.mask & truth.mask
+    assert known.sum() > 0.8 * truth.mask.sum()
+    err = np.abs(res.coord - truth.coord(spec))[known]
+    assert np.mean(err < 2.0) > 0.999 and err.max() < 15.0  # no pixel a fringe (30 px) off
+
+
+@pytest.mark.parametrize("dtype", ["float16", "int8", "int32", "uint32", "uint64", "longdouble"])
+def test_every_real_dtype_decodes(dtype):
+    spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3, stairs=4,
+                     group_rows=16, local_rows=10)
+    pats = encode(spec)
+    kind = np.dtype(dtype).kind
+    images = (np.round(pats * min(np.iinfo(dtype).max, 65535)).astype(dtype) if kind in "iu"
+              else pats.astype(dtype))
+    res = decode(images, spec)
+    assert res.mask.all() and np.allclose(res.coord[0], np.arange(240), atol=0.05)

@@ -119,6 +119,46 @@ def test_renamed_keys_rotation_vector_and_other_size_keys(tmp_path, monkeypatch,
         assert_same(load_calibration(out), cal)
 
 
+@pytest.mark.parametrize("suffix", [".xml", ".yml"])
+def test_slstudio_names_and_sizes(suffix, tmp_path, monkeypatch, capfd):
+    """SLStudio's calibration file: Kc, kc, Kp, kp, Rp, Tp (X_p = Rp X_c + Tp), its errors,
+    the camera size as frameWidth + frameHeight and the projector's as screenResX +
+    screenResY: no size option needed."""
+    cal = _example_calibration()
+    names = {"camera": "Kc", "camera_dist": "kc", "projector": "Kp", "projector_dist": "kp",
+             "R": "Rp", "T": "Tp"}
+    src = write_fs(tmp_path / f"calibration{suffix}",
+                   {**stereo_items(cal, names), "cam_error": np.array(0.12),
+                    "proj_error": np.array(0.2), "stereo_error": np.array(0.25),
+                    "frameWidth": 640, "frameHeight": 480, "screenResX": 1280,
+                    "screenResY": 800})
+    out = tmp_path / "calib.json"
+    code, stdout, err = run(monkeypatch, capfd, src, "--out", out, "--keys",
+                            "camera=Kc,camera_dist=kc,projector=Kp,projector_dist=kp,R=Rp,T=Tp")
+    assert code == 0, err
+    assert stdout.startswith("camera 640x480, projector 1280x800, baseline 150.00 mm")
+    assert_same(load_calibration(out), cal)
+    # a size option still wins over the file's
+    got = read_opencv_calibration([src], (1920, 1080), (1280, 960), keys=names)
+    assert got.camera.size == (1280, 960) and got.projector.size == (1920, 1080)
+
+
+def test_size_as_s_and_named_projector_size(tmp_path):
+    """``S`` holds the camera size when it is two numbers (and is left alone otherwise);
+    ``projector_size=KEY`` names the projector's."""
+    cal = _example_calibration()
+    src = write_fs(tmp_path / "s.yml", {**stereo_items(cal), "S": [640, 480],
+                                        "display": [1280, 800]})
+    got = read_opencv_calibration([src], keys={"projector_size": "display"})
+    assert_same(got, cal)
+    other = write_fs(tmp_path / "s3.yml", {**stereo_items(cal), "S": np.eye(3),
+                                           "projector_size": [1280, 800]})
+    with pytest.raises(BistairError, match="no camera size in .*give it with --camera-size"):
+        read_opencv_calibration([other])
+    assert read_opencv_calibration([other], camera_size=(640, 480)).projector.size == (1280,
+                                                                                       800)
+
+
 def test_hand_written_yaml_with_plain_sequences(tmp_path):
     """YAML a person or another tool wrote: sequences instead of !!opencv-matrix, a 1.0
     header, image_width + image_height."""
@@ -219,6 +259,13 @@ def _bad_files(tmp: Path) -> dict[str, tuple[list[str], str]]:
                         "--camera-size must be WIDTHxHEIGHT"),
         "no camera size": ([fs("nosize.yml", image_size=None), *proj],
                            "give it with --camera-size WxH"),
+        "no projector size": ([fs("noproj.yml")], "no projector size in "),
+        "projector size key bad": ([fs("proj3.yml", screenResX=1280)],
+                                   "no projector size in "),
+        "projector size fractional": ([fs("projf.yml", screenResX=np.array(1280.5),
+                                          screenResY=800)],
+                                      "must be two positive whole numbers of pixels, got "
+                                      "1280.5x800"),
         "size key bad": ([fs("size3.yml", image_size=[640, 480, 3]), *proj],
                          "must be [width, height], got 3 numbers"),
         "size key fractional": ([fs("sizef.yml", image_size=np.array([640.5, 480])), *proj],

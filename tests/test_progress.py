@@ -61,8 +61,9 @@ def _bistair(*args: str, delay: str) -> subprocess.CompletedProcess:
 @pytest.fixture(scope="module")
 def captures(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("progress") / "scans"
+    # 640 x 512: the partition bands thick enough that the decode has nothing to warn of
     done = _bistair("simulate", "--scene", "plane", "--method", "bidirectional", "--camera",
-                    "320x256", "--out", str(out), "--quiet", delay="0")
+                    "640x512", "--out", str(out), "--quiet", delay="0")
     assert done.returncode == 0 and done.stdout == "" and done.stderr == ""
     return out / "bidirectional"
 
@@ -72,7 +73,7 @@ def test_decode_reports_its_stages_in_a_log(captures: Path, tmp_path: Path) -> N
     assert done.returncode == 0, done.stderr
     stages = [line.split(" (")[0] for line in done.stderr.splitlines()]
     assert stages == ["bistair: reading the captures",
-                      "bistair: decoding 6 frames of 320x256",
+                      "bistair: decoding 6 frames of 640x512",
                       "bistair: writing outputs and previews"]
     assert done.stdout.startswith("decoded bidirectional")
 
@@ -93,3 +94,20 @@ def test_an_error_after_progress_is_still_one_line(captures: Path, tmp_path: Pat
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and done.stderr.startswith("Error: ")
     assert not (tmp_path / "d").exists()
+
+
+def test_warnings_are_printed_also_when_quiet_and_above_the_live_line() -> None:
+    log = io.StringIO()
+    with Progress(quiet=True, stream=log) as say:
+        say("not shown")
+        say.warn("skipped pose-03: board not found")
+    assert log.getvalue() == "Warning: skipped pose-03: board not found\n"
+    tty = _Terminal()
+    with Progress(stream=tty, delay=0.0) as say:
+        say("decoding pose 1 of 2")
+        say.warn("skipped pose-01: board not found")
+    text = tty.getvalue()
+    line = "bistair: decoding pose 1 of 2 ... 0 s"
+    # the live line is erased, the warning written on a line of its own
+    assert text.startswith(f"\r{line}\r{' ' * len(line)}\rWarning: skipped pose-01: board "
+                           "not found\n")

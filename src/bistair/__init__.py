@@ -25,20 +25,21 @@ from typing import TYPE_CHECKING, Any
 from .errors import BistairError
 
 if TYPE_CHECKING:
+    from .acquire import scan
     from .codecs import decode, encode, get_codec, make_spec, methods, spec_from_dict
     from .core.result import DecodeResult
     from .geometry.stereo import stereo
     from .io.read import load_spec
 
 __all__ = ["BistairError", "DecodeResult", "decode", "encode", "get_codec", "load_spec",
-           "make_spec", "methods", "spec_from_dict", "stereo"]
+           "make_spec", "methods", "scan", "spec_from_dict", "stereo"]
 __version__ = "0.1.0"
 
 # the public names, imported on first use (PEP 562) so that ``import bistair`` and
 # ``bistair --version`` do not pay for SciPy and the codecs before they are needed
 _LAZY = {"decode": ".codecs", "encode": ".codecs", "get_codec": ".codecs",
          "make_spec": ".codecs", "methods": ".codecs", "spec_from_dict": ".codecs",
-         "DecodeResult": ".core.result", "load_spec": ".io.read",
+         "DecodeResult": ".core.result", "load_spec": ".io.read", "scan": ".acquire",
          "stereo": ".geometry.stereo"}
 
 

@@ -67,10 +67,12 @@ class BaseSpec:
     """
 
     method: ClassVar[str] = ""
+    # a method that can decode without phase shifts (a Gray code alone) allows steps = 0
+    shiftless: ClassVar[bool] = False
 
     width: int = field(1080, "projector width in pixels")
     height: int = field(1080, "projector height in pixels")
-    steps: int = field(4, "phase-shift steps N (N >= 3)")
+    steps: int = field(4, "phase-shift steps N (N >= 3; 0 for a Gray code alone)")
     bits: int = field(8, "bit depth of the pattern images (8 or 16)", shapes=False,
                       choices=(8, 16))
     offset: float = field(0.5, "pattern mean a, as a fraction of full scale", shapes=False)
@@ -104,14 +106,26 @@ class BaseSpec:
         return self.frame_order or self.default_frames()
 
     def default_frames(self) -> tuple[str, ...]:
-        """The method's frames, then the white frame if asked for."""
+        """The method's frames, then the white frame (and others, see
+        :meth:`extra_frames`) if asked for."""
         if self.orientation == "both":
             own = tuple(f"{tag}/{name}" for axis, tag in AXES.items() for name in
                         dataclasses.replace(self, orientation=axis, frame_order=())
                         .method_frames())
         else:
             own = self.method_frames()
-        return own + (("white",) if self.white else ())
+        return own + self.extra_frames()
+
+    @classmethod
+    def defaults(cls, params: dict) -> dict:
+        """Defaults that depend on the other parameters given (none here; a method's spec
+        may have some), applied by :func:`bistair.codecs.make_spec` and the command line to
+        the fields left out."""
+        return {}
+
+    def extra_frames(self) -> tuple[str, ...]:
+        """The role frames appended after the method's own: ``white`` when asked for."""
+        return ("white",) if self.white else ()
 
     @property
     def frame_count(self) -> int:
@@ -149,8 +163,9 @@ class BaseSpec:
         if self.width < 8 or self.height < 8:
             raise BistairError(f"projector size {self.width}x{self.height} is too small (at "
                                "least 8x8)")
-        if self.steps < 3:
-            raise BistairError(f"steps must be at least 3, got {self.steps}")
+        if self.steps < 3 and not (self.shiftless and self.steps == 0):
+            alone = " (or 0 for a Gray code alone)" if self.shiftless else ""
+            raise BistairError(f"steps must be at least 3{alone}, got {self.steps}")
         if self.bits not in (8, 16):
             raise BistairError(f"bits must be 8 or 16, got {self.bits}")
         if self.orientation not in ("columns", "rows", "both"):
@@ -174,7 +189,7 @@ class BaseSpec:
         if not self.frame_order:
             return
         own = [n for n in self.frame_order if n not in ROLES]
-        want = self.default_frames()
+        want = [n for n in self.default_frames() if n != "black"]
         if "white" in self.frame_order and not self.white:
             raise BistairError("spec field 'frames' lists a white frame but 'white' is 0 "
                                "(set \"white\": 1)")
@@ -254,7 +269,11 @@ class PeriodSpec(BaseSpec):
 
     def validate(self) -> None:
         super().validate()
-        if not (math.isfinite(self.period) and self.period >= 4):
+        if self.steps == 0:  # a code alone: its cells may be a pixel wide
+            if not (math.isfinite(self.period) and self.period >= 1):
+                raise BistairError(f"period (the code's cell) must be at least 1 projector "
+                                   f"pixel, got {self.period}")
+        elif not (math.isfinite(self.period) and self.period >= 4):
             raise BistairError(f"period must be at least 4 projector pixels, got {self.period}")
 
 

@@ -48,6 +48,15 @@ def _quiet(func: Callable) -> Callable:
                         help="print only errors and warnings (no progress, no summary)")(func)
 
 
+def _force(func: Callable) -> Callable:
+    """``--force``: decode where a thresholded check would refuse."""
+    return click.option("--force", is_flag=True,
+                        help="decode where a thresholded check would refuse the captures: its "
+                        "reasons are printed as warnings and kept in info.json ('forced'); "
+                        "hard errors (frame count, unreadable files, no valid pixel) stay "
+                        "errors")(func)
+
+
 def _threads(func: Callable) -> Callable:
     """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
 
@@ -123,6 +132,11 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
         from .jobs import read_gamma, save_patterns
 
         values = {key: coerce_field(fields[key], value) for key, value in values.items()}
+        ctx = click.get_current_context()
+        given = {key: value for key, value in values.items()
+                 if ctx.get_parameter_source(key) is not click.core.ParameterSource.DEFAULT}
+        values.update({key: value for key, value in spec_class.defaults(given).items()
+                       if key not in given})
         if gamma_file is not None:
             values["gamma"] = read_gamma(gamma_file)
         spec = spec_class(**values)
@@ -183,11 +197,12 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@_force
 @_threads
 @_quiet
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
-           min_modulation: float | None, no_previews: bool, quiet: bool) -> None:
+           min_modulation: float | None, no_previews: bool, force: bool, quiet: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order.
 
     CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
@@ -196,8 +211,8 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     from .jobs import decode_folder
     from .progress import Progress
 
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
-               if v is not None}
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
+                                 ("force", force or None)) if v is not None}
     with Progress(quiet) as say:
         result = decode_folder(list(captures), out, spec_path, previews=not no_previews,
                                progress=say, **options)
@@ -275,6 +290,10 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
               help="with --count: processes of the local cluster [default: the cores]")
 @click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
               help="with --count: run on an existing Dask cluster instead")
+@click.option("--no-white", is_flag=True,
+              help="--scene calibration: no white frame (the board is found in the mean image)")
+@click.option("--both-axes", is_flag=True,
+              help="--scene calibration: one capture set of both axes per pose")
 @click.option("--cameras", type=click.IntRange(1, 2), default=1, show_default=True,
               help="2: a second camera (OUT/<method>/L and R, stereo.json, truth/L and R)")
 @click.option("--baseline", type=float, default=200.0, show_default=True,
@@ -284,8 +303,8 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None, cameras: int,
-             baseline: float, quiet: bool) -> None:
+             vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
+             both_axes: bool, cameras: int, baseline: float, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
@@ -297,6 +316,9 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
     imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
                    bits=int(bits))
     if cameras == 2:
+        if no_white or both_axes:
+            raise CliError("--no-white and --both-axes are for one camera's --scene "
+                           "calibration")
         _simulate_stereo(scene, chosen, out, camera, compensated, seed, count, baseline,
                          quiet, imaging)
         return
@@ -312,7 +334,7 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-                progress=say, **imaging)
+                progress=say, white=not no_white, both_axes=both_axes, **imaging)
         if quiet:
             return
         if scene == "calibration":
@@ -322,6 +344,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
             click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
                        f"to {out}")
         return
+    if no_white or both_axes:
+        raise CliError("--no-white and --both-axes are for --scene calibration")
     from .simulate import simulate_many
 
     try:
@@ -371,46 +395,39 @@ def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
-@click.option("--board", type=click.Path(path_type=Path), default=None,
-              help="board description [default: CAPTURES/board.json]")
+@click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
+              help="board.json, or e.g. chessboard:9x7:25 (inner corners, square in mm) "
+              "[default: CAPTURES/board.json]")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec of both axes for pose folders of captures [default: each "
+              "folder's spec.json, else CAPTURES/spec.json]")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found and mapped (3 or more)")
+@click.option("--corner-fit", type=click.Choice(["homography", "quadratic"]),
+              default="homography", show_default=True,
+              help="how a board feature is mapped to the projector")
 @_quiet
 @reports_errors
-def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
-              quiet: bool) -> None:
-    """Calibrate camera and projector from board captures (both orientations per pose).
+def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | None,
+              min_poses: int, corner_fit: str, quiet: bool) -> None:
+    """Calibrate camera and projector from board captures (both projector axes per pose:
+    columns/ and rows/ folders, or captures of both axes with one spec).
 
-    Prints the reprojection errors and one standard deviation of every parameter."""
+    Prints the reprojection errors and one standard deviation of every parameter; a pose
+    that does not decode or does not show the board is skipped with a warning."""
     from ..geometry.calibrate import MIN_POSES
-    from .jobs import calibrate_folder
+    from .calibrate import calibrate_folder, summary_lines
     from .progress import Progress
 
     if min_poses < MIN_POSES:
         raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
                        f"needs at least {MIN_POSES} board poses")
     with Progress(quiet) as say:
-        cal = calibrate_folder(captures, out, board=board, min_poses=min_poses, progress=say)
-    if quiet:
-        return
-    sigma = cal.uncertainty
-    click.echo(f"camera RMS {cal.camera.rms:.3f} px, projector RMS {cal.projector.rms:.3f} px, "
-               f"stereo RMS {cal.rms:.3f} px, baseline {cal.baseline:.2f} +/- "
-               f"{sigma.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} poses; "
-               f"wrote {out}")
-    for name in ("camera", "projector"):
-        dev, sd = getattr(cal, name), getattr(sigma, name)
-        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
-        click.echo(f"  {name + ':':10s} " + ", ".join(
-            f"{key} {v:.2f} +/- {s:.2f}"
-            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
-    click.echo(f"  rotation +/- {sigma.angle:.3f} deg, T +/- "
-               f"({', '.join(f'{v:.2f}' for v in sigma.T)}) mm (one standard deviation, from "
-               f"correspondence noise of {sigma.noise[0]:.3f} px in the camera and "
-               f"{sigma.noise[1]:.3f} px in the projector per coordinate)")
-    for pose in cal.poses:
-        click.echo(f"  {pose['name']}: {pose['features']} features, camera "
-                   f"{pose['camera_rms']:.3f} px, projector {pose['projector_rms']:.3f} px")
+        cal = calibrate_folder(captures, out, board=board, spec=spec_path, min_poses=min_poses,
+                               corner_fit=corner_fit, progress=say,
+                               skipped=lambda name, why: say.warn(f"skipped {name}: {why}"))
+    if not quiet:
+        click.echo("\n".join(summary_lines(cal, out)))
 
 
 @cli.command("import-calibration")
@@ -418,14 +435,16 @@ def calibrate(captures: Path, out: Path, board: Path | None, min_poses: int,
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="calibration file to write (JSON)")
 @click.option("--projector-size", default=None, metavar="WxH",
-              help="projector size WIDTHxHEIGHT (required without --stereo)")
+              help="projector size WIDTHxHEIGHT [default: from projector_size, screenResX + "
+              "screenResY, ... in the files; not with --stereo]")
 @click.option("--camera-size", default=None, metavar="WxH",
               help="camera size WIDTHxHEIGHT [default: from image_size, imageSize, "
-              "image_width + image_height, ... in the files]")
+              "image_width + image_height, frameWidth + frameHeight, S, ... in the files]")
 @click.option("--keys", default=None, metavar="NAME=KEY,...",
               help="key names, NAME=KEY joined by commas [default: camera=M1,camera_dist=D1,"
               "projector=M2,projector_dist=D2,R=R,T=T; with --stereo left=M1,left_dist=D1,"
-              "right=M2,right_dist=D2,R=R,T=T]; camera_size=KEY names the size key")
+              "right=M2,right_dist=D2,R=R,T=T]; camera_size=KEY and projector_size=KEY name "
+              "the size keys")
 @click.option("--stereo", is_flag=True, help="two cameras (left first) for 'bistair stereo', "
               "not a camera and a projector")
 @reports_errors
@@ -451,9 +470,6 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
         return
     from .jobs import import_calibration as run
 
-    if projector_size is None:
-        raise CliError("Missing option '--projector-size' (a projector's size is never in "
-                       "these files; or give --stereo for two cameras)")
     cal = run(files, out, projector_size, camera_size, keys)
     click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
                f"{cal.projector.width}x{cal.projector.height}, baseline {cal.baseline:.2f} mm; "
@@ -475,12 +491,13 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="specs of both axes: drop pixels whose projector column and "
               "row lie farther than this (projector pixels) from the camera ray's projection")
+@_force
 @_threads
 @_quiet
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
                 depth: Path | None, strategy: str | None, depth_range: str | None,
-                epipolar_tolerance: float, quiet: bool) -> None:
+                epipolar_tolerance: float, force: bool, quiet: bool) -> None:
     """Decode, triangulate with a calibration, write a coloured PLY and a depth map.
 
     With a spec of both axes (orientation both), each point fits both projector
@@ -491,11 +508,14 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 
     depth = depth or out.with_name(out.stem + "-depth")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {} if strategy is None else {"strategy": strategy}
+    options = {k: v for k, v in (("strategy", strategy), ("force", force or None))
+               if v is not None}
     with Progress(quiet) as say:
         rec = reconstruct_folder(captures, spec_path, calibration, out, depth_dir=depth,
                                  min_depth=low, max_depth=high,
                                  epipolar_tolerance=epipolar_tolerance, progress=say, **options)
+    for message in rec.info.get("warnings", []):
+        click.echo(f"Warning: {message}", err=True)
     if quiet:
         return
     notes = []
@@ -553,12 +573,13 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="with --calibration and specs of both axes: see "
               "'bistair reconstruct --help'")
+@_force
 @_quiet
 @reports_errors
 def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
           workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
           min_modulation: float | None, no_previews: bool, depth_range: str | None,
-          epipolar_tolerance: float, quiet: bool) -> None:
+          epipolar_tolerance: float, force: bool, quiet: bool) -> None:
     """Decode (with --calibration also reconstruct) many capture sets on Dask.
 
     ROOT: a folder whose sub-folders are the capture sets, or a CSV manifest with the
@@ -570,8 +591,8 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     from .jobs import parse_depth_range
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
-               if v is not None}
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
+                                 ("force", force or None)) if v is not None}
     try:
         report = run_batch(root, out, spec_path, calibration, workers=workers,
                            scheduler=scheduler, resume=resume, previews=not no_previews,
@@ -689,6 +710,102 @@ def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
     for pose in cal.poses:
         click.echo(f"  {pose['name']}: {pose['features']} corners, left "
                    f"{pose['left_rms']:.3f} px, right {pose['right_rms']:.3f} px")
+
+
+@cli.command()
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set to project (from 'bistair patterns')")
+@click.option("--display", required=True, metavar="DISPLAY",
+              help="window[:SCREEN] (a full-screen window on the projector's screen, from 0) "
+              "or none (the projector holds the patterns and triggers the camera)")
+@click.option("--camera", required=True, metavar="CAMERA",
+              help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
+              "sim[:SCENE[:WxH]]")
+@click.option("--out", "-o", type=click.Path(path_type=Path), default=None,
+              help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
+@click.option("--settle-ms", type=float, default=None,
+              help="wait after showing each pattern [default: as measured by "
+              "--measure-latency]")
+@click.option("--average", type=int, default=1, show_default=True,
+              help="frames grabbed and averaged per pattern")
+@click.option("--drop", type=int, default=None,
+              help="frames dropped after the wait [default: the camera's buffer]")
+@click.option("--exposure", type=float, default=None,
+              help="camera exposure in its own units (genicam: microseconds)")
+@click.option("--gain", type=float, default=None, help="camera gain in its own units")
+@click.option("--pixel-format", type=click.Choice(["Mono8", "Mono12", "Mono16"]),
+              default=None, help="genicam pixel format")
+@click.option("--decode", "decode_it", is_flag=True,
+              help="also decode the scan into OUT/decode/")
+@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+              help="also reconstruct: OUT/decode/cloud.ply, depth.npy")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="with --calibration: keep points with depth z in [MIN, MAX] mm")
+@click.option("--measure-latency", is_flag=True,
+              help="flash black and white, time when the camera sees it and save the settle "
+              "time for this display and camera (no scan)")
+@click.option("--latency-file", type=click.Path(path_type=Path), default=None,
+              help="where measured settle times are kept [default: "
+              "~/.config/bistair/latency.json or $BISTAIR_LATENCY_FILE]")
+@_quiet
+@reports_errors
+def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
+         settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
+         gain: float | None, pixel_format: str | None, decode_it: bool,
+         calibration: Path | None, depth_range: str | None, measure_latency: bool,
+         latency_file: Path | None, quiet: bool) -> None:
+    """Project a pattern set with DISPLAY, grab it with CAMERA, write a capture folder.
+
+    Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
+    grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly."""
+    from .progress import Progress
+
+    settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
+    if measure_latency:
+        from .scan import measure_settle
+
+        with Progress(quiet) as say:
+            latency, path = measure_settle(display, camera, latency_file, progress=say,
+                                           **settings)
+        if not quiet:
+            times = latency.latencies_ms
+            click.echo(f"latency {latency.display} -> {latency.camera}: {min(times):.0f} to "
+                       f"{max(times):.0f} ms over {len(times)} changes (camera levels: black "
+                       f"{100 * latency.black:.1f}%, white {100 * latency.white:.1f}%); settle "
+                       f"{latency.settle_ms:g} ms saved to {path}")
+        return
+    for name, value in (("--spec", spec_path), ("--out", out)):
+        if value is None:
+            raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
+    from .jobs import parse_depth_range
+    from .scan import scan_folder
+
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    with Progress(quiet) as say:
+        report = scan_folder(spec_path, display, camera, out, decode=decode_it,
+                             calibration=calibration, depth_range=(low, high), progress=say,
+                             settle_ms=settle_ms, average=average, drop=drop,
+                             latency_file=latency_file, **settings)
+    info = report.scan.info
+    for message in info["warnings"]:
+        click.echo(f"Warning: {message}", err=True)
+    if report.decoded is not None:
+        _warn(report.decoded)
+    if quiet:
+        return
+    frames = report.scan.frames
+    click.echo(f"scanned {len(frames)} {report.scan.spec.method} patterns with "
+               f"{info['display']['name']} and {info['camera']['name']} in "
+               f"{info['seconds']:.1f} s (settle {info['settle_ms']:g} ms, "
+               f"{info['settle_source']}; {frames.shape[2]}x{frames.shape[1]} "
+               f"{frames.dtype.itemsize * 8}-bit frames); wrote {out}")
+    result = report.decoded
+    if result is not None:
+        click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
+                   f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}/decode")
+    if report.reconstruction is not None:
+        click.echo(f"{int(report.reconstruction.mask.sum())} points; wrote "
+                   f"{out}/decode/cloud.ply and depth.npy")
 
 
 def _terminated(signum: int, frame: Any) -> None:

@@ -1,7 +1,7 @@
 """The jobs on folders behind the command line: write a pattern set, decode a capture folder,
-reconstruct, measure height against a reference plane, calibrate from board captures, import
-an OpenCV calibration; and the parsers of their option strings (``WxH``, ``MIN:MAX``,
-``NAME=KEY,...``).
+reconstruct, measure height against a reference plane, import an OpenCV calibration (the
+calibration from board captures is :mod:`bistair.app.calibrate`); and the parsers of their
+option strings (``WxH``, ``MIN:MAX``, ``NAME=KEY,...``).
 
 Each job reads its inputs, works in memory and writes its outputs atomically (a temporary
 folder or file moved in at the end), so a failed job leaves nothing behind.
@@ -31,8 +31,6 @@ from ..core.captures import full_scale_of, to_bit_depth
 from ..core.response import Response, estimate_response, ramp_levels
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
-from ..geometry.board import Board
-from ..geometry.calibrate import MIN_POSES, PoseCapture, calibrate_poses, check_min_poses
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
@@ -44,8 +42,6 @@ from ..io.read import (
     Captures,
     capture_files,
     find_spec,
-    load_spec,
-    natural_key,
     read_captures,
     read_with_spec,
 )
@@ -244,6 +240,12 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     say("triangulating")
     rec = reconstruct(decoded, calibration, spec, orientation, min_depth, max_depth,
                       epipolar_tolerance)
+    infos = [decoded.x.info, decoded.y.info] if isinstance(decoded, AxesResult) \
+        else [decoded.info]
+    for key in ("warnings", "forced"):  # the decode's, passed on to the caller
+        found = [m for info in infos for m in info.get(key, [])]
+        if found:
+            rec.info[key] = found
     pts, cols = rec.cloud()
     say(f"writing {len(pts)} points")
     if depth_dir is None:
@@ -256,107 +258,18 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
 
 
 # -- calibration ---------------------------------------------------------------------------
-def pose_folders(folder: Path) -> list[Path]:
-    """The pose sub-folders of a calibration capture folder (natural name order)."""
-    subs = sorted((p for p in folder.iterdir() if p.is_dir()), key=lambda p: natural_key(p.name))
-    poses = []
-    for sub in subs:
-        have = [(sub / o).is_dir() for o in ("columns", "rows")]
-        if all(have):
-            poses.append(sub)
-        elif any(have):
-            missing = "rows" if have[0] else "columns"
-            raise BistairError(f"pose {sub.name} has no {missing}/ folder")
-    return poses
-
-
-def read_pose(folder: Path, orientation: str) -> tuple[np.ndarray, np.ndarray, BaseSpec]:
-    """Decode one orientation of a pose: the projector coordinate, the white frame, the spec."""
-    sub = folder / orientation
-    spec = load_spec(sub / "spec.json")
-    where = f"{folder.name}/{orientation}"
-    if spec.orientation != orientation:
-        raise BistairError(f"{where}/spec.json codes {spec.orientation}, the folder is for "
-                           f"{orientation}")
-    if not spec.white:
-        raise BistairError(f"{where}/spec.json has no white frame (white=1 is needed to "
-                           "find the board)")
-    try:
-        result = decode(read_captures(sub), spec)
-    except BistairError as exc:
-        raise BistairError(f"{where}: {exc}") from None
-    return result.coord, result.texture, spec
-
-
-def calibrate_folder(folder: str | Path, out: str | Path | None = None,
-                     board: Board | str | Path | None = None, min_poses: int = MIN_POSES,
-                     progress: Say | None = None, **options: Any) -> Calibration:
-    """Calibrate from board captures; write the calibration file to ``out`` (atomically) if
-    given. ``options`` go to :func:`~bistair.geometry.calibrate.calibrate_poses` and
-    :func:`~bistair.geometry.calibrate.calibrate_points` (``fix_k3``, ``refine``).
-
-    ``min_poses`` (at least :data:`~bistair.geometry.calibrate.MIN_POSES`, 3) poses must
-    show the board with its features mapped to the projector; the calibration carries the
-    standard deviations of its parameters (``uncertainty``).
-
-    Capture layout::
-
-        calib/
-          board.json            {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20}
-          pose-00/columns/      images in name order + spec.json (orientation columns, white=1)
-          pose-00/rows/         images in name order + spec.json (orientation rows, white=1)
-          pose-01/...
-
-    Every sub-folder holding ``columns/`` and ``rows/`` is a pose (in natural name order);
-    both specs must code the same projector size. ``board.json``: see
-    :mod:`bistair.geometry.board` (``columns x rows`` inner corners or circles, ``spacing``
-    in mm). ``progress`` is called with each stage's name as it starts.
-    """
-    say = progress or _silent
-    check_min_poses(min_poses)
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise BistairError(f"calibration captures {folder} not found")
-    if not isinstance(board, Board):
-        board = Board.load(folder / "board.json" if board is None else board)
-    folders = pose_folders(folder)
-    if not folders:
-        raise BistairError(f"no pose folders with columns/ and rows/ in {folder}")
-    poses, proj_size, cam_size = [], None, None
-    for number, sub in enumerate(folders, 1):
-        say(f"decoding pose {number} of {len(folders)} ({sub.name})")
-        x, white, sx = read_pose(sub, "columns")
-        y, _, sy = read_pose(sub, "rows")
-        for s, o in ((sx, "columns"), (sy, "rows")):
-            if proj_size is None:
-                proj_size = (s.width, s.height)
-            elif (s.width, s.height) != proj_size:
-                raise BistairError(f"{sub.name}/{o}/spec.json is for a {s.width}x{s.height} "
-                                   f"projector, earlier specs for {proj_size[0]}x{proj_size[1]}")
-        for arr, o in ((x, "columns"), (y, "rows")):
-            if cam_size is None:
-                cam_size = arr.shape
-            elif arr.shape != cam_size:
-                raise BistairError(f"{sub.name}/{o} images are {arr.shape[1]}x{arr.shape[0]}, "
-                                   f"earlier ones {cam_size[1]}x{cam_size[0]}")
-        poses.append(PoseCapture(sub.name, white, x, y))
-    assert proj_size is not None
-    say(f"calibrating from {len(poses)} poses")
-    cal = calibrate_poses(poses, board, proj_size, min_poses=min_poses, **options)
-    if out is not None:
-        save_calibration(cal, out)
-    return cal
 
 
 def import_calibration(files: Sequence[str | Path], out: str | Path,
-                       projector_size: tuple[int, int] | str,
+                       projector_size: tuple[int, int] | str | None,
                        camera_size: tuple[int, int] | str | None = None,
                        keys: Mapping[str, str] | str | None = None) -> Calibration:
     """Read an OpenCV FileStorage calibration (YAML or XML, keys of several files merged)
     and write it as a bistair calibration file ``out`` (atomically).
 
-    Sizes are ``(width, height)`` or ``"WxH"``; ``keys`` renames parts (a mapping or
-    ``"camera=M1,T=T"``), see :func:`~bistair.geometry.opencv.read_opencv_calibration`.
+    Sizes are ``(width, height)`` or ``"WxH"``, or ``None`` to read them from the files;
+    ``keys`` renames parts (a mapping or ``"camera=M1,T=T"``), see
+    :func:`~bistair.geometry.opencv.read_opencv_calibration`.
     Nothing is written on error.
     """
     if isinstance(projector_size, str):

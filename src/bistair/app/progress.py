@@ -98,6 +98,19 @@ class Progress:
                 self._write("\r" + " " * self.width + "\r")
                 self.width = 0
 
+    def warn(self, message: str) -> None:
+        """Print one warning line now, also when quiet (above the live line, which the clock
+        draws again)."""
+        with self._lock:
+            if self.live and self.width:
+                self._write("\r" + " " * self.width + "\r")
+                self.width = 0
+            try:
+                self.stream.write(f"Warning: {message}\n")
+                self.stream.flush()
+            except (OSError, ValueError):
+                pass
+
     def _tick(self) -> None:
         period = 0.25 if self.live else 0.1
         while not self._stop.wait(period):

@@ -68,12 +68,16 @@ from .engine import (
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
              camera_size: tuple[int, int] | None = None, compensated: bool = True,
-             progress: Callable[[str], None] | None = None, **imaging: Any) -> Path:
+             progress: Callable[[str], None] | None = None, white: bool = True,
+             both_axes: bool = False, **imaging: Any) -> Path:
     """Render ``scene`` for each of ``methods`` and write the capture folders into ``out``.
 
     ``imaging`` goes to :class:`bistair.sim.Imaging` (``gamma``, ``read_noise``,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
     the projector's gamma. ``progress`` is called with each stage's name as it starts.
+    For the scene ``calibration``, ``white`` false leaves the white frame out (the board is
+    then found in the mean image) and ``both_axes`` writes one capture set of both axes per
+    pose instead of ``columns/`` and ``rows/``.
 
     Raises
     ------
@@ -89,7 +93,10 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     methods = _check_methods(methods)
     im = _imaging(compensated, imaging)
     if scene == "calibration":
-        return _calibration(methods, out, camera_size, compensated, im)
+        return _calibration(methods, out, camera_size, compensated, im, white, both_axes)
+    if not white or both_axes:
+        raise BistairError("board captures without a white frame or of both axes at once "
+                           "are for --scene calibration")
     rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
     say = progress or (lambda stage: None)
     with output_folder(out) as tmp:
@@ -158,13 +165,17 @@ def _rig_dict(rig: Any) -> dict[str, Any]:
 
 
 def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, int] | None,
-                 compensated: bool, imaging: Any) -> Path:
-    """A 9 x 6 checkerboard (20 mm) in eight poses, both orientations with a white frame, in
-    the layout ``bistair calibrate`` reads (one method: the first named)."""
+                 compensated: bool, imaging: Any, white: bool = True,
+                 both_axes: bool = False) -> Path:
+    """A 9 x 6 checkerboard (20 mm) in eight poses, both orientations (``columns/`` and
+    ``rows/``, or with ``both_axes`` one capture set of both axes per pose), with a white
+    frame unless ``white`` is false, in the layout ``bistair calibrate`` reads (one method:
+    the first named)."""
     rig = Rig.default(**({} if camera_size is None else {"camera_size": camera_size}))
     base = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
                         methods=methods[:1])[methods[0]][0]
-    specs = {o: base.replace(orientation=o, white=1) for o in ("columns", "rows")}
+    axes = ("both",) if both_axes else ("columns", "rows")
+    specs = {o: base.replace(orientation=o, white=int(white)) for o in axes}
     return write_board_captures(rig, Board("checkerboard", 9, 6, 20.0), specs, out,
                                 imaging=imaging)
 

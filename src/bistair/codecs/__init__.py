@@ -77,7 +77,7 @@ def get_codec(method: str) -> Codec:
     --------
     >>> codec = get_codec("graycode")
     >>> codec.name, codec.options
-    ('graycode', ('min_modulation', 'strategy'))
+    ('graycode', ('min_modulation', 'force', 'strategy'))
     >>> get_codec("fourier")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -124,6 +124,7 @@ def make_spec(method: str, **params: Any) -> BaseSpec:
     bistair.errors.BistairError: bad parameters for graycode: ...
     """
     codec = get_codec(method)
+    params = {**codec.spec_class.defaults(params), **params}
     try:
         return codec.spec_class(**params)
     except TypeError as exc:

@@ -26,7 +26,7 @@ Examples
 >>> fringes = codec.phase_map(patterns, spec)
 >>> code = codec.code_map(patterns, spec)
 >>> code.code[0, ::30].tolist(), codec.options
-([0, 1, 2, 3, 4, 5, 6, 7], ('min_modulation', 'strategy'))
+([0, 1, 2, 3, 4, 5, 6, 7], ('min_modulation', 'force', 'strategy'))
 """
 
 from __future__ import annotations
@@ -44,8 +44,10 @@ from ..core.checks import (
     axis_problem,
     convention_problem,
     edge_alignment,
+    forcing,
     jump_problem,
     outside_problem,
+    refuse,
     swapped_frames,
     wrap_steps,
 )
@@ -172,9 +174,11 @@ class Codec:
 
     @property
     def options(self) -> tuple[str, ...]:
-        """Decode keyword options: ``min_modulation`` and those of the order stage."""
+        """Decode keyword options: ``min_modulation``, ``force`` and those of the order
+        stage."""
         params = inspect.signature(self.order_columns).parameters.values()
-        return ("min_modulation", *(p.name for p in params if p.kind is p.KEYWORD_ONLY))
+        return ("min_modulation", "force",
+                *(p.name for p in params if p.kind is p.KEYWORD_ONLY))
 
     # -- encoding ----------------------------------------------------------------------------
     def encode(self, spec: BaseSpec) -> np.ndarray:
@@ -233,7 +237,11 @@ class Codec:
         """All stages: absolute phase, projector coordinate and fringe order per pixel.
 
         A spec of both axes gives an :class:`~bistair.core.result.AxesResult` (one decode
-        per axis), any other a :class:`~bistair.core.result.DecodeResult`.
+        per axis), any other a :class:`~bistair.core.result.DecodeResult`. With
+        ``force=True``, the thresholded checks that would refuse the captures (the shares
+        of :mod:`bistair.core.checks` and the codecs' own) are reported instead: their
+        reasons in ``info["forced"]`` and as warnings; hard errors (frame count, no valid
+        pixel) still raise.
         """
         unknown = set(options) - set(self.options)
         if unknown:
@@ -244,13 +252,25 @@ class Codec:
         if spec.orientation == "both":
             x, y = (self.decode(images, axis_spec, **options) for _, axis_spec in spec.axes())
             return AxesResult(x, y)
+        force = bool(options.pop("force", False))
+        with forcing(force) as forced:
+            result = self._decode(images, spec, **options)
+        if forced:  # decoded where thresholded checks would have refused
+            result.info["forced"] = list(forced)
+            result.info["warnings"] = [*result.info.get("warnings", []),
+                                       *(f"forced past a check: {p}" for p in forced)]
+        return result
+
+    def _decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:
+        """One axis of :meth:`decode` (the thresholded checks through
+        :func:`~bistair.core.checks.refuse`)."""
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
-        _refuse(shift_order_problem(cols, fs.valid, spec))
+        refuse(shift_order_problem(cols, fs.valid, spec))
         turned = axis_problem(fs.phi, fs.valid, spec.orientation)
         if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
-            _refuse(turned)
+            refuse(turned)
         code = self.code_columns(cols, spec, fs, min_modulation)
         # every set is measured: saturation is in the validity, the clipped masks (one byte
         # a pixel, twice for the rows orientation) need not stay in memory
@@ -263,8 +283,14 @@ class Codec:
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
             bad, big, links = wrap_steps(fs.phi, orders.order, fs.valid)
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
-            _refuse(jump_problem(bad, links, limit=0.05, big=big, big_limit=0.02))
-        _refuse(jump_problem(orders.info.get("jump_violations", 0),
+            refuse(jump_problem(bad, links, big=big, big_limit=0.02))
+            if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
+                orders.info["warnings"] = [*orders.info.get("warnings", []), (
+                    f"the orders do not step by one across {100 * bad / links:.1f}% of the "
+                    "phase jumps: pixels beside the code's edges read one order off (a code "
+                    "whose edges sit on the phase jumps; a complementary or shifted code, a "
+                    "second period or --strategy region avoid it)")]
+        refuse(jump_problem(orders.info.get("jump_violations", 0),
                              orders.info.get("jump_links", 0)))
         words, beyond = code.code, code.beyond
         del code  # its maps are done with: the result is made without them in memory
@@ -273,7 +299,7 @@ class Codec:
         if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
-        _refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
+        refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
                                 spec.coded_length))
         result.info["valid_pixels"] = int(result.mask.sum())
         result.info.setdefault("full_scale", prepared.full_scale)
@@ -343,11 +369,6 @@ def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
     return None
 
 
-def _refuse(problem: str | None) -> None:
-    if problem is not None:
-        raise BistairError(f"the captures do not fit the spec: {problem}")
-
-
 def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     """Refuse captures whose code steps do not sit where the spec's phase convention puts
     them (:mod:`bistair.core.checks`); returns the warnings worth a line.
@@ -397,7 +418,8 @@ def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
         return []
     kind, message = problem
     if kind == "refuse":
-        raise BistairError(f"the captures do not fit the spec: {message}")
+        refuse(message)
+        return []
     return [message]
 
 

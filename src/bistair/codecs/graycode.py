@@ -60,13 +60,23 @@ import math
 import numpy as np
 
 from ..core.captures import Prepared
+from ..core.checks import cell_steps, direction_problem, refuse
 from ..core.measure import FringeSet, measure
 from ..core.phase import TWO_PI, wrap
 from ..core.regions import core_weight, fringe_regions
 from ..core.resolve import code_evidence, orders_from_regions
 from ..errors import BistairError
 from ..spec import PeriodSpec, field
-from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
+from .base import (
+    Codec,
+    CodeMap,
+    Orders,
+    along_columns,
+    fringe_index,
+    measure_shifts,
+    shift_patterns,
+)
+from .graycode_alone import code_alone, measure_alone
 from .graycode_jit import code_bits, gray_orders
 
 
@@ -99,6 +109,7 @@ def gray_to_binary(gray: np.ndarray) -> np.ndarray:
 @dataclasses.dataclass(frozen=True, kw_only=True)
 class GrayCodeSpec(PeriodSpec):
     method = "graycode"
+    shiftless = True  # steps = 0: the Gray code alone (see the module docstring)
 
     complementary: int = field(0, "add the complementary pattern (three-zone rule)",
                                choices=(0, 1))
@@ -126,12 +137,23 @@ class GrayCodeSpec(PeriodSpec):
 
     def method_frames(self) -> tuple[str, ...]:
         codes = tuple(f"gray-{i}" for i in range(self.code_bits + self.complementary))
+        if self.steps == 0:  # OpenCV's GrayCodePattern order: each bit, then its inverse
+            return tuple(n for c in codes for n in ((c, f"{c}-inv") if self.inverse else (c,)))
         inverse = tuple(f"{c}-inv" for c in codes) if self.inverse else ()
         second = tuple(f"second-{n}" for n in self.shift_frames()) if self.second_period else ()
         return (*self.shift_frames(), *second, *codes, *inverse)
 
+    def extra_frames(self) -> tuple[str, ...]:
+        """``white``, and for a Gray code alone ``black`` after it (the mid-level the bits
+        are read against without inverses, and the shadow mask: OpenCV's layout)."""
+        if self.steps == 0 and self.white:
+            return ("white", "black")
+        return super().extra_frames()
+
     def validate(self) -> None:
         super().validate()
+        if self.steps == 0:
+            self._validate_alone()
         for name in ("complementary", "inverse"):
             if getattr(self, name) not in (0, 1):
                 raise BistairError(f"{name} must be 0 or 1, got {getattr(self, name)}")
@@ -148,6 +170,31 @@ class GrayCodeSpec(PeriodSpec):
                 raise BistairError(
                     f"period / second_period = {self.period / self.second_period:.3f} is too "
                     "close to a whole number: a period off would not show in the second phase")
+
+
+    def _validate_alone(self) -> None:
+        """A Gray code without phase shifts: no second period, no complementary or shifted
+        code (they refine a phase), and something to read the bits against."""
+        for name in ("complementary", "gray_offset", "second_period"):
+            if getattr(self, name):
+                raise BistairError(f"{name} needs phase shifts: a Gray code alone (steps 0) "
+                                   "has none")
+        if not self.inverse:
+            if not self.white:
+                raise BistairError("a Gray code alone (steps 0) needs inverse patterns "
+                                   "(inverse 1) or white and black frames (white 1) to read "
+                                   "its bits against")
+            if self.frame_order and "black" not in self.frame_order:
+                raise BistairError("a Gray code alone without inverse patterns needs a black "
+                                   "frame: add 'black' to frames")
+
+    @classmethod
+    def defaults(cls, params: dict) -> dict:
+        """Defaults that depend on other parameters: a Gray code alone has cells of one
+        projector pixel (OpenCV's ``GrayCodePattern``) unless a period is given."""
+        if params.get("steps") == 0 and "period" not in params:
+            return {"period": 1.0}
+        return {}
 
 
 def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
@@ -190,7 +237,9 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     gray = level ^ (level >> 1)
     bits = (gray[None, :] >> np.arange(n_bits - 1, -1, -1)[:, None]) & 1
     codes = spec.offset + spec.amplitude * (2.0 * bits - 1.0)
-    if spec.inverse:
+    if spec.inverse and spec.steps == 0:  # each bit, then its inverse
+        codes = np.stack([codes, 2 * spec.offset - codes], axis=1).reshape(-1, codes.shape[1])
+    elif spec.inverse:
         codes = np.concatenate([codes, 2 * spec.offset - codes])
     return along_columns(np.concatenate([shifts, second, codes]), spec)
 
@@ -238,6 +287,8 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     >>> code.code.dtype, code.code[0, ::30].tolist(), code.edge_phase, code.beyond
     (dtype('int32'), [0, 1, 2, 3, 4, 5, 6, 7], 0.0, 0)
     """
+    if spec.steps == 0:
+        return code_alone(prepared, spec, fs, min_modulation)
     n = spec.steps
     start = n * (2 if spec.second_period else 1)
     n_bits = spec.code_bits + spec.complementary
@@ -344,10 +395,17 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     """
     if strategy not in ("pixel", "region"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'pixel' or 'region')")
+    if strategy == "region" and spec.steps == 0:
+        raise BistairError("strategy 'region' needs phase shifts: a Gray code alone (steps 0) "
+                           "decodes per pixel")
     info = {"strategy": strategy, "noise": fs.noise,
             "bits": spec.code_bits + spec.complementary}
     k = code.code
     if strategy == "pixel":
+        if spec.steps == 0:  # no phase to check the cells against: their direction
+            against, steps = cell_steps(k)
+            info.update(cell_steps=steps, cell_steps_against=against)
+            refuse(direction_problem(against, steps))
         return Orders(k, info)
     labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
@@ -361,6 +419,39 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     order = orders_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
                                    info)
     return Orders(order, info)
+
+
+def measure_columns(prepared: Prepared, spec: GrayCodeSpec,
+                    min_modulation: float | None = None) -> FringeSet:
+    """Stage 1: the N-step set (:func:`~bistair.codecs.base.measure_shifts`), or for a Gray
+    code alone the contrast and validity of its bits
+    (:func:`~bistair.codecs.graycode_alone.measure_alone`).
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout.
+    spec : GrayCodeSpec
+        The spec of one coded axis.
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a valid pixel needs.
+
+    Returns
+    -------
+    FringeSet
+        The stage-1 maps (see the two functions).
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=64, height=16, steps=0, inverse=1)
+    >>> measure_columns(prepare(encode(spec), spec.frame_count, "graycode"), spec).steps
+    0
+    """
+    if spec.steps == 0:
+        return measure_alone(prepared, spec, min_modulation)
+    return measure_shifts(prepared, spec, min_modulation)
 
 
 def comparable(width: int, height: int, period: int, steps: int) -> dict:
@@ -396,5 +487,6 @@ CODEC = Codec(
     encode_columns=encode_columns,
     code_columns=code_columns,
     order_columns=order_columns,
+    measure_columns=measure_columns,
     comparable=comparable,
 )

@@ -166,3 +166,134 @@ def gray_orders(gray: np.ndarray, phi: np.ndarray, valid: np.ndarray, mode: int,
     """
     return _gray_orders(gray, np.asarray(phi, np.float32), np.asarray(valid, bool), int(mode),
                         int(fringes))
+
+
+@kernel(parallel=True)
+def alone_levels(raw: np.ndarray, bits: int, inverse: bool, scale: float, white: np.ndarray,
+                 black: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mid-level and contrast of a Gray code capture without phase shifts, per pixel.
+
+    With inverses (frames ``2i`` and ``2i+1`` a bit and its inverse): the mid-level is the
+    mean over the bits of ``(pattern + inverse) / 2`` and the contrast the median over the
+    bits of ``|pattern - inverse| / 2``; without, ``(white + black) / 2`` and
+    ``(white - black) / 2`` (negative where black is the brighter).
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The code frames in method order, any dtype.
+    bits : int
+        Code bits.
+    inverse : bool
+        Each bit's frame is followed by its inverse.
+    scale : float
+        Multiplies a raw value into a fraction of full scale.
+    white, black : (H, W) float32 arrays
+        The white and black frames (fractions of full scale); empty arrays with inverses.
+
+    Returns
+    -------
+    avg, mod : (H, W) float32 arrays
+
+    Examples
+    --------
+    >>> raw = np.stack([np.full((1, 3), 200, np.uint8), np.full((1, 3), 40, np.uint8)])
+    >>> avg, mod = alone_levels(raw, 1, True, 1 / 255, np.empty((0, 0), np.float32),
+    ...                         np.empty((0, 0), np.float32))
+    >>> avg.astype(float).round(4).tolist(), mod.astype(float).round(4).tolist()
+    ([[0.4706, 0.4706, 0.4706]], [[0.3137, 0.3137, 0.3137]])
+    """
+    h, w = raw.shape[1], raw.shape[2]
+    avg = np.empty((h, w), np.float32)
+    mod = np.empty((h, w), np.float32)
+    s = np.float32(scale)
+    half = np.float32(0.5)
+    for y in prange(h):
+        diff = np.empty(max(bits, 1), np.float32)
+        for x in range(w):
+            if not inverse:
+                avg[y, x] = (white[y, x] + black[y, x]) * half
+                mod[y, x] = (white[y, x] - black[y, x]) * half
+                continue
+            total = np.float32(0.0)
+            for i in range(bits):
+                a = np.float32(raw[2 * i, y, x]) * s
+                b = np.float32(raw[2 * i + 1, y, x]) * s
+                total += a + b
+                diff[i] = abs(a - b) * half
+            avg[y, x] = total * half / np.float32(bits)
+            mod[y, x] = np.median(diff[:bits])
+    return avg, mod
+
+
+@kernel(parallel=True)
+def alone_cells(raw: np.ndarray, bits: int, inverse: bool, scale: float, mid: np.ndarray,
+                valid: np.ndarray, clear: float) -> np.ndarray:
+    """Each pixel's cell from a Gray code without phase shifts, -1 where not ``valid`` or a
+    bit is not clear.
+
+    A bit is 1 where its frame is brighter than its inverse (frames ``2i``, ``2i+1``) or,
+    without inverses, than the mid-level ``mid``, and clear where the two differ by at least
+    ``clear``; the bits, most significant first, form the Gray code word ``g`` of the cell
+    ``c`` (``g = c ^ (c >> 1)``).
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The code frames in method order, any dtype.
+    bits : int
+        Code bits (at most 30).
+    inverse : bool
+        Each bit's frame is followed by its inverse.
+    scale : float
+        Multiplies a raw value into a fraction of full scale.
+    mid : (H, W) float32 array
+        The mid-level (without inverses).
+    valid : (H, W) bool array
+        Pixels with enough contrast.
+    clear : float
+        The least difference of a clear bit, fraction of full scale.
+
+    Returns
+    -------
+    (H, W) int32 array
+
+    Examples
+    --------
+    >>> cells = np.array([0, 1, 2, 3])
+    >>> gray = cells ^ (cells >> 1)
+    >>> raw = np.stack([((gray >> 1) & 1), 1 - ((gray >> 1) & 1), gray & 1,
+    ...                 1 - (gray & 1)])[:, None, :].astype(np.float32)
+    >>> alone_cells(raw, 2, True, 1.0, raw[0], np.ones((1, 4), bool), 0.1).tolist()
+    [[0, 1, 2, 3]]
+    """
+    h, w = raw.shape[1], raw.shape[2]
+    out = np.empty((h, w), np.int32)
+    s = np.float32(scale)
+    lim = np.float32(clear)
+    step = 2 if inverse else 1
+    for y in prange(h):
+        for x in range(w):
+            if not valid[y, x]:
+                out[y, x] = -1
+                continue
+            g = 0
+            ok = True
+            for i in range(bits):
+                a = np.float32(raw[step * i, y, x]) * s
+                b = np.float32(raw[step * i + 1, y, x]) * s if inverse else mid[y, x]
+                d = a - b
+                if not abs(d) >= lim:
+                    ok = False
+                    break
+                g = (g << 1) | (1 if d > 0 else 0)
+            if not ok:
+                out[y, x] = -1
+                continue
+            c = g
+            shift = 1
+            while shift < 32:
+                c ^= c >> shift
+                shift <<= 1
+            out[y, x] = c
+    return out

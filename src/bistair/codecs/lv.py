@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.checks import stair_misfit
+from ..core.checks import refuse, stair_misfit
 from ..core.measure import FringeSet
 from ..core.memory import row_bands
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
@@ -328,9 +328,8 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     theta = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)[0]
     codes = quantize32(theta, spec.levels, fs.valid)
     if stair_misfit(theta, fs.valid, stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
-        raise BistairError("the captures do not fit the spec: the code phases sit halfway "
-                           "between the code's levels: are code-cos and code-sin swapped (or "
-                           "levels wrong)?")
+        refuse("the code phases sit halfway between the code's levels: are code-cos and "
+               "code-sin swapped (or levels wrong)?")
     return CodeMap(codes, {"code_phase": theta}, cycle=spec.levels)
 
 
@@ -406,8 +405,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
     windows, unknown = info.get("code_windows", 0), info.get("unknown_windows", 0)
     if windows >= 20 and unknown > 0.15 * windows:
-        raise BistairError(
-            f"the captures do not fit the spec: {100 * unknown / windows:.0f}% of the "
+        refuse(
+            f"{100 * unknown / windows:.0f}% of the "
             f"{windows} code windows read are not in the spec's code sequence: does the spec "
             "fit (period, projector size, levels, window)?")
     return Orders(order, info)

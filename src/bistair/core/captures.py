@@ -129,7 +129,8 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
 
     Parameters
     ----------
-    images : (frames, height, width) stack, any numeric dtype (a 2-D image is one frame).
+    images : (frames, height, width) stack, any real numeric dtype (a 2-D image is one
+        frame; float16 is read as float32, extended precision as float64).
     frame_count : the frames the spec describes.
     method : the method's name, for messages.
     select : the indices of the frames to decode, in the order to keep (default: all);
@@ -170,6 +171,9 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
         raise BistairError(f"captures of {stack.shape[2]}x{stack.shape[1]} pixels are too small")
     if not (np.issubdtype(stack.dtype, np.number) and not np.iscomplexobj(stack)):
         raise BistairError(f"captures must be numeric images, got dtype {stack.dtype}")
+    if stack.dtype.kind == "f" and stack.dtype not in (np.float32, np.float64):
+        # half and extended precision: the compiled passes read float32 and float64
+        stack = stack.astype(np.float32 if stack.dtype.itemsize < 4 else np.float64)
     if select is None or list(select) == list(range(len(select))):
         used = stack[:frame_count if select is None else len(select)]
     else:

@@ -23,14 +23,88 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+from contextvars import ContextVar
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import BistairError
 from .checks_jit import code_steps, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 
 MIN_EDGES = 50  # code steps needed before the check says anything
+_FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
+
+
+def refuse(problem: str | None) -> None:
+    """Refuse captures that a thresholded check finds not to fit the spec: raise
+    ``BistairError("the captures do not fit the spec: <problem>")``, or inside
+    :func:`forcing` record the problem and go on.
+
+    Only the thresholded checks (a share of pixels, steps or windows past a limit) go
+    through here; hard errors (frame count, unreadable captures, no valid pixel) always
+    raise.
+
+    Parameters
+    ----------
+    problem : str or None
+        The check's one-line reason, or ``None`` when the check passed.
+
+    Raises
+    ------
+    BistairError
+        ``problem`` is not ``None`` and no :func:`forcing` is active.
+
+    Examples
+    --------
+    >>> refuse(None)
+    >>> refuse("half the windows are unknown")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: half the windows are unknown
+    >>> with forcing(True) as forced:
+    ...     refuse("half the windows are unknown")
+    >>> forced
+    ['half the windows are unknown']
+    """
+    if problem is None:
+        return
+    forced = _FORCED.get()
+    if forced is None:
+        raise BistairError(f"the captures do not fit the spec: {problem}")
+    forced.append(problem)
+
+
+@contextlib.contextmanager
+def forcing(force: bool = True) -> Iterator[list[str]]:
+    """Within the block, :func:`refuse` records problems instead of raising (``force``
+    True); yields the list it records them in (empty when ``force`` is False).
+
+    Parameters
+    ----------
+    force : bool
+        Decode where a thresholded check would refuse.
+
+    Yields
+    ------
+    list of str
+        The problems found, in the order the checks ran.
+
+    Examples
+    --------
+    >>> with forcing(False) as forced:
+    ...     pass
+    >>> forced
+    []
+    """
+    forced: list[str] = []
+    token = _FORCED.set(forced if force else None)
+    try:
+        yield forced
+    finally:
+        _FORCED.reset(token)
 
 
 @dataclass(frozen=True)
@@ -345,6 +419,71 @@ def jump_problem(violations: int, links: int, limit: float = 0.1,
             "the phase jumps, so the code is not read reliably: does the spec fit the "
             "captures (method, levels, stairs, partitions, period, frame order), or is there "
             "too much noise or blur for this code?")
+
+
+def cell_steps(order: np.ndarray) -> tuple[int, int]:
+    """How a per-pixel code's cells (or orders) step between neighbouring decoded pixels
+    along the rows (the coded axis of the column layout): ``(against, steps)``, the steps
+    against the majority direction and all steps.
+
+    On a surface the cells grow one way along the coded axis (the other way on a mirrored
+    rig); steps against it happen only at occlusions and depth edges. A code read with a bit
+    inverted (a code frame exchanged with its inverse) runs backwards inside every block of
+    that bit, a low bit making half the steps go against the rest.
+
+    Parameters
+    ----------
+    order : (H, W) int array
+        Cells or orders, -1 where not decoded.
+
+    Returns
+    -------
+    (against, steps) : tuple of int
+
+    Examples
+    --------
+    >>> cells = np.tile(np.arange(40) // 2, (4, 1))
+    >>> cell_steps(cells)
+    (0, 76)
+    >>> cell_steps(cells ^ 1)  # the lowest bit read inverted
+    (36, 76)
+    """
+    a, b = order[:, :-1], order[:, 1:]
+    step = (b - a)[(a >= 0) & (b >= 0) & (a != b)]
+    up = int(np.count_nonzero(step > 0))
+    return min(up, step.size - up), int(step.size)
+
+
+def direction_problem(against: int, steps: int, limit: float = 0.25) -> str | None:
+    """A one-line reason to refuse when more than ``limit`` of a per-pixel code's steps run
+    against the rest (:func:`cell_steps`): a code frame exchanged with its inverse, or bits
+    in another order than the spec's.
+
+    Parameters
+    ----------
+    against : int
+        Steps against the majority direction.
+    steps : int
+        All steps; with fewer than 200, nothing is said.
+    limit : float
+        Share of steps against the rest above which to refuse (right decodes of the real
+        captures in ../shared/data: at most 7.5%, at occlusions).
+
+    Returns
+    -------
+    str or None
+        The reason, or ``None``.
+
+    Examples
+    --------
+    >>> direction_problem(36, 76) is None, direction_problem(360, 760)[:31]
+    (True, 'the decoded cells run backwards')
+    """
+    if steps < 200 or against <= limit * steps:
+        return None
+    return (f"the decoded cells run backwards at {100 * against / steps:.0f}% of their steps "
+            "along the coded axis: are code frames exchanged with their inverses, or the bits "
+            "in another order than the spec's (frames, orientation)?")
 
 
 def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> float:

@@ -21,7 +21,8 @@ from collections.abc import Callable
 
 import cv2
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, sparse
+from scipy.sparse import csgraph
 
 from .regions import RegionLinks, fill_orders, fringe_direction, region_links
 from .resolve_jit import (
@@ -288,7 +289,9 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     adopted = 0
     if phase_noise is not None:
         k_reg, adopted = adopt_demanded(links, k_reg, evidence)
-    k_reg, dropped = drop_contradicted(links, k_reg)
+        k_reg, dropped = settle(links, k_reg, _faint(evidence, min_score, min_margin))
+    else:
+        k_reg, dropped = drop_contradicted(links, k_reg)
     if info is not None:
         info.update(regions_adopted=adopted, regions_contradicted=dropped)
     order, outside = label_orders(labels, k_reg.astype(np.int32), valid)
@@ -296,7 +299,8 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
 
 
 def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
-                      min_pairs: int = 3) -> tuple[np.ndarray, int]:
+                      min_pairs: int = 3, say: np.ndarray | None = None
+                      ) -> tuple[np.ndarray, int]:
     """Undecide the regions whose orders contradict their neighbours' more than they agree.
 
     A decided region whose wrap links to decided neighbours do not step as the links say
@@ -313,6 +317,10 @@ def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
         Order per region label, -1 where undecided (label 0: outside any region).
     min_pairs : int
         Contradicting pixel pairs below which a region is kept.
+    say : (n+1,) float array, optional
+        How much each region's order counts when it agrees with or denies a neighbour's
+        (1 everywhere by default; less for regions whose own code did not decide them, so
+        that a chain of them cannot outvote a region that decides itself).
 
     Returns
     -------
@@ -336,10 +344,13 @@ def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
         both = (ks >= 0) & (kd >= 0)
         good = both & (kd - ks == links.step)
         bad = both & ~good
-        agree = (np.bincount(links.src[good], count[good], k.size)
-                 + np.bincount(links.dst[good], count[good], k.size))
-        deny = (np.bincount(links.src[bad], count[bad], k.size)
-                + np.bincount(links.dst[bad], count[bad], k.size))
+        # each side of a link hears the other: its pairs, weighted by what the other says
+        to_src = count if say is None else count * say[links.dst]
+        to_dst = count if say is None else count * say[links.src]
+        agree = (np.bincount(links.src[good], to_src[good], k.size)
+                 + np.bincount(links.dst[good], to_dst[good], k.size))
+        deny = (np.bincount(links.src[bad], to_src[bad], k.size)
+                + np.bincount(links.dst[bad], to_dst[bad], k.size))
         worse = np.where((deny > agree) & (deny >= min_pairs) & (k >= 0), deny - agree, 0.0)
         worse[0] = 0.0
         worst = int(np.argmax(worse))
@@ -347,6 +358,103 @@ def drop_contradicted(links: RegionLinks, region_order: np.ndarray,
             return k, dropped
         k[worst] = -1
         dropped += 1
+
+
+def settle(links: RegionLinks, region_order: np.ndarray, faint: np.ndarray,
+           faint_say: float = 0.2) -> tuple[np.ndarray, int]:
+    """Undecide the regions whose orders their surroundings do not bear out, until none is
+    left: contradicted regions (:func:`drop_contradicted`, where a region its own code did
+    not decide counts ``faint_say`` of one that did), faint regions whose neighbours demand
+    two orders (:func:`~bistair.core.split.contradicted_regions`: two surfaces in one
+    region) and faint regions that no chain of agreeing links ties to a region its own code
+    decided (:func:`unanchored`): an order a region cannot show is never a guess.
+
+    Parameters
+    ----------
+    links : RegionLinks
+        Wrap links between regions.
+    region_order : (n+1,) int array
+        Order per region label, -1 where undecided.
+    faint : (n+1,) bool array
+        Regions whose own evidence does not decide them.
+    faint_say : float
+        How much a faint region's order counts against a neighbour's.
+
+    Returns
+    -------
+    (orders, dropped) : ((n+1,) int array, int)
+        The orders left and how many regions were undecided.
+
+    Examples
+    --------
+    Regions 1-2 decide themselves (orders 0, 1); regions 3-4 are faint and agree only with
+    each other (orders 7, 8): they are undecided, the others kept.
+
+    >>> from bistair.core.regions import RegionLinks
+    >>> links = RegionLinks(np.array([1, 2, 3]), np.array([2, 3, 4]), np.array([1, 1, 1]),
+    ...                     np.array([20, 5, 20]))
+    >>> faint = np.array([False, False, False, True, True])
+    >>> k, dropped = settle(links, np.array([-1, 0, 1, 7, 8]), faint)
+    >>> k.tolist(), dropped
+    ([-1, 0, 1, -1, -1], 2)
+    """
+    say = np.where(faint, faint_say, 1.0)
+    k, dropped = drop_contradicted(links, region_order, say=say)
+    while True:
+        doubt = (contradicted_regions(links, k, faint=faint) | unanchored(links, k, faint)) \
+            & (k >= 0)
+        if not doubt.any():
+            return k, dropped
+        k[doubt] = -1
+        k, more = drop_contradicted(links, k, say=say)
+        dropped += int(doubt.sum()) + more
+
+
+def unanchored(links: RegionLinks, region_order: np.ndarray, faint: np.ndarray) -> np.ndarray:
+    """Decided faint regions that no chain of agreeing links (both ends decided, orders
+    stepping as the link says) ties to a decided region that is not faint.
+
+    Parameters
+    ----------
+    links : RegionLinks
+        Wrap links between regions.
+    region_order : (n+1,) int array
+        Order per region label, -1 where undecided.
+    faint : (n+1,) bool array
+        Regions whose own evidence does not decide them.
+
+    Returns
+    -------
+    (n+1,) bool array
+
+    Examples
+    --------
+    >>> from bistair.core.regions import RegionLinks
+    >>> links = RegionLinks(np.array([1, 3]), np.array([2, 4]), np.array([1, 1]),
+    ...                     np.array([20, 20]))
+    >>> faint = np.array([False, False, True, True, True])
+    >>> unanchored(links, np.array([-1, 0, 1, 5, 6]), faint).tolist()
+    [False, False, False, True, True]
+    """
+    k = np.asarray(region_order)
+    n = k.size
+    ks, kd = k[links.src], k[links.dst]
+    good = (ks >= 0) & (kd >= 0) & (kd - ks == links.step)
+    graph = sparse.coo_matrix((np.ones(int(good.sum())), (links.src[good], links.dst[good])),
+                              shape=(n, n))
+    _, comp = csgraph.connected_components(graph, directed=False)
+    anchored = np.zeros(n, bool)
+    anchored[np.unique(comp[(k >= 0) & ~faint])] = True
+    return (k >= 0) & faint & ~anchored[comp]
+
+
+def _faint(evidence: np.ndarray, min_score: float, min_margin: float) -> np.ndarray:
+    """Regions whose own evidence does not decide them: no order scores ``min_score``, or
+    the best leads the runner-up by less than ``min_margin``."""
+    if evidence.shape[1] < 2:
+        return evidence.max(axis=1, initial=0.0) < min_score
+    top2 = np.sort(evidence, axis=1)[:, -2:]
+    return (top2[:, 1] < min_score) | (top2[:, 1] - top2[:, 0] < min_margin)
 
 
 def _decide(evidence: np.ndarray, links: RegionLinks, min_score: float,

@@ -30,6 +30,7 @@ from ..errors import BistairError
 from ..io.jsonfile import read_json
 
 BOARD_TYPES = ("checkerboard", "circles", "asymmetric-circles")
+ALIASES = {"chessboard": "checkerboard"}  # other names of the board types
 
 
 @dataclass(frozen=True)
@@ -60,7 +61,8 @@ class Board:
         if missing:
             raise BistairError(f"board description misses field(s): {', '.join(missing)}")
         try:
-            return cls(str(data["type"]), _int(data["columns"]), _int(data["rows"]),
+            kind = str(data["type"])
+            return cls(ALIASES.get(kind, kind), _int(data["columns"]), _int(data["rows"]),
                        float(data["spacing"]))
         except (TypeError, ValueError) as exc:
             if isinstance(exc, BistairError):
@@ -148,6 +150,72 @@ class Board:
             if not found:
                 return None
         return np.asarray(pts, np.float64).reshape(-1, 2)
+
+
+def parse_board(text: str) -> Board:
+    """A board from its short description ``TYPE:COLUMNSxROWS:SPACING``.
+
+    ``TYPE`` is ``chessboard`` (or ``checkerboard``), ``circles`` or
+    ``asymmetric-circles``; ``COLUMNSxROWS`` the inner corners (circles) per row and column;
+    ``SPACING`` the square side (centre distance) in millimetres.
+
+    Parameters
+    ----------
+    text : str
+        The description, e.g. ``"chessboard:9x7:75"``.
+
+    Returns
+    -------
+    Board
+
+    Raises
+    ------
+    BistairError
+        If the text is not of that form or describes a board that cannot be.
+
+    Examples
+    --------
+    >>> parse_board("chessboard:9x7:75")
+    Board(type='checkerboard', columns=9, rows=7, spacing=75.0)
+    >>> parse_board("chessboard:9x7")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: a board is TYPE:COLUMNSxROWS:SPACING (e.g. chessboard:9x7:25 \
+for 9 x 7 inner corners of 25 mm squares), got 'chessboard:9x7'
+    """
+    parts = [part.strip() for part in text.strip().split(":")]
+    size = parts[1].lower().split("x") if len(parts) == 3 else []
+    try:
+        if len(size) != 2 or not all(s.isdigit() for s in size):
+            raise ValueError
+        spacing = float(parts[2])
+    except ValueError:
+        raise BistairError(f"a board is TYPE:COLUMNSxROWS:SPACING (e.g. chessboard:9x7:25 for "
+                           f"9 x 7 inner corners of 25 mm squares), got {text!r}") from None
+    return Board.from_dict({"type": parts[0].lower(), "columns": int(size[0]),
+                            "rows": int(size[1]), "spacing": spacing})
+
+
+def is_board_text(text: str) -> bool:
+    """Whether a ``--board`` value is a short description rather than a file name.
+
+    Parameters
+    ----------
+    text : str
+        The value.
+
+    Returns
+    -------
+    bool
+        True when it starts with a board type and a colon (``chessboard:``, ...).
+
+    Examples
+    --------
+    >>> is_board_text("chessboard:9x7:75"), is_board_text("calib/board.json")
+    (True, False)
+    """
+    kind = text.strip().split(":", 1)[0].lower()
+    return ":" in text and (kind in BOARD_TYPES or kind in ALIASES)
 
 
 def _int(value: Any) -> int:

@@ -1,14 +1,16 @@
 """Calibrating a camera and a projector from board captures (Zhang and Huang, Opt. Eng.
 45(8), 083601, 2006).
 
-For every pose of a planar board the board features are found in the camera's white frame;
-the absolute phases of both orientations map each feature to projector pixels (a robust local
-quadratic fit to the decoded projector x and y around the feature, :func:`sample_local`); the
-camera and the projector are calibrated like two cameras with the same model points
+For every pose of a planar board the board features are found in the camera's white frame
+(or, without one, the mean image of the captures); the decoded projector coordinates of both
+axes map each feature to projector pixels (a robust local homography of the decoded projector
+x and y around the feature, :func:`~bistair.geometry.corners.local_homography`, after Moreno
+and Taubin, 3DIMPVT 2012; or a local quadratic fit, :func:`sample_local`); the camera and the
+projector are calibrated like two cameras with the same model points
 (``cv2.calibrateCamera``) and then as a pair (``cv2.stereoCalibrate``), giving ``R, T`` with
 ``X_p = R @ X_c + T`` (:class:`~bistair.geometry.calibration.Calibration`). Reprojection
 errors are those of the final (stereo) model. Reading the capture folders is
-:func:`bistair.app.jobs.calibrate_folder`.
+:func:`bistair.app.calibrate.calibrate_folder`.
 
 How many poses: at least :data:`MIN_POSES` = 3. A view of a plane fixes a homography
 (8 numbers), 6 of which go to the board's pose, so each view gives 2 constraints on a
@@ -54,7 +56,7 @@ Examples
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -64,6 +66,7 @@ import numpy as np
 from ..errors import BistairError
 from .board import Board
 from .calibration import Calibration, Device, Uncertainty
+from .corners import local_homography
 
 MIN_POSES = 3  # the fewest board poses that calibrate a pair (see the module's notes)
 
@@ -385,13 +388,50 @@ def sample_local(values: np.ndarray, points: np.ndarray, radius: int, min_pixels
 
 @dataclass(frozen=True)
 class PoseCapture:
-    """One board pose in memory: the camera's white frame and the projector column ``x`` and
-    row ``y`` decoded per camera pixel (NaN where invalid)."""
+    """One board pose in memory: the camera image the board is found in (``white``: the
+    white frame, or without one the mean image of the captures) and the projector column
+    ``x`` and row ``y`` decoded per camera pixel (NaN where invalid)."""
 
     name: str
     white: np.ndarray
     x: np.ndarray
     y: np.ndarray
+
+
+@dataclass(frozen=True)
+class BoardView:
+    """The board in one pose: its features found in the camera and mapped to the projector.
+
+    ``features`` is the board's number of features; ``object_points`` ``(n, 3)`` (mm),
+    ``camera_points`` and ``projector_points`` ``(n, 2)`` (pixels) hold the ``n`` of them
+    mapped (none when the board is not ``found``); ``usable`` when enough are (see
+    :func:`board_view`); ``why`` says why not."""
+
+    name: str
+    found: bool
+    features: int
+    object_points: np.ndarray
+    camera_points: np.ndarray
+    projector_points: np.ndarray
+    needed: int = 6
+
+    @property
+    def usable(self) -> bool:
+        """The board was found and at least ``needed`` features were mapped."""
+        return self.found and len(self.object_points) >= self.needed
+
+    @property
+    def why(self) -> str:
+        """Why the view is not usable (empty when it is)."""
+        if not self.found:
+            return "board not found"
+        if not self.usable:
+            return (f"{len(self.object_points)} of {self.features} board features mapped to "
+                    f"the projector, need {self.needed} (are the phases valid on the board?)")
+        return ""
+
+
+CORNER_FITS = ("homography", "quadratic")  # how a feature is mapped to the projector
 
 
 def feature_spacing(points: np.ndarray, columns: int) -> float:
@@ -423,11 +463,127 @@ def feature_spacing(points: np.ndarray, columns: int) -> float:
     return float(np.median(np.hypot(steps[:, 0], steps[:, 1])))
 
 
+def board_view(pose: PoseCapture, board: Board, corner_fit: str = "homography",
+               min_mapped: float = 0.5) -> BoardView:
+    """Find the board in a pose and map its features to the projector.
+
+    The board is detected in ``pose.white``; each feature's projector ``x`` and ``y`` come
+    from the decoded maps in a window around it: a local homography
+    (:func:`~bistair.geometry.corners.local_homography`, Moreno and Taubin) or a quadratic
+    fit (:func:`sample_local`). The window is ``0.7`` (checkerboards) or one (circle grids)
+    feature spacing wide, at least 7 and at most 61 pixels.
+
+    Parameters
+    ----------
+    pose : PoseCapture
+        The board image and the decoded projector coordinates.
+    board : Board
+        The board it shows.
+    corner_fit : {"homography", "quadratic"}
+        How a feature is mapped (:data:`CORNER_FITS`).
+    min_mapped : float, default 0.5
+        The view is usable when at least this share of the features (and at least 6) are
+        mapped.
+
+    Returns
+    -------
+    BoardView
+
+    Raises
+    ------
+    BistairError
+        An unknown ``corner_fit``.
+
+    Examples
+    --------
+    >>> blank = np.ones((60, 80))
+    >>> view = board_view(PoseCapture("pose-0", blank, blank, blank), Board())
+    >>> view.found, view.usable, view.why
+    (False, False, 'board not found')
+    """
+    if corner_fit not in CORNER_FITS:
+        raise BistairError(f"corner fit must be one of {', '.join(CORNER_FITS)}, got "
+                           f"{corner_fit!r}")
+    model = board.object_points()
+    needed = max(6, int(np.ceil(min_mapped * len(model))))
+    pts = board.detect(pose.white)
+    if pts is None:
+        none = np.empty((0, 2))
+        return BoardView(pose.name, False, len(model), np.empty((0, 3), np.float32), none,
+                         none, needed)
+    share = 0.35 if board.type == "checkerboard" else 0.5
+    radius = int(np.clip(round(share * feature_spacing(pts, board.columns)), 3, 30))
+    fit = local_homography if corner_fit == "homography" else sample_local
+    xy = fit(np.stack([pose.x, pose.y]), pts, radius).T
+    ok = np.isfinite(xy).all(axis=1)
+    return BoardView(pose.name, True, len(model), model[ok], pts[ok], xy[ok], needed)
+
+
+def calibrate_views(views: Sequence[BoardView], board: Board, camera_size: tuple[int, int],
+                    projector_size: tuple[int, int], min_poses: int = MIN_POSES,
+                    poses_total: int | None = None, **options: Any) -> Calibration:
+    """Calibrate from the usable views of the board (:func:`calibrate_points`; ``options``
+    go there).
+
+    Parameters
+    ----------
+    views : sequence of BoardView
+        Every pose's view (:func:`board_view`), usable or not.
+    board : Board
+        The board, recorded in the calibration.
+    camera_size, projector_size : tuple of int
+        ``(width, height)``.
+    min_poses : int
+        The fewest usable views to calibrate from (at least :data:`MIN_POSES`).
+    poses_total : int, optional
+        How many poses there were in all, counting those without a view (default: the
+        views).
+
+    Returns
+    -------
+    Calibration
+        With the board and the number of poses.
+
+    Raises
+    ------
+    BistairError
+        ``min_poses`` below :data:`MIN_POSES`, the board found in fewer than ``min_poses``
+        poses, fewer than ``min_poses`` usable views, or a failed calibration.
+
+    Examples
+    --------
+    >>> none = np.empty((0, 2))
+    >>> lost = BoardView("p0", False, 54, np.empty((0, 3)), none, none)
+    >>> calibrate_views([lost], Board(), (640, 480), (800, 600), poses_total=4)
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: board found in 0 of 4 poses, need at least 3
+    """
+    check_min_poses(min_poses)
+    total = len(views) if poses_total is None else poses_total
+    found = sum(view.found for view in views)
+    if found < min_poses:
+        raise BistairError(f"board found in {found} of {total} poses, need at least "
+                           f"{min_poses}")
+    used = [view for view in views if view.usable]
+    if len(used) < min_poses:
+        raise BistairError(f"board features mapped to the projector in {len(used)} of "
+                           f"{total} poses, need at least {min_poses} (are the phases "
+                           "valid on the board?)")
+    cal = calibrate_points([v.object_points for v in used], [v.camera_points for v in used],
+                           [v.projector_points for v in used], camera_size, projector_size,
+                           [v.name for v in used], **options)
+    return cal.replace(board=board.to_dict(), poses_total=total)
+
+
 def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
                     projector_size: tuple[int, int], min_poses: int = MIN_POSES,
-                    min_mapped: float = 0.5, **options: Any) -> Calibration:
+                    min_mapped: float = 0.5, corner_fit: str = "homography",
+                    skipped: Callable[[str, str], None] | None = None,
+                    **options: Any) -> Calibration:
     """Detect the board, map its features through the phases and calibrate
-    (:func:`calibrate_points`; ``options`` go there).
+    (:func:`board_view`, :func:`calibrate_views`; ``options`` go to
+    :func:`calibrate_points`).
 
     Parameters
     ----------
@@ -435,8 +591,10 @@ def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
     board : the board they show.
     projector_size : ``(width, height)``.
     min_poses : the fewest usable poses to calibrate from (at least :data:`MIN_POSES`).
-    min_mapped : a pose is used when the board is found in its white frame and at least
+    min_mapped : a pose is used when the board is found in its board image and at least
         this share of its features get projector coordinates in both orientations.
+    corner_fit : how a feature is mapped to the projector (:func:`board_view`).
+    skipped : called with the name of each pose left out and why.
 
     Returns
     -------
@@ -472,31 +630,12 @@ def calibrate_poses(poses: Sequence[PoseCapture], board: Board,
                     f"{pose.name}: {what} is {getattr(pose, what).shape[1]}x"
                     f"{getattr(pose, what).shape[0]} but {poses[0].name} images are "
                     f"{size[1]}x{size[0]}")
-    found = [(pose, board.detect(pose.white)) for pose in poses]
-    found = [(pose, pts) for pose, pts in found if pts is not None]
-    if len(found) < min_poses:
-        raise BistairError(f"board found in {len(found)} of {len(poses)} poses, need at least "
-                           f"{min_poses}")
-    model = board.object_points()
-    obj, cam, proj, names = [], [], [], []
-    for pose, pts in found:
-        spacing = feature_spacing(pts, board.columns)
-        share = 0.35 if board.type == "checkerboard" else 0.5
-        radius = int(np.clip(round(share * spacing), 3, 30))
-        xy = sample_local(np.stack([pose.x, pose.y]), pts, radius).T
-        ok = np.isfinite(xy).all(axis=1)
-        if ok.mean() >= min_mapped and ok.sum() >= 6:
-            obj.append(model[ok])
-            cam.append(pts[ok])
-            proj.append(xy[ok])
-            names.append(pose.name)
-    if len(obj) < min_poses:
-        raise BistairError(f"board features mapped to the projector in {len(obj)} of "
-                           f"{len(poses)} poses, need at least {min_poses} (are the phases "
-                           "valid on the board?)")
-    cal = calibrate_points(obj, cam, proj, (size[1], size[0]), projector_size, names,
+    views = [board_view(pose, board, corner_fit, min_mapped) for pose in poses]
+    for view in views:
+        if not view.usable and skipped is not None:
+            skipped(view.name, view.why)
+    return calibrate_views(views, board, (size[1], size[0]), projector_size, min_poses,
                            **options)
-    return cal.replace(board=board.to_dict(), poses_total=len(poses))
 
 
 def check_min_poses(min_poses: int) -> None:

@@ -8,8 +8,9 @@ merged; a key that two files give differently is refused.
 
 The key of each part (:data:`DEFAULT_KEYS`) can be renamed. The camera size comes from the
 caller, else from a size key of the files (:data:`SIZE_KEYS`, :data:`SIZE_PAIRS`, or the
-``camera_size`` key if one is named). A projector size is never in these files and must be
-given.
+``camera_size`` key if one is named); the projector size from the caller, else from
+:data:`PROJECTOR_SIZE_KEYS`, :data:`PROJECTOR_SIZE_PAIRS` (SLStudio's ``screenResX``,
+``screenResY``) or the ``projector_size`` key if one is named.
 
 Examples
 --------
@@ -48,12 +49,20 @@ DEFAULT_KEYS = {"camera": "M1", "camera_dist": "D1", "projector": "M2", "project
 #: What each part is, for messages; ``camera_size`` may be named too (no default).
 ROLES = {"camera": "camera matrix", "camera_dist": "camera distortion",
          "projector": "projector matrix", "projector_dist": "projector distortion",
-         "R": "rotation", "T": "translation", "camera_size": "camera size"}
-#: Keys holding the camera size ``[width, height]``, tried in this order.
-SIZE_KEYS = ("image_size", "imageSize", "img_size", "camera_size", "cameraSize")
-#: Key pairs holding the camera width and height, tried after :data:`SIZE_KEYS`.
+         "R": "rotation", "T": "translation", "camera_size": "camera size",
+         "projector_size": "projector size"}
+#: Keys holding the camera size ``[width, height]``, tried in this order (``S`` only when it
+#: holds two numbers).
+SIZE_KEYS = ("image_size", "imageSize", "img_size", "camera_size", "cameraSize", "S")
+#: Key pairs holding the camera width and height, tried after :data:`SIZE_KEYS`
+#: (``frameWidth``, ``frameHeight``: SLStudio's).
 SIZE_PAIRS = (("image_width", "image_height"), ("imageWidth", "imageHeight"),
-              ("camera_width", "camera_height"))
+              ("camera_width", "camera_height"), ("frameWidth", "frameHeight"))
+#: Keys holding the projector size ``[width, height]``, tried in this order.
+PROJECTOR_SIZE_KEYS = ("projector_size", "projectorSize", "proj_size")
+#: Key pairs holding the projector width and height (``screenResX``, ``screenResY``:
+#: SLStudio's).
+PROJECTOR_SIZE_PAIRS = (("screenResX", "screenResY"), ("projector_width", "projector_height"))
 # OpenCV's distortion terms after (k1, k2, p1, p2, k3)
 _HIGHER = ("k4", "k5", "k6", "s1", "s2", "s3", "s4", "tauX", "tauY")
 _ROTATION_TOL = 1e-6  # what Calibration.from_dict accepts as is
@@ -138,7 +147,8 @@ def _node_array(node: Any) -> np.ndarray | None:
     return None
 
 
-def read_opencv_calibration(paths: Sequence[str | Path], projector_size: tuple[int, int],
+def read_opencv_calibration(paths: Sequence[str | Path],
+                            projector_size: tuple[int, int] | None = None,
                             camera_size: tuple[int, int] | None = None,
                             keys: Mapping[str, str] | None = None) -> Calibration:
     """A :class:`Calibration` from OpenCV FileStorage files.
@@ -146,11 +156,13 @@ def read_opencv_calibration(paths: Sequence[str | Path], projector_size: tuple[i
     Parameters
     ----------
     paths : the files; their keys are merged.
-    projector_size : ``(width, height)`` of the projector in pixels.
-    camera_size : ``(width, height)`` of the camera; by default from a size key.
+    projector_size : ``(width, height)`` of the projector in pixels; by default from a
+        projector size key (:data:`PROJECTOR_SIZE_KEYS`, :data:`PROJECTOR_SIZE_PAIRS`).
+    camera_size : ``(width, height)`` of the camera; by default from a size key
+        (:data:`SIZE_KEYS`, :data:`SIZE_PAIRS`).
     keys : key names that replace those of :data:`DEFAULT_KEYS` (``camera``,
         ``camera_dist``, ``projector``, ``projector_dist``, ``R``, ``T``), and optionally
-        ``camera_size``.
+        ``camera_size`` and ``projector_size``.
 
     Returns
     -------
@@ -198,6 +210,8 @@ def read_opencv_calibration(paths: Sequence[str | Path], projector_size: tuple[i
     files = [(Path(p), read_filestorage(p)) for p in paths]
     if not files:
         raise BistairError("no calibration files given")
+    if projector_size is None:
+        projector_size = _projector_size(files, names.get("projector_size"))
     proj_w, proj_h = _size_pair(projector_size, "projector size")
     if camera_size is None:
         camera_size = _camera_size(files, names.get("camera_size"))
@@ -321,6 +335,8 @@ def _camera_size(files: list[tuple[Path, Values]], key: str | None) -> tuple[int
     for _, values in files:
         merged.update(values)
     for name in SIZE_KEYS:
+        if name == "S" and (merged.get(name) is None or merged[name].size != 2):
+            continue  # a short name that may mean something else: a size only as 2 numbers
         if name in merged:
             value, label, where = _lookup(files, name, "camera_size")
             return _size_value(value, label, where)
@@ -332,6 +348,28 @@ def _camera_size(files: list[tuple[Path, Values]], key: str | None) -> tuple[int
     raise BistairError(f"no camera size in {_where(files)} (none of the keys "
                        f"{', '.join(SIZE_KEYS)} or {SIZE_PAIRS[0][0]} + {SIZE_PAIRS[0][1]}); "
                        "give it with --camera-size WxH")
+
+
+def _projector_size(files: list[tuple[Path, Values]], key: str | None) -> tuple[int, int]:
+    """The projector size from the named key, else the first projector size key or pair."""
+    if key is not None:
+        value, label, where = _lookup(files, key, "projector_size")
+        return _size_value(value, label, where)
+    merged: Values = {}
+    for _, values in files:
+        merged.update(values)
+    for name in PROJECTOR_SIZE_KEYS:
+        if name in merged:
+            value, label, where = _lookup(files, name, "projector_size")
+            return _size_value(value, label, where)
+    for wkey, hkey in PROJECTOR_SIZE_PAIRS:
+        if wkey in merged and hkey in merged:
+            width, label, where = _lookup(files, wkey, "projector_size")
+            height = _lookup(files, hkey, "projector_size")[0]
+            return _size_value(np.array([width, height]).ravel(), label, where)
+    raise BistairError(f"no projector size in {_where(files)} (none of the keys "
+                       f"{', '.join(PROJECTOR_SIZE_KEYS)} or {PROJECTOR_SIZE_PAIRS[0][0]} + "
+                       f"{PROJECTOR_SIZE_PAIRS[0][1]}); give it with --projector-size WxH")
 
 
 def _size_value(value: np.ndarray, label: str, where: str) -> tuple[int, int]:

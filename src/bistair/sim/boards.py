@@ -51,8 +51,11 @@ def board_plane(board: Board, rx: float, ry: float, rz: float, *centre: float) -
 def write_board_captures(rig: Rig, board: Board, specs: dict[str, BaseSpec], out: str | Path,
                          poses: Sequence[Sequence[float]] = POSES,
                          imaging: Imaging | None = None, suffix: str = ".png") -> Path:
-    """Render ``board`` in every pose for the ``"columns"`` and ``"rows"`` specs (each with a
-    white frame) and write ``board.json`` and ``pose-NN/{columns,rows}/`` into ``out``."""
+    """Render ``board`` in every pose for the ``"columns"`` and ``"rows"`` specs and write
+    ``board.json`` and ``pose-NN/{columns,rows}/`` into ``out``; or for one ``"both"`` spec
+    (both axes in one capture set), ``pose-NN/`` with the captures and their ``spec.json``.
+    The board is found in the white frame of specs that have one, else in the mean image
+    (``bistair calibrate``)."""
     imaging = imaging or Imaging()
     patterns = {o: encode(s) for o, s in specs.items()}
     with output_folder(out) as tmp:
@@ -61,7 +64,8 @@ def write_board_captures(rig: Rig, board: Board, specs: dict[str, BaseSpec], out
             traced = trace(rig, Scene([board_plane(board, *pose)]),
                            dataclasses.replace(imaging, seed=imaging.seed + i))
             for orientation, spec in specs.items():
-                folder = tmp / f"pose-{i:02d}" / orientation
+                folder = tmp / f"pose-{i:02d}"
+                folder = folder if orientation == "both" else folder / orientation
                 folder.mkdir(parents=True)
                 for j, img in enumerate(expose(traced, patterns[orientation])):
                     write_image(folder / f"{j:02d}{suffix}", img)

@@ -337,7 +337,7 @@ def _plane_depth(rig: Rig, centre: _Hits, dirs: np.ndarray) -> np.ndarray:
 
 
 def expose(trace: Trace, patterns: np.ndarray, imaging: Imaging | None = None,
-           workers: int | None = None) -> np.ndarray:
+           workers: int | None = None, first_frame: int = 0) -> np.ndarray:
     """Camera images ``(frames, H, W)`` of projector ``patterns`` on a traced scene.
 
     ``patterns`` are floats in [0, 1] of shape ``(frames, projector height, width)``, e.g.
@@ -346,6 +346,8 @@ def expose(trace: Trace, patterns: np.ndarray, imaging: Imaging | None = None,
     Returns integer codes (uint8 for 8 bits, uint16 otherwise) or float32, see
     :class:`Imaging`. Frames are made on ``workers`` threads (default: the CPU count), each
     with its own noise stream from ``imaging.seed``, so the result does not depend on it.
+    Frame ``k`` takes the noise of frame ``first_frame + k`` of a longer set, so exposing a
+    set one frame at a time (``first_frame=k``) gives the images of exposing it whole.
     """
     imaging = imaging or trace.imaging
     proj = trace.rig.projector
@@ -360,7 +362,9 @@ def expose(trace: Trace, patterns: np.ndarray, imaging: Imaging | None = None,
     else:
         where = list(trace.coords)
     ambient = np.float32(imaging.ambient) * trace.albedo.sum(axis=0)
-    seeds = np.random.SeedSequence(imaging.seed).spawn(len(pats))
+    # the children SeedSequence(seed).spawn(n) gives, from any first frame
+    seeds = [np.random.SeedSequence(imaging.seed, spawn_key=(first_frame + k,))
+             for k in range(len(pats))]
     jobs = [(pattern, seed) for pattern, seed in zip(pats, seeds, strict=True)]
     count = min(workers or os.cpu_count() or 1, len(jobs))
     if count > 1:

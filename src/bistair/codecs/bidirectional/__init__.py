@@ -44,8 +44,9 @@ import math
 import numpy as np
 
 from ...core.captures import Prepared
-from ...core.checks import stair_misfit, wrap_steps
+from ...core.checks import refuse, stair_misfit, wrap_steps
 from ...core.measure import FringeSet
+from ...core.phase import TWO_PI, wrap
 from ...core.regions import core_weight, fringe_direction, fringe_regions
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair
@@ -64,7 +65,13 @@ from .evidence import (
     split_regions,
 )
 from .paper import paper_orders
-from .profiles import RowProfiles, profile_centroids, row_profiles, stair_row_profiles, stair_values
+from .profiles import (
+    RowProfiles,
+    profile_centroids,
+    row_profiles,
+    stair_row_profiles,
+    stair_values,
+)
 from .stairs import stair_edges, stair_fit
 from .stairs_jit import stair_agreement, stair_noise
 
@@ -216,9 +223,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     theta, stair_mod = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
-        raise BistairError("the captures do not fit the spec: the stair phases sit halfway "
-                           "between the levels of the code: are stair-cos and stair-sin "
-                           "swapped (or partitions and stairs wrong)?")
+        refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
+               "and stair-sin swapped (or partitions and stairs wrong)?")
     return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod}, cycle=spec.stairs)
 
 
@@ -290,9 +296,20 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
         order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
     misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
     info["stair_misfit"] = round(misfit, 4)
+    band = info.get("group_height", spec.group_rows) * (1 - spec.local_rows / spec.group_rows)
+    if band < MIN_BAND_PX:
+        info["warnings"] = [*info.get("warnings", []), (
+            f"the partition bands are {band:.1f} camera pixels tall: at this resolution blur "
+            "mixes them with the local bands and some regions can read a wrong partition "
+            "(more group_rows, a longer period or a closer camera give thicker bands)")]
+    if info.get("level_offset", 0.0) > OFFSET_WARNING:
+        info["warnings"] = [*info.get("warnings", []), (
+            f"the band rows read {100 * info['level_offset']:.0f}% of the way to the next "
+            "stair level (median): is the projector's gamma compensated (spec field gamma, "
+            "'bistair gamma')? With many levels whole partitions can read wrong")]
     if misfit > 0.1:
-        raise BistairError(
-            f"the captures do not fit the spec: at {100 * misfit:.0f}% of the decoded pixels "
+        refuse(
+            f"at {100 * misfit:.0f}% of the decoded pixels "
             "the stair phase is nearer a level other than the local or partition level of the "
             "decoded order: are partitions, stairs and period right, and stair-cos and "
             "stair-sin in the spec's order?")
@@ -334,6 +351,8 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         prof = profiles(labels)
+        if "level_offset" not in info:  # how far the band rows read from the levels
+            info["level_offset"] = round(level_offset(prof, levels), 3)
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = edge_rows(runs, band_splits(runs, heights, spec.local_rows / spec.group_rows))
@@ -347,7 +366,8 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
                             default)
         info.update(region_splits=info.get("region_splits", 0) + len(splits),
                     group_height=default)
-        return labels, n, region_evidence(runs, n, heights, layout)
+        evidence = region_evidence(runs, n, heights, layout)
+        return labels, n, thin_band_doubt(evidence, default, spec)
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """A pixel reads its order's local or partition level (its row decides which)."""
@@ -356,6 +376,103 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
     # the labels are passed on, not kept here: the decode replaces them as it splits regions
     return orders_from_regions(fs.phi, fs.valid, regions(), evidence_of, agrees, info,
                                phase_noise=phase_noise, direction=direction)
+
+
+def thin_band_doubt(evidence: np.ndarray, group_height: float,
+                    spec: BidirectionalSpec) -> np.ndarray:
+    """The band evidence, the orders whose two stairs read one level (``k = j*(S+1)``,
+    local and partition level both ``j``) made faint (scaled by ``THIN_DOUBT``) while the
+    partition bands are thinner than ``MIN_BAND_PX`` camera pixels.
+
+    Blur mixes a band that thin with the local bands either side: its rows lose the
+    modulation of a band and are skipped as transitions, so a region whose partition level
+    differs from its local level seems to read one level throughout, which only such an
+    order explains (a small object at 320 x 256, its partition bands 3 px tall and read 4,
+    its local bands 6: decoded as order 54 = 6*(8+1) rather than 38, by two partitions).
+    Those regions then take their orders from neighbours that decide themselves, or stay
+    undecided (:func:`bistair.core.resolve.settle`).
+
+    Parameters
+    ----------
+    evidence : numpy.ndarray
+        (n+1, K) band evidence per region.
+    group_height : float
+        The median band group height, camera pixels.
+    spec : BidirectionalSpec
+        The spec (stairs, partitions, local and group rows).
+
+    Returns
+    -------
+    numpy.ndarray
+        The evidence, those orders' columns scaled where the bands are thin.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("bidirectional", width=240, height=64, period=20, partitions=3,
+    ...                  stairs=4, group_rows=16, local_rows=10)
+    >>> ev = np.ones((2, 12))
+    >>> thin_band_doubt(ev, 8.0, spec)[1].tolist()  # 3-px partition bands
+    [0.4, 1.0, 1.0, 1.0, 1.0, 0.4, 1.0, 1.0, 1.0, 1.0, 0.4, 1.0]
+    >>> bool((thin_band_doubt(ev, 16.0, spec) == ev).all())  # 6 px: read as they are
+    True
+    """
+    band = group_height * (1.0 - spec.local_rows / spec.group_rows)
+    if not band < MIN_BAND_PX:
+        return evidence
+    merged = np.arange(min(spec.stairs, spec.partitions)) * (spec.stairs + 1)
+    merged = merged[merged < evidence.shape[1]]
+    out = np.array(evidence, copy=True)
+    out[:, merged] *= THIN_DOUBT
+    return out
+
+
+def level_offset(prof: RowProfiles, levels: np.ndarray) -> float:
+    """How far the band rows of the regions read from the nearest stair level: the weighted
+    median distance, as a share of half the gap to the next level (0 on the levels, 1
+    halfway between two). The rows of band cores only (stair-pair modulation at least 0.7
+    of the fringes'). A compensated projector reads about 0.1-0.2 (noise, blur at the
+    band edges); an uncompensated gamma of 2.2 about 0.5-0.6, where a distortion that
+    varies along the stair can put a level nearer its neighbour.
+
+    Parameters
+    ----------
+    prof : RowProfiles
+        The regions' row profiles.
+    levels : numpy.ndarray
+        (levels,) nominal level phases (:func:`~.bands.union_levels`).
+
+    Returns
+    -------
+    float
+        The median share (0.0 with no band row).
+
+    Examples
+    --------
+    >>> from bistair.codecs.bidirectional.profiles import RowProfiles
+    >>> levels = union_levels(4, 4)
+    >>> theta = levels[[0, 1, 2, 3]] + np.array([0.0, 0.1, -0.1, 0.2])
+    >>> one = np.ones(4)
+    >>> prof = RowProfiles(one, one, np.cos(theta), np.sin(theta), one, one, one, one)
+    >>> round(level_offset(prof, levels), 3)
+    0.127
+    """
+    theta = np.arctan2(prof.sin, prof.cos)
+    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
+    if theta.size == 0 or not weight.sum() > 0:
+        return 0.0
+    dist = np.abs(wrap(theta[:, None] - levels[None, :]))
+    nearest = dist.argmin(axis=1)
+    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
+    share = dist.min(axis=1) / (0.5 * gaps.min(axis=1)[nearest])
+    order = np.argsort(share)
+    cum = np.cumsum(weight[order])
+    return float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
+
+
+OFFSET_WARNING = 0.4  # level_offset above which the decode warns of an uncompensated gamma
+MIN_BAND_PX = 4.0  # partition bands thinner than this (camera pixels) are read with doubt
+THIN_DOUBT = 0.4  # below the resolve stage's min_score: faint
 
 
 def stairs_for(fringes: int) -> tuple[int, int]:
