@@ -1,4 +1,4 @@
-"""The README's picture of a binocular reconstruction: ``docs/images/stereo-depth.png``.
+"""The README's picture of a binocular reconstruction: ``docs/_static/stereo-depth.png``.
 
 Renders mugs-on-wall on the two-camera virtual rig (640 x 512 cameras 200 mm apart, the
 projector between them; Gray code with the complementary pattern and a white frame), runs
@@ -6,7 +6,7 @@ projector between them; Gray code with the complementary pattern and a white fra
 white frame and the depth on its own image grid (turbo, near red, far blue; black where no
 point: the projector's shadow, what the right camera does not see).
 
-    python docs/stereo_figure.py
+    python docs/make_stereo_figure.py
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from bistair.io.previews import colorize
 from bistair.sim import Imaging, preset
 from bistair.sim.stereo import StereoRig, render_stereo
 
-OUT = Path(__file__).resolve().parent / "images" / "stereo-depth.png"
+OUT = Path(__file__).resolve().parent / "_static" / "stereo-depth.png"
 
 
 def main() -> None:
