@@ -628,9 +628,9 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
 @click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale [default: from noise]")
-@click.option("--smooth", type=float, default=0.0, show_default=True, metavar="PX",
+@click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
               help="Gaussian sigma of a smoothing of the projector coordinates before "
-              "matching (never across surfaces): less depth noise, less lateral detail")
+              "matching (never across surfaces): less depth noise, less lateral detail; 0: none")
 @click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
 @_threads
 @_quiet

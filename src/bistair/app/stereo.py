@@ -68,7 +68,7 @@ def _silent(stage: str) -> None:
 def stereo_folder(left: Any, right: Any, out: str | Path,
                   calibration: StereoCalibration | str | Path,
                   spec: BaseSpec | str | Path | None = None, min_depth: float = 0.0,
-                  max_depth: float = np.inf, force: bool = False, smooth: float = 0.0,
+                  max_depth: float = np.inf, force: bool = False, smooth: float = 1.0,
                   previews: bool = True, progress: Say | None = None,
                   **options: Any) -> StereoResult:
     """Decode two cameras' captures (each a folder, image files, a glob pattern or a ``.npy``

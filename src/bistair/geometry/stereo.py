@@ -254,7 +254,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                        rectification: Rectification | None = None, min_depth: float = 0.0,
                        max_depth: float = math.inf, tolerance: float = 1.0,
                        other_tolerance: float = 2.0, gap: int = 3, wiggle: float = 1.0,
-                       support: float = 2.0, smooth: float = 0.0, offset: float = 0.5,
+                       support: float = 2.0, smooth: float = 1.0, offset: float = 0.5,
                        force: bool = False) -> StereoResult:
     """Match two cameras' decodes of the same patterns and triangulate (module docstring).
 
@@ -503,7 +503,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
            calibration: StereoCalibration | str | Path, *,
            rectification: Rectification | None = None, min_depth: float = 0.0,
            max_depth: float = math.inf, force: bool = False, tolerance: float = 1.0,
-           other_tolerance: float = 2.0, smooth: float = 0.0, **options: Any) -> StereoResult:
+           other_tolerance: float = 2.0, smooth: float = 1.0, **options: Any) -> StereoResult:
     """Decode two cameras' captures of the same patterns and reconstruct by matching equal
     absolute phase along rectified rows (:func:`reconstruct_stereo`).
 
