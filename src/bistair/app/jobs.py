@@ -19,7 +19,6 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -45,7 +44,7 @@ from ..io.read import (
     read_captures,
     read_with_spec,
 )
-from ..io.writers import RESULT_FILES, write_depth, write_ply, write_result
+from ..io.writers import save_result, write_depth, write_ply
 from ..spec import BaseSpec
 
 
@@ -124,12 +123,7 @@ def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Pa
     say(_decoding(stack, spec))
     result = require_valid(decode(stack, spec, **options))
     say("writing " + ("outputs and previews" if previews else "outputs"))
-    with output_folder(out) as tmp:
-        write_result(result, tmp, previews=previews)
-        written = {p.name for p in tmp.iterdir()}
-    for name in RESULT_FILES - written:  # an earlier decode's files there: not this one's
-        with contextlib.suppress(OSError):
-            (Path(out) / name).unlink()
+    save_result(result, out, previews=previews)
     return result
 
 
@@ -196,7 +190,7 @@ def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
     heights = model.height(obj).astype(np.float32)
     with output_folder(out) as tmp:
         np.save(tmp / "height.npy", heights)
-        write_image(tmp / "height.png", colorize(heights, "viridis"))
+        write_image(tmp / "height.png", colorize(heights, "viridis", unit="mm"))
     return heights
 
 
