@@ -15,6 +15,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
@@ -107,9 +108,63 @@ def draw_method(row: Row, truth: Any) -> Figure:
             bar.locator = MaxNLocator(integer=True)
             bar.update_ticks()
     s = row.scores
-    fig.suptitle(f"{row.label}: {row.frames} frames, coverage {100 * s['coverage']:.2f}%, "
+    refused = res.info.get("refused")
+    fig.suptitle(f"{row.label}: {row.frames} frames, refused: {refused}" if refused else
+                 f"{row.label}: {row.frames} frames, coverage {100 * s['coverage']:.2f}%, "
                  f"order errors {100 * s['order_error_rate']:.3f}%, "
                  f"RMSE {s['phase_rmse']:.4f} rad (black: no value)", fontsize=11)
+    return fig
+
+
+def sweep_figure(curves: dict[str, Sequence[tuple[float, float | None]]], xlabel: str,
+                 ylabel: str) -> Figure:
+    """One line per method of a score (a share, drawn in %) against a factor; a decode that
+    refused the captures (a ``None`` score) is drawn as refused: a cross at the top of the
+    plot in the method's colour, the line broken there, never as a score of 0.
+
+    Parameters
+    ----------
+    curves : method label -> ``(factor value, share or None)`` points.
+    xlabel, ylabel : the axes' labels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The plot, with a legend entry "refused decode" when any decode refused.
+
+    Examples
+    --------
+    >>> fig = sweep_figure({"a": [(1, 0.0), (2, None), (3, 0.01)], "b": [(1, 0.02)]},
+    ...                    "noise", "order error rate (%)")
+    >>> ax = fig.axes[0]
+    >>> ax.lines[0].get_ydata().tolist()  # the refused point is no score
+    [0.0, nan, 1.0]
+    >>> [t.get_text() for t in ax.get_legend().get_texts()]
+    ['a', 'b', 'refused decode']
+    """
+    fig = Figure(figsize=(6.4, 4), layout="constrained")
+    ax = fig.subplots()
+    top = ax.get_xaxis_transform()  # x in data, y in axes fraction
+    any_refused = False
+    for method, points in curves.items():
+        pts = sorted(points, key=lambda p: p[0])
+        xs = [p[0] for p in pts]
+        ys = [np.nan if p[1] is None else 100 * p[1] for p in pts]
+        line, = ax.plot(xs, ys, marker="o", label=method)
+        refused = [x for x, y in pts if y is None]
+        if refused:
+            any_refused = True
+            ax.scatter(refused, [0.97] * len(refused), transform=top, marker="X", s=70,
+                       color=line.get_color(), clip_on=False, zorder=3)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    if any_refused:
+        handles.append(Line2D([], [], color="0.3", marker="X", linestyle="none",
+                              markersize=8))
+        labels.append("refused decode")
+    ax.legend(handles, labels, fontsize=7)
     return fig
 
 
@@ -143,7 +198,8 @@ def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, 
     path : the HTML file to write.
     title, intro : the page's heading and first paragraph (``intro`` may hold HTML).
     rows, objects : :func:`~bistair.evaluation.benchmark.table` rows and the object ids,
-        largest first (all but the first are the small objects).
+        largest first (all but the first are the small objects); a refused row reads
+        "refused" and why across its score cells.
     figures : ``(heading, PNG file)`` per figure, e.g. the method's label such as
         ``"bidirectional (paper decoder)"``.
     notes : a paragraph after the table.
@@ -159,6 +215,11 @@ def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, 
         "RMSE vs reference (rad)", *(f"object {i} right" for i in small)))
     body = []
     for r in rows:
+        if r.get("refused"):  # no scores: the decode refused the captures
+            body.append(f"<tr><td>{html.escape(r['method'])}</td><td>{r['frames']}</td>"
+                        f"<td colspan=\"{4 + len(small)}\" style=\"text-align:left\">"
+                        f"refused: {html.escape(r['refused'])}</td></tr>")
+            continue
         cells = [html.escape(r["method"]), str(r["frames"]), f"{100 * r['coverage']:.2f}%",
                  f"{100 * r['order_error_rate']:.3f}%", f"{r['phase_rmse']:.4f}",
                  f"{r['rmse_vs_reference']:.4f}",
