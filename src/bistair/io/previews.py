@@ -280,16 +280,19 @@ def preview_images(result: DecodeResult, colorbar: bool = False) -> dict[str, np
     >>> preview_images(res, colorbar=True)["order"][:2, :3].tolist() == images["order"].tolist()
     True
     """
-    code = np.where(result.code >= 0, result.code, np.nan).astype(np.float32)
-    order = np.where(result.order >= 0, result.order, np.nan).astype(np.float32)
-    values = {"wrapped": result.wrapped, "ks": code, "order": order, "phase": result.phase,
-              "modulation": result.modulation}
-    out = {}
-    for stem in PREVIEW_NAMES:
-        s = SCALES[stem]
-        out[stem] = colorize(values[stem], s.cmap, s.vmin, s.vmax,
-                             unit=s.unit if colorbar else None, integer=s.integer)
-    return out
+    return {stem: _preview(result, stem, colorbar) for stem in PREVIEW_NAMES}
+
+
+def _preview(result: DecodeResult, stem: str, colorbar: bool) -> np.ndarray:
+    """One preview image (:func:`preview_images`)."""
+    if stem in ("ks", "order"):  # -1: not decoded
+        codes = result.code if stem == "ks" else result.order
+        values = np.where(codes >= 0, codes, np.nan).astype(np.float32)
+    else:
+        values = getattr(result, stem)
+    s = SCALES[stem]
+    return colorize(values, s.cmap, s.vmin, s.vmax, unit=s.unit if colorbar else None,
+                    integer=s.integer)
 
 
 def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -> list[Path]:
@@ -330,10 +333,13 @@ def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -
     >>> shutil.rmtree(tmp)
     """
     folder = Path(folder)
-    images = preview_images(result, colorbar=True)
-    paths = [folder / f"{stem}{suffix}.png" for stem in images]
-    with ThreadPoolExecutor(max_workers=len(paths)) as pool:  # the encoder frees the GIL
-        done = list(pool.map(_write_png, paths, images.values()))
+    paths = [folder / f"{stem}{suffix}.png" for stem in PREVIEW_NAMES]
+
+    def write(stem: str, path: Path) -> bool:
+        return _write_png(path, _preview(result, stem, colorbar=True))
+
+    with ThreadPoolExecutor(max_workers=len(paths)) as pool:  # OpenCV frees the GIL
+        done = list(pool.map(write, PREVIEW_NAMES, paths))
     if not all(done):
         raise OSError(f"cannot write the previews in {folder}")
     return paths
