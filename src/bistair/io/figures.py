@@ -3,11 +3,15 @@
 Wrapped phase (rad), absolute phase (rad), projector coordinate (projector px), fringe
 order, modulation (fraction of full scale) and the mask of valid pixels, coloured as the
 PNG previews are (:data:`bistair.io.previews.SCALES`); invalid pixels black. The figure is
-a :class:`matplotlib.figure.Figure` made without pyplot: a notebook shows it as a cell's
-value, ``fig.savefig("decode.png")`` writes it, and no window or backend is touched.
+a :class:`matplotlib.figure.Figure` made without pyplot (no backend chosen, no window, no
+figure kept by pyplot): a notebook shows it as a cell's value (it has ``_repr_png_``, for a
+kernel whose matplotlib integration is not active yet), ``fig.savefig("decode.png")``
+writes it; ``plt.show()`` does not know it.
 """
 
 from __future__ import annotations
+
+import io
 
 import numpy as np
 from matplotlib import colormaps
@@ -25,6 +29,16 @@ PANELS = (("wrapped", "wrapped"), ("phase", "phase"), ("coord", "coord"),
           ("order", "order"), ("modulation", "modulation"), ("mask", None))
 # the mask panel: colour of valid and of invalid pixels
 MASK_COLOURS = ((0.85, 0.85, 0.85), (0.0, 0.0, 0.0))
+
+
+class ResultFigure(Figure):
+    """A figure a notebook shows as a PNG even before pyplot (and its inline backend) is
+    loaded."""
+
+    def _repr_png_(self) -> bytes:
+        buffer = io.BytesIO()
+        self.savefig(buffer, format="png", dpi=72)
+        return buffer.getvalue()
 
 
 def plot_result(result: DecodeResult | AxesResult, width: float = 13.0) -> Figure:
@@ -55,13 +69,15 @@ def plot_result(result: DecodeResult | AxesResult, width: float = 13.0) -> Figur
     ['wrapped phase', 'projector coordinate', 'modulation']
     >>> [ax.get_ylabel() for ax in fig.axes if ax.get_label() == "<colorbar>"]
     ['rad', 'rad', 'projector px', 'fringe order', 'fraction of full scale']
+    >>> fig._repr_png_()[:4]  # what a notebook shows
+    b'\x89PNG'
     """
     axes = [("", result)] if isinstance(result, DecodeResult) else [("x: ", result.x),
                                                                      ("y: ", result.y)]
     h, w = axes[0][1].mask.shape
     panel = width / 3
     height = len(axes) * 2 * (0.72 * panel * h / max(w, 1) + 0.5) + 0.4  # bars beside
-    fig = Figure(figsize=(width, height), layout="constrained")
+    fig = ResultFigure(figsize=(width, height), layout="constrained")
     grid = fig.subplots(2 * len(axes), 3, squeeze=False)
     step = max(1, min(h, w) // 500)  # a panel is a few hundred pixels wide anyway
     for row, (tag, res) in enumerate(axes):
