@@ -4,7 +4,7 @@ VENV ?= .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: test demo lint bench clean
+.PHONY: test demo lint bench docs clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -13,19 +13,30 @@ $(STAMP): pyproject.toml
 	touch $(STAMP)
 
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 	$(BIN)/python -m pytest -q
 
 demo: $(STAMP)
 	$(BIN)/bistair demo --out demo-out
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/decode_speed.py
 
+DOCS_STAMP := $(VENV)/.docs-installed
+
+$(DOCS_STAMP): $(STAMP) pyproject.toml
+	$(BIN)/python -m pip install --quiet -e '.[dev,docs]'
+	touch $(DOCS_STAMP)
+
+# the documentation site into docs/_build/html (warnings are errors; the gallery runs)
+docs: $(DOCS_STAMP)
+	$(BIN)/python -m sphinx -W --keep-going -b html docs docs/_build/html
+
 clean:
-	rm -rf $(VENV) demo-out .pytest_cache build src/*.egg-info
+	rm -rf $(VENV) demo-out .pytest_cache build src/*.egg-info docs/_build docs/auto_examples \
+		docs/api/*.rst docs/sg_execution_times.rst
 	# numba's cache files are keyed by file and line: they pile up after code moves
 	find src tests -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete

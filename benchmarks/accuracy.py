@@ -20,6 +20,7 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+from markdown_page import markdown_page  # noqa: E402
 
 import bistair
 from bistair.app.calibrate import calibrate_folder
@@ -45,10 +46,23 @@ def calibration_errors(cal: Calibration, truth: Calibration) -> str:
             f"rotation {angle:.3f} deg, stereo RMS {cal.rms:.3f} px")
 
 
+TITLE = 'Accuracy: calibration and 3-D'
+ABOUT = ("A calibration from rendered board poses against the rig's truth, and the sphere "
+         'of the sphere-on-plane scene measured with each codec, with the exact and the '
+         'estimated calibration.')
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--markdown", type=Path, default=None,
+                        help="also write what is printed as a Markdown page")
     parser.add_argument("--camera", default="640x512")
     args = parser.parse_args()
+    with markdown_page(args.markdown, TITLE, ABOUT):
+        measure_all(args)
+
+
+def measure_all(args: argparse.Namespace) -> None:
     camera = tuple(int(v) for v in args.camera.split("x"))
     with tempfile.TemporaryDirectory() as tmp:
         caps = simulate("calibration", ["multifreq"], Path(tmp) / "calib", camera_size=camera)

@@ -125,7 +125,8 @@ def test_a_refused_decode_reads_refused_in_the_table_and_report(tmp_path):
                                         "captures do not fit")
 
 
-def _robustness():
+def _robustness(monkeypatch):
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))  # as `python benchmarks/...` runs
     spec = importlib.util.spec_from_file_location("robustness", ROOT / "benchmarks"
                                                   / "robustness.py")
     module = importlib.util.module_from_spec(spec)
@@ -133,8 +134,9 @@ def _robustness():
     return module
 
 
-def test_robustness_plots_draw_refused_decodes_as_refused_under_clean_names(tmp_path):
-    rob = _robustness()
+def test_robustness_plots_draw_refused_decodes_as_refused_under_clean_names(tmp_path,
+                                                                            monkeypatch):
+    rob = _robustness(monkeypatch)
     rows = [{"factor": "gamma (uncompensated)", "value": v, "method": m,
              "refused": "refused" if (m, v) == ("lv", 2.2) else None,
              "order_error_rate": 0.0 if (m, v) == ("lv", 2.2) else 0.01 * v}

@@ -476,7 +476,7 @@ def direction_problem(against: int, steps: int, limit: float = 0.25) -> str | No
 
     Examples
     --------
-    >>> direction_problem(36, 76) is None, direction_problem(360, 760)[:30]
+    >>> direction_problem(36, 76) is None, direction_problem(360, 760)[:31]
     (True, 'the decoded cells run backwards')
     """
     if steps < 200 or against <= limit * steps:

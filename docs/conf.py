@@ -1,0 +1,174 @@
+"""Sphinx configuration of bistair's documentation site (``make docs``)."""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "src"))
+os.environ.setdefault("BISTAIR_PROGRESS_DELAY", "3600")  # no progress lines in the build
+
+import bistair  # noqa: E402
+
+project = "bistair"
+author = "the bistair developers"
+copyright = "2026, the bistair developers"  # noqa: A001
+release = bistair.__version__
+version = release
+
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.viewcode",
+    "numpydoc",
+    "sphinx_click",
+    "sphinx_gallery.gen_gallery",
+    "myst_parser",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+exclude_patterns = ["_build", "auto_examples/*.ipynb", "auto_examples/*.py",
+                    "auto_examples/*.zip", "auto_examples/*.json", "auto_examples/*.md5"]
+myst_enable_extensions = ["colon_fence", "deflist"]
+myst_heading_anchors = 3
+
+autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
+autodoc_typehints = "none"  # numpydoc's Parameters sections say the types
+autosummary_generate = False
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+numpydoc_validation_checks: set[str] = set()
+numpydoc_xref_param_type = False
+
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"/plot_",
+    "ignore_pattern": r"__init__\.py",
+    "within_subsection_order": "FileNameSortKey",
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "abort_on_example_error": True,
+    "matplotlib_animations": False,
+    "plot_gallery": "True",
+}
+
+html_theme = "pydata_sphinx_theme"
+html_title = "bistair"
+html_static_path = ["_static"]
+html_theme_options = {
+    "navigation_with_keys": False,
+    "show_toc_level": 2,
+    "navbar_align": "left",
+    "footer_start": ["copyright"],
+    "footer_end": [],
+}
+html_show_sourcelink = False
+nitpicky = False
+suppress_warnings = ["myst.header"]
+
+# -- the API reference: one page per layer, a section per module (as ARCHITECTURE.md) ------
+LAYERS = [
+    ("core", "Core: the building blocks on arrays",
+     "One concept a module; the compiled passes of ``X.py`` in ``X_jit.py`` beside it."),
+    ("codecs", "Codecs: one module (or package) per method",
+     "The registry, the interface every method implements and the methods."),
+    ("io", "I/O: captures in, results out", "Reading captures and specs, writing results "
+     "atomically, previews."),
+    ("geometry", "Geometry: calibration and 3-D", "Calibrations, boards, triangulation, "
+     "height, two cameras."),
+    ("sim", "The virtual rig", "Pinhole devices, scenes, ray tracing and exposure."),
+    ("evaluation", "Evaluation", "Scores against the truth, the method comparison, reports."),
+    ("acquire", "Acquisition", "Displays, cameras and the scan loop of ``bistair scan``."),
+    ("app", "Jobs and the command line", "The jobs the commands run; the only layer that "
+     "prints."),
+]
+
+
+def _modules(package: str) -> list[str]:
+    base = ROOT / "src" / "bistair" / package
+    names = []
+    for path in sorted(base.rglob("*.py")):
+        parts = path.relative_to(base).with_suffix("").parts
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        if any(p.startswith("_") and p != "__init__" for p in parts) or parts[-1:] == ("cli",):
+            continue
+        names.append(".".join(("bistair", package, *parts)))
+    return names
+
+
+def _write_api() -> None:
+    out = Path(__file__).parent / "api"
+    out.mkdir(exist_ok=True)
+    pages = []
+    for package, title, text in LAYERS:
+        lines = [title, "=" * len(title), "", text, ""]
+        for module in _modules(package):
+            lines += [f"``{module}``", "-" * (len(module) + 4), "",
+                      f".. automodule:: {module}", "   :members:", "   :no-index:"
+                      if False else "", ""]
+        page = out / f"{package}.rst"
+        content = "\n".join(lines).rstrip() + "\n"
+        if not page.exists() or page.read_text() != content:
+            page.write_text(content)
+        pages.append(package)
+    index = ["API reference", "=============", "",
+             "The public functions and classes of every layer, from their docstrings, grouped "
+             "as ``ARCHITECTURE.md`` groups them (imports point down this list).", "",
+             ".. toctree::", "   :maxdepth: 1", "", *(f"   {p}" for p in pages), ""]
+    content = "\n".join(index)
+    page = out / "index.rst"
+    if not page.exists() or page.read_text() != content:
+        page.write_text(content)
+
+
+_write_api()
+
+
+# -- every spec field of every method, from the spec classes (docs/guide/spec-fields.md) ----
+def _write_spec_fields() -> None:
+    import dataclasses
+
+    from bistair.codecs import REGISTRY
+    from bistair.spec import BaseSpec
+
+    base = {f.name for f in dataclasses.fields(BaseSpec)}
+    lines = ["# Every spec field", "",
+             "Written from the spec classes when the documentation is built. A spec read "
+             "from a file must name every field that shapes the patterns (marked *shapes*); "
+             "the others may be left out and take their defaults. Numbers may be written as "
+             "fractions or with `pi` (`\"1920/58\"`, `\"-2*pi/3\"`); `frames` lists the "
+             "captures in order (the method's frame names, and `white`, `black`, `ignore`).",
+             "", "## Every method", "", "| field | default | shapes | meaning |",
+             "| --- | --- | --- | --- |"]
+
+    def row(f: dataclasses.Field) -> str:
+        default = f.default if f.default is not dataclasses.MISSING else ""
+        needed = f.metadata.get("shapes", True) and f.metadata.get("cli", True) is not False
+        shapes = "yes" if needed else ""
+        meaning = f.metadata.get("help", "").replace("|", "\\|")
+        name = "frames" if f.name == "frame_order" else f.name
+        return f"| `{name}` | `{default!r}` | {shapes} | {meaning} |"
+
+    lines += [row(f) for f in dataclasses.fields(BaseSpec)]
+    for name, codec in REGISTRY.items():
+        own = [f for f in dataclasses.fields(codec.spec_class) if f.name not in base]
+        lines += ["", f"## `{name}`", "", codec.summary + ".", "",
+                  "| field | default | shapes | meaning |", "| --- | --- | --- | --- |",
+                  *(row(f) for f in own)]
+    page = Path(__file__).parent / "guide" / "spec-fields.md"
+    page.parent.mkdir(exist_ok=True)
+    content = "\n".join(lines) + "\n"
+    if not page.exists() or page.read_text() != content:
+        page.write_text(content)
+
+
+_write_spec_fields()

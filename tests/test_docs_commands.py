@@ -1,0 +1,124 @@
+"""Every command the README and the user guide show runs as written and prints what they
+show (issue 25): the docs cannot go stale.
+
+In a Markdown file, a fenced block of language ``sh`` is a script: each line that is not a
+comment is a command (``\\`` continues it), and the ``# `` lines right after a command are
+its output, line for line (``...`` in a line stands for any text); a ``python`` block runs
+as one script and must succeed. The blocks of a file run
+in order in one working directory of their own, beside a ``shared`` folder that points at
+``../shared`` (the real captures) and with ``examples/`` of the repository, so the commands
+read as a user types them from a clone. A block right after ``<!-- not run: REASON -->``
+(installing, hardware, a user's own files) is not run; its reason is printed.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shlex
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+SHARED = ROOT.parent / "shared"
+DOCS = [ROOT / "README.md", ROOT / "docs" / "getting-started.md",
+        *sorted((ROOT / "docs" / "guide").glob("*.md"))]
+FENCE = re.compile(r"^```(\w*)\s*$")
+NOT_RUN = re.compile(r"<!--\s*not run:\s*(.*?)\s*-->")
+
+
+def blocks(path: Path) -> list[tuple[int, str | None, list[str]]]:
+    """``(first line, reason not run or None, lines)`` of every ``sh`` block of a file, and
+    of every ``python`` block as one ``python -c`` command."""
+    out, lines = [], path.read_text().splitlines()
+    i = 0
+    while i < len(lines):
+        match = FENCE.match(lines[i])
+        if match is None:
+            i += 1
+            continue
+        end = next(j for j in range(i + 1, len(lines)) if lines[j].startswith("```"))
+        if match.group(1) in ("sh", "python"):
+            before = next((lines[j] for j in range(i - 1, -1, -1) if lines[j].strip()), "")
+            skip = NOT_RUN.search(before)
+            body = lines[i + 1:end]
+            if match.group(1) == "python":  # a script, run as one command
+                body = [f"python -c {shlex.quote(chr(10).join(body))}"]
+            out.append((i + 1, skip.group(1) if skip else None, body))
+        i = end + 1
+    return out
+
+
+def commands(lines: list[str]) -> list[tuple[str, list[str]]]:
+    """``(command, expected output lines)`` of a block: the ``# `` lines right after a
+    command (no blank line between) are its output; other comment lines are comments."""
+    out: list[tuple[str, list[str]]] = []
+    pending, collecting = "", False
+    for line in lines:
+        if pending:
+            pending += " " + line.strip()
+        elif line.startswith("#"):
+            if collecting:
+                out[-1][1].append(line[2:])
+            continue
+        elif line.strip():
+            pending = line.strip()
+        else:
+            collecting = False
+            continue
+        if pending.endswith("\\"):
+            pending = pending[:-1].rstrip()
+            continue
+        out.append((pending.split("  #")[0].rstrip(), []))  # a comment after the command
+        pending, collecting = "", True
+    return out
+
+
+def matches(expected: str, got: str) -> bool:
+    pattern = ".*".join(re.escape(part) for part in expected.split("..."))
+    return re.fullmatch(pattern, got) is not None
+
+
+CASES = [pytest.param(path, id=path.relative_to(ROOT).as_posix())
+         for path in DOCS if path.exists() and any(b[1] is None for b in blocks(path))]
+
+
+@pytest.mark.parametrize("path", CASES)
+def test_commands_print_what_the_docs_show(path, tmp_path):
+    work = tmp_path / "clone"
+    work.mkdir()
+    (work / "examples").symlink_to(ROOT / "examples")
+    if SHARED.is_dir():
+        (tmp_path / "shared").symlink_to(SHARED)
+    env = {**os.environ, "BISTAIR_PROGRESS_DELAY": "3600", "COLUMNS": "100",
+           "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    for start, skip, lines in blocks(path):
+        if skip is not None:
+            print(f"{path.name}:{start}: not run ({skip})")
+            continue
+        for command, expected in commands(lines):
+            if "../shared" in command and not SHARED.is_dir():
+                pytest.skip("../shared is not here")
+            proc = subprocess.run(["bash", "-c", command], cwd=work, env=env, text=True,
+                                  capture_output=True, timeout=600)
+            where = f"{path.name}:{start}: {command}"
+            assert proc.returncode == 0, f"{where}\n{proc.stdout}{proc.stderr}"
+            printed = [line for line in (proc.stdout + proc.stderr).splitlines()
+                       if line.strip()]
+            if expected:
+                assert len(printed) == len(expected) and all(
+                    matches(e, g) for e, g in zip(expected, printed, strict=True)), \
+                    f"{where}\nshown:\n" + "\n".join(expected) + "\nprinted:\n" + \
+                    "\n".join(printed)
+
+
+def test_the_parser_reads_commands_outputs_and_continuations():
+    lines = ["bistair a \\", "    --b 1   # a comment", "# out 1", "# out 2", "",
+             "# a comment line", "bistair c"]
+    assert commands(lines) == [("bistair a --b 1", ["out 1", "out 2"]), ("bistair c", [])]
+    assert matches("wrote 7 ... to pats", "wrote 7 bidirectional patterns to pats")
+    assert not matches("wrote 7", "wrote 8")
+    assert shlex.split("a 'b c'") == ["a", "b c"]
