@@ -84,11 +84,15 @@ def test_height_png_has_a_colour_bar_in_mm(tmp_path, monkeypatch, capsys):
         (tmp_path / name).mkdir()
         np.save(tmp_path / name / "stack.npy", images)
         (tmp_path / name / "spec.json").write_text(spec.to_json())
+    monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "0")
     code, _, err = cli_run(monkeypatch, capsys, "height", tmp_path / "obj" / "stack.npy",
                            "--reference", tmp_path / "ref" / "stack.npy", "--spec",
                            tmp_path / "ref" / "spec.json", "--geometry", "600,200,0.1",
                            "--out", tmp_path / "h")
     assert code == 0, err
+    assert [line.split(" (")[0] for line in err.splitlines()] == [
+        "bistair: reading the captures", f"bistair: decoding {tmp_path / 'ref' / 'stack.npy'}",
+        "bistair: decoding 8 frames of 120x48", "bistair: writing height.npy and height.png"]
     heights = np.load(tmp_path / "h" / "height.npy")
     png = iio.imread(tmp_path / "h" / "height.png")
     assert png.shape[0] == max(48, 60) and png.shape[1] > 120

@@ -580,14 +580,18 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 @click.option("--geometry", default=None, metavar="DISTANCE,BASELINE,FREQUENCY",
               help="mm, mm and fringes per mm on the reference, for the classical formula "
               "instead of planes")
+@_quiet
 @reports_errors
 def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
-           planes: tuple[str, ...], geometry: str | None) -> None:
+           planes: tuple[str, ...], geometry: str | None, quiet: bool) -> None:
     """Height above a reference plane without a calibration (phase-to-height)."""
     from .jobs import height_folder
+    from .progress import Progress
 
-    h = height_folder(captures, reference, out, spec_path, planes, geometry)
-    click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
+    with Progress(quiet) as say:
+        h = height_folder(captures, reference, out, spec_path, planes, geometry, progress=say)
+    if not quiet:
+        click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
 @cli.command()

@@ -155,15 +155,19 @@ def require_valid(result: DecodeResult | AxesResult) -> DecodeResult | AxesResul
 
 def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
                   spec: BaseSpec | str | Path | None = None, planes: tuple[str, ...] = (),
-                  geometry: str | None = None) -> np.ndarray:
+                  geometry: str | None = None, progress: Say | None = None) -> np.ndarray:
     """Height above a reference plane (mm) from the captures of the object, of the plane and
     either of planes at known heights (``"FOLDER:HEIGHT"``, two or more) or of the geometry
-    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``."""
+    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``.
+    ``progress`` is called with each stage's name as it starts."""
+    say = progress or _silent
+    say("reading the captures")
     stack, spec = read_with_spec(captures, spec)
     if bool(planes) == bool(geometry):
         raise BistairError("give either two or more --plane FOLDER:HEIGHT or --geometry")
 
     def coord(folder: str | Path) -> np.ndarray:
+        say(f"decoding {folder}")
         return decode(read_captures(folder), spec).coord.astype(np.float64)
 
     ref = coord(reference)
@@ -183,11 +187,13 @@ def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
             except ValueError:
                 raise BistairError(f"--plane must be FOLDER:HEIGHT, got {item!r}") from None
         model = HeightModel.fit(ref, [p for p, _ in pairs], [h for _, h in pairs])
+    say(_decoding(stack, spec))
     obj = decode(stack, spec).coord.astype(np.float64)
     if obj.shape != ref.shape:
         raise BistairError(f"captures are {obj.shape[1]}x{obj.shape[0]}, the reference "
                            f"{ref.shape[1]}x{ref.shape[0]}")
     heights = model.height(obj).astype(np.float32)
+    say("writing height.npy and height.png")
     with output_folder(out) as tmp:
         np.save(tmp / "height.npy", heights)
         write_image(tmp / "height.png", colorize(heights, "viridis", unit="mm"))
