@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from ..core.phase import TWO_PI  # noqa: E402
@@ -119,8 +119,9 @@ def draw_method(row: Row, truth: Any) -> Figure:
 def sweep_figure(curves: dict[str, Sequence[tuple[float, float | None]]], xlabel: str,
                  ylabel: str) -> Figure:
     """One line per method of a score (a share, drawn in %) against a factor; a decode that
-    refused the captures (a ``None`` score) is drawn as refused: a cross at the top of the
-    plot in the method's colour, the line broken there, never as a score of 0.
+    refused the captures (a ``None`` score) is drawn as refused: a cross in the method's
+    colour in a hatched "refused" band above the scores, the line broken there, never as a
+    score of 0.
 
     Parameters
     ----------
@@ -139,32 +140,43 @@ def sweep_figure(curves: dict[str, Sequence[tuple[float, float | None]]], xlabel
     >>> ax = fig.axes[0]
     >>> ax.lines[0].get_ydata().tolist()  # the refused point is no score
     [0.0, nan, 1.0]
-    >>> [t.get_text() for t in ax.get_legend().get_texts()]
-    ['a', 'b', 'refused decode']
+    >>> [t.get_text() for t in ax.get_legend().get_texts()], [t.get_text() for t in ax.texts]
+    (['a', 'b', 'refused decode'], ['refused'])
+    >>> ax.collections[0].get_offsets()[:, 0].tolist()  # the cross, where it refused
+    [2.0]
     """
     fig = Figure(figsize=(6.4, 4), layout="constrained")
     ax = fig.subplots()
-    top = ax.get_xaxis_transform()  # x in data, y in axes fraction
-    any_refused = False
+    refused_at: list[tuple[list[float], str]] = []
+    scores = []
     for method, points in curves.items():
         pts = sorted(points, key=lambda p: p[0])
-        xs = [p[0] for p in pts]
         ys = [np.nan if p[1] is None else 100 * p[1] for p in pts]
-        line, = ax.plot(xs, ys, marker="o", label=method)
-        refused = [x for x, y in pts if y is None]
-        if refused:
-            any_refused = True
-            ax.scatter(refused, [0.97] * len(refused), transform=top, marker="X", s=70,
-                       color=line.get_color(), clip_on=False, zorder=3)
+        line, = ax.plot([p[0] for p in pts], ys, marker="o", label=method)
+        scores += [y for y in ys if np.isfinite(y)]
+        if any(p[1] is None for p in pts):
+            refused_at.append(([x for x, y in pts if y is None], line.get_color()))
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     handles, labels = ax.get_legend_handles_labels()
-    if any_refused:
+    if refused_at:  # a band above the scores: no cross can be read as a score
+        low, high = (min(scores), max(scores)) if scores else (0.0, 1.0)
+        span = (high - low) or 1.0
+        ax.set_ylim(low - 0.05 * span, low + span / 0.78)
+        ax.set_yticks([t for t in ax.get_yticks() if low - 0.05 * span <= t <= high])
+        ax.add_patch(Rectangle((0, 0.84), 1, 0.16, transform=ax.transAxes, facecolor="0.94",
+                               edgecolor="0.75", hatch="//", zorder=0))
+        ax.text(0.01, 0.92, "refused", transform=ax.transAxes, va="center", fontsize=8,
+                color="0.35")
+        top = ax.get_xaxis_transform()  # x in data, y in axes fraction
+        for k, (xs, colour) in enumerate(refused_at):
+            ax.scatter(xs, [0.97 - 0.1 * k / max(1, len(refused_at) - 1)] * len(xs),
+                       transform=top, marker="X", s=60, color=colour, zorder=3)
         handles.append(Line2D([], [], color="0.3", marker="X", linestyle="none",
                               markersize=8))
         labels.append("refused decode")
-    ax.legend(handles, labels, fontsize=7)
+    ax.legend(handles, labels, fontsize=7, loc="center right")
     return fig
 
 
