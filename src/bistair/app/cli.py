@@ -75,6 +75,89 @@ def _threads(func: Callable) -> Callable:
                         help="use at most N threads [default: every core]")(func)
 
 
+class _Text(click.ParamType):
+    """A value kept as text for the command to parse, shown in the help by its form
+    (``WxH``, ``NUMBER``: a number, a fraction such as 1920/58 or ``-2*pi/3``, ...)."""
+
+    def __init__(self, metavar: str) -> None:
+        self.name = metavar.lower()
+        self.metavar = metavar
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return self.metavar
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        return value
+
+
+class _Size(_Text):
+    """``WIDTHxHEIGHT`` as ``(width, height)``."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if isinstance(value, tuple):
+            return value
+        try:
+            width, height = (int(v) for v in str(value).lower().split("x"))
+        except ValueError:
+            self.fail("expected WIDTHxHEIGHT, e.g. 1280x1024", param, ctx)
+        return width, height
+
+
+class _Strategy(_Text):
+    """A fringe-order strategy of some method's decoder (each decoder checks its own)."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if value not in {v for values in _strategies().values() for v in values}:
+            self.fail(f"{value!r} is no decoder's strategy ({_strategy_help()})", param, ctx)
+        return value
+
+
+def _strategies() -> dict[str, tuple[str, ...]]:
+    """Each method's strategies, its default first (from the codecs' order stages)."""
+    from ..codecs import REGISTRY
+
+    return {name: codec.choices["strategy"] for name, codec in REGISTRY.items()
+            if "strategy" in codec.choices}
+
+
+def _strategy_help() -> str:
+    from ..codecs import REGISTRY
+
+    listed = "; ".join(f"{name}: {' [default] | '.join(values)}"
+                       for name, values in _strategies().items())
+    alone = [name for name in REGISTRY if name not in _strategies()]
+    return listed + (f" ({' and '.join(alone)}: none)" if alone else "")
+
+
+def _method_help() -> str:
+    from ..codecs import REGISTRY
+
+    return ", ".join(REGISTRY)
+
+
+class _LazyHelp(click.Option):
+    """An option whose help names what the registry holds, made when the help is shown (so
+    that ``bistair --help`` and every command itself do not import the codecs for it)."""
+
+    def __init__(self, *args: Any, help_from: Callable[[], str], **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help_from, self.help_text = help_from, kwargs.get("help") or ""
+
+    def get_help_record(self, ctx: click.Context) -> tuple[str, str] | None:
+        self.help = self.help_text.format(self.help_from())
+        return super().get_help_record(ctx)
+
+
+def _strategy(func: Callable) -> Callable:
+    """``--strategy``: a fringe-order strategy, listed per method in the help."""
+    return click.option("--strategy", type=_Strategy("STRATEGY"), default=None, cls=_LazyHelp,
+                        help_from=_strategy_help,
+                        help="fringe-order strategy of the method's decoder: {}")(func)
+
+
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="bistair", prog_name="bistair")
 def cli() -> None:
@@ -115,7 +198,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
         default = f.default
         shown = ",".join(_show(v) for v in default) if kind is tuple else _show(default)
         opt: dict[str, Any] = {"help": f.metadata.get("help", ""), "show_default": True,
-                               "default": shown, "type": str}
+                               "default": shown, "type": _Text(_SPEC_TYPES[kind])}
         if "choices" in f.metadata:
             opt["type"] = click.Choice([_show(c) for c in f.metadata["choices"]])
             if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
@@ -146,6 +229,10 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
     return click.Command(name, params=params, callback=callback, help=summary)
 
 
+# how a spec field's value is shown in the help (numbers may be fractions or hold pi)
+_SPEC_TYPES = {int: "INTEGER", float: "NUMBER", str: "TEXT", tuple: "NUMBER,..."}
+
+
 def _show(value: Any) -> str:
     """A default as the command line shows it: 30 rather than 30.0."""
     return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
@@ -158,7 +245,8 @@ def _show(value: Any) -> str:
               help="projector height in pixels")
 @click.option("--levels", type=int, default=17, show_default=True,
               help="grey levels from black to white")
-@click.option("--bits", type=click.Choice(["8", "16"]), default="8", show_default=True)
+@click.option("--bits", type=click.Choice(["8", "16"]), default="8", show_default=True,
+              help="bit depth of the frames")
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="output folder")
 @reports_errors
@@ -190,9 +278,10 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
 @click.argument("captures", nargs=-1, required=True)
 @click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
               help="spec.json of the pattern set [default: spec.json in the captures' folder]")
-@click.option("--out", "-o", required=True, help="output folder")
-@click.option("--strategy", default=None, help="fringe-order strategy (bidirectional: "
-              "region [default] or paper)")
+@click.option("--out", "-o", required=True, type=click.Path(),
+              help="output folder: phase.npy, coord.npy, order.npy, ..., the PNG previews "
+              "and info.json")
+@_strategy
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
@@ -237,21 +326,12 @@ def _warn(result: Any) -> None:
             click.echo(f"Warning: {message}", err=True)
 
 
-def _size(ctx: click.Context, param: click.Parameter, value: str | None) -> Any:
-    if value is None:
-        return None
-    try:
-        width, height = (int(v) for v in value.lower().split("x"))
-    except ValueError:
-        raise click.BadParameter("expected WIDTHxHEIGHT, e.g. 1280x1024") from None
-    return width, height
-
-
 @cli.command()
 @click.option("--out", "-o", type=click.Path(path_type=Path), default=Path("demo-out"),
               show_default=True, help="output folder")
-@click.option("--seed", type=int, default=0, show_default=True)
-@click.option("--camera", callback=_size, default="1280x1024", show_default=True,
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="seed of the rendered noise")
+@click.option("--camera", type=_Size("WxH"), default="1280x1024", show_default=True,
               help="camera size WIDTHxHEIGHT")
 @reports_errors
 def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
@@ -262,13 +342,18 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 
 
 @cli.command()
-@click.option("--scene", default=None, help="preset scene (paper-sim, two-masks, mask-prism, "
-              "two-sculptures, plane, sphere-on-plane, objects-on-plane, mugs-on-wall) or "
-              "calibration (board captures)")
-@click.option("--method", "methods", required=True, multiple=True,
-              help="method to render (repeatable), or all")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
-@click.option("--camera", callback=_size, default=None, help="camera size WIDTHxHEIGHT "
+@click.option("--scene", default=None, metavar="SCENE", help="preset scene (paper-sim, "
+              "two-masks, mask-prism, two-sculptures, plane, sphere-on-plane, "
+              "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
+              "checkerboard in eight poses)")
+@click.option("--method", "methods", required=True, multiple=True, metavar="METHOD",
+              cls=_LazyHelp, help_from=_method_help,
+              help="method to render (repeatable): {} or all")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
+              "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
+              "(OUT/<method>/ each for several methods)")
+@click.option("--camera", type=_Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
               "[default: 1280x1024]")
 @click.option("--noise", type=float, default=0.01, show_default=True,
               help="read noise, fraction of full scale")
@@ -277,10 +362,12 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 @click.option("--gamma", type=float, default=2.2, show_default=True, help="projector gamma")
 @click.option("--compensated/--uncompensated", default=True, show_default=True,
               help="patterns pre-compensate the projector gamma")
-@click.option("--ambient", type=float, default=0.05, show_default=True)
+@click.option("--ambient", type=float, default=0.05, show_default=True,
+              help="ambient light on the scene, fraction of the projector's full white")
 @click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
               show_default=True, help="camera bit depth")
-@click.option("--seed", type=int, default=0, show_default=True)
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="seed of the noise (with --count, of the whole data set)")
 @click.option("--count", type=int, default=None,
               help="a data set: COUNT scenes in OUT/scene-NNNN/ and OUT/index.csv, rendered "
               "in parallel")
@@ -338,8 +425,10 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
         if quiet:
             return
         if scene == "calibration":
-            click.echo(f"wrote {chosen[0]} board captures (8 poses, both orientations) to "
-                       f"{out}")
+            where = str(out) if len(chosen) == 1 else f"{out}/<method>/"
+            click.echo(f"wrote {', '.join(chosen)} board captures (8 poses, "
+                       f"{'both axes at once' if both_axes else 'both orientations'}) to "
+                       f"{where}")
         else:
             click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
                        f"to {out}")
@@ -480,12 +569,14 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
               help="spec.json of the pattern set [default: CAPTURES/spec.json]")
-@click.option("--calibration", required=True, type=click.Path(path_type=Path))
+@click.option("--calibration", required=True, type=click.Path(path_type=Path),
+              help="calibration file (JSON) from 'bistair calibrate' or 'bistair "
+              "import-calibration'")
 @click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
               help="point cloud to write (.ply)")
 @click.option("--depth", type=click.Path(path_type=Path), default=None,
               help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
-@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@_strategy
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="keep points with depth z in [MIN, MAX] mm (camera frame)")
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
@@ -533,20 +624,28 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 @click.argument("captures", type=click.Path(path_type=Path))
 @click.option("--reference", required=True, type=click.Path(path_type=Path),
               help="captures of the flat reference plane (same spec)")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None)
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path))
-@click.option("--plane", "planes", multiple=True, help="FOLDER:HEIGHT_MM of a plane parallel "
-              "to the reference (two or more calibrate the height per pixel)")
-@click.option("--geometry", default=None, help="DISTANCE,BASELINE,FREQUENCY (mm, mm, fringes "
-              "per mm on the reference) for the classical formula instead of planes")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set [default: CAPTURES/spec.json]")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder: height.npy (mm, NaN where invalid) and height.png")
+@click.option("--plane", "planes", multiple=True, metavar="FOLDER:HEIGHT_MM",
+              help="captures of a plane parallel to the reference and its height in mm "
+              "(repeatable; two or more calibrate the height per pixel)")
+@click.option("--geometry", default=None, metavar="DISTANCE,BASELINE,FREQUENCY",
+              help="mm, mm and fringes per mm on the reference, for the classical formula "
+              "instead of planes")
+@_quiet
 @reports_errors
 def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
-           planes: tuple[str, ...], geometry: str | None) -> None:
+           planes: tuple[str, ...], geometry: str | None, quiet: bool) -> None:
     """Height above a reference plane without a calibration (phase-to-height)."""
     from .jobs import height_folder
+    from .progress import Progress
 
-    h = height_folder(captures, reference, out, spec_path, planes, geometry)
-    click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
+    with Progress(quiet) as say:
+        h = height_folder(captures, reference, out, spec_path, planes, geometry, progress=say)
+    if not quiet:
+        click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
 @cli.command()
@@ -563,7 +662,7 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
               help="run on an existing Dask cluster instead (its workers must see the same "
               "paths)")
 @click.option("--resume", is_flag=True, help="skip sets whose outputs are complete")
-@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
+@_strategy
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
