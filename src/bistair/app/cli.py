@@ -8,10 +8,8 @@ not pay for the imaging and geometry libraries.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import signal
 import sys
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -19,143 +17,23 @@ import click
 import numpy as np
 
 from ..core.memory import keep_freed_memory
-from ..errors import BistairError
 from ..spec import BaseSpec, coerce_field, field_kind
-
-
-class CliError(click.ClickException):
-    exit_code = 2
-
-
-def reports_errors(func: Callable) -> Callable:
-    """Turn :class:`BistairError` into a one-line message and exit code 2."""
-
-    @functools.wraps(func)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return func(*args, **kwargs)
-        except BistairError as exc:
-            raise CliError(str(exc)) from None
-        except MemoryError:
-            raise CliError("not enough memory for these captures") from None
-
-    return wrapper
-
-
-def _quiet(func: Callable) -> Callable:
-    """``--quiet``: no progress and no summary; errors and warnings are still printed."""
-    return click.option("--quiet", "-q", is_flag=True,
-                        help="print only errors and warnings (no progress, no summary)")(func)
-
-
-def _force(func: Callable) -> Callable:
-    """``--force``: decode where a thresholded check would refuse."""
-    return click.option("--force", is_flag=True,
-                        help="decode where a thresholded check would refuse the captures: its "
-                        "reasons are printed as warnings and kept in info.json ('forced'); "
-                        "hard errors (frame count, unreadable files, no valid pixel) stay "
-                        "errors")(func)
-
-
-def _threads(func: Callable) -> Callable:
-    """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
-
-    def limit(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
-        if value is not None:
-            import cv2
-
-            from ..core.jit import set_threads
-
-            set_threads(value)
-            cv2.setNumThreads(value)
-        return value
-
-    return click.option("--threads", type=click.IntRange(min=1), default=None,
-                        expose_value=False, callback=limit,
-                        help="use at most N threads [default: every core]")(func)
-
-
-class _Text(click.ParamType):
-    """A value kept as text for the command to parse, shown in the help by its form
-    (``WxH``, ``NUMBER``: a number, a fraction such as 1920/58 or ``-2*pi/3``, ...)."""
-
-    def __init__(self, metavar: str) -> None:
-        self.name = metavar.lower()
-        self.metavar = metavar
-
-    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
-        return self.metavar
-
-    def convert(self, value: Any, param: click.Parameter | None,
-                ctx: click.Context | None) -> Any:
-        return value
-
-
-class _Size(_Text):
-    """``WIDTHxHEIGHT`` as ``(width, height)``."""
-
-    def convert(self, value: Any, param: click.Parameter | None,
-                ctx: click.Context | None) -> Any:
-        if isinstance(value, tuple):
-            return value
-        try:
-            width, height = (int(v) for v in str(value).lower().split("x"))
-        except ValueError:
-            self.fail("expected WIDTHxHEIGHT, e.g. 1280x1024", param, ctx)
-        return width, height
-
-
-class _Strategy(_Text):
-    """A fringe-order strategy of some method's decoder (each decoder checks its own)."""
-
-    def convert(self, value: Any, param: click.Parameter | None,
-                ctx: click.Context | None) -> Any:
-        if value not in {v for values in _strategies().values() for v in values}:
-            self.fail(f"{value!r} is no decoder's strategy ({_strategy_help()})", param, ctx)
-        return value
-
-
-def _strategies() -> dict[str, tuple[str, ...]]:
-    """Each method's strategies, its default first (from the codecs' order stages)."""
-    from ..codecs import REGISTRY
-
-    return {name: codec.choices["strategy"] for name, codec in REGISTRY.items()
-            if "strategy" in codec.choices}
-
-
-def _strategy_help() -> str:
-    from ..codecs import REGISTRY
-
-    listed = "; ".join(f"{name}: {' [default] | '.join(values)}"
-                       for name, values in _strategies().items())
-    alone = [name for name in REGISTRY if name not in _strategies()]
-    return listed + (f" ({' and '.join(alone)}: none)" if alone else "")
-
-
-def _method_help() -> str:
-    from ..codecs import REGISTRY
-
-    return ", ".join(REGISTRY)
-
-
-class _LazyHelp(click.Option):
-    """An option whose help names what the registry holds, made when the help is shown (so
-    that ``bistair --help`` and every command itself do not import the codecs for it)."""
-
-    def __init__(self, *args: Any, help_from: Callable[[], str], **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self.help_from, self.help_text = help_from, kwargs.get("help") or ""
-
-    def get_help_record(self, ctx: click.Context) -> tuple[str, str] | None:
-        self.help = self.help_text.format(self.help_from())
-        return super().get_help_record(ctx)
-
-
-def _strategy(func: Callable) -> Callable:
-    """``--strategy``: a fringe-order strategy, listed per method in the help."""
-    return click.option("--strategy", type=_Strategy("STRATEGY"), default=None, cls=_LazyHelp,
-                        help_from=_strategy_help,
-                        help="fringe-order strategy of the method's decoder: {}")(func)
+from .cli_batch import batch
+from .cli_options import (
+    CliError,
+    _force,
+    _quiet,
+    _show,
+    _Size,
+    _strategy,
+    _Text,
+    _threads,
+    _warn,
+    reports_errors,
+)
+from .cli_scan import scan
+from .cli_simulate import simulate
+from .cli_stereo import calibrate_stereo, stereo
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -231,11 +109,6 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
 
 # how a spec field's value is shown in the help (numbers may be fractions or hold pi)
 _SPEC_TYPES = {int: "INTEGER", float: "NUMBER", str: "TEXT", tuple: "NUMBER,..."}
-
-
-def _show(value: Any) -> str:
-    """A default as the command line shows it: 30 rather than 30.0."""
-    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
 
 
 @patterns.command("gamma")
@@ -318,14 +191,6 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
                    f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}")
 
 
-def _warn(result: Any) -> None:
-    """Print a decode's warnings on stderr, one line each."""
-    infos = [result.info] if not hasattr(result, "x") else [result.x.info, result.y.info]
-    for info in infos:
-        for message in info.get("warnings", []):
-            click.echo(f"Warning: {message}", err=True)
-
-
 @cli.command()
 @click.option("--out", "-o", type=click.Path(path_type=Path), default=Path("demo-out"),
               show_default=True, help="output folder")
@@ -339,145 +204,6 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
     from .demo import run_demo
 
     run_demo(out, seed=seed, camera_size=camera)
-
-
-@cli.command()
-@click.option("--scene", default=None, metavar="SCENE", help="preset scene (paper-sim, "
-              "two-masks, mask-prism, two-sculptures, plane, sphere-on-plane, "
-              "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
-              "checkerboard in eight poses)")
-@click.option("--method", "methods", required=True, multiple=True, metavar="METHOD",
-              cls=_LazyHelp, help_from=_method_help,
-              help="method to render (repeatable): {} or all")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
-              "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
-              "(OUT/<method>/ each for several methods)")
-@click.option("--camera", type=_Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
-              "[default: 1280x1024]")
-@click.option("--noise", type=float, default=0.01, show_default=True,
-              help="read noise, fraction of full scale")
-@click.option("--blur", type=float, default=1.0, show_default=True,
-              help="camera defocus, Gaussian sigma in pixels")
-@click.option("--gamma", type=float, default=2.2, show_default=True, help="projector gamma")
-@click.option("--compensated/--uncompensated", default=True, show_default=True,
-              help="patterns pre-compensate the projector gamma")
-@click.option("--ambient", type=float, default=0.05, show_default=True,
-              help="ambient light on the scene, fraction of the projector's full white")
-@click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
-              show_default=True, help="camera bit depth")
-@click.option("--seed", type=int, default=0, show_default=True,
-              help="seed of the noise (with --count, of the whole data set)")
-@click.option("--count", type=int, default=None,
-              help="a data set: COUNT scenes in OUT/scene-NNNN/ and OUT/index.csv, rendered "
-              "in parallel")
-@click.option("--vary", default=None, metavar="optics,objects,pose",
-              help="with --count: what each scene draws at random (see README)")
-@click.option("--workers", type=int, default=None,
-              help="with --count: processes of the local cluster [default: the cores]")
-@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
-              help="with --count: run on an existing Dask cluster instead")
-@click.option("--no-white", is_flag=True,
-              help="--scene calibration: no white frame (the board is found in the mean image)")
-@click.option("--both-axes", is_flag=True,
-              help="--scene calibration: one capture set of both axes per pose")
-@click.option("--cameras", type=click.IntRange(1, 2), default=1, show_default=True,
-              help="2: a second camera (OUT/<method>/L and R, stereo.json, truth/L and R)")
-@click.option("--baseline", type=float, default=200.0, show_default=True,
-              help="with --cameras 2: mm between the cameras (the projector between them)")
-@_quiet
-@reports_errors
-def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
-             camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
-             compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
-             vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
-             both_axes: bool, cameras: int, baseline: float, quiet: bool) -> None:
-    """Render a preset scene on the virtual rig: one capture folder per method + the truth.
-
-    With --count N, a data set of N scenes (deterministic for a --seed whatever the number
-    of workers), each varied as --vary says. With --cameras 2, two cameras and the
-    projector between them, for 'bistair stereo'."""
-    from ..codecs import REGISTRY
-
-    chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
-    imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
-                   bits=int(bits))
-    if cameras == 2:
-        if no_white or both_axes:
-            raise CliError("--no-white and --both-axes are for one camera's --scene "
-                           "calibration")
-        _simulate_stereo(scene, chosen, out, camera, compensated, seed, count, baseline,
-                         quiet, imaging)
-        return
-    if count is None:
-        for name, value in (("--vary", vary), ("--workers", workers),
-                            ("--scheduler", scheduler)):
-            if value is not None:
-                raise CliError(f"{name} applies to a data set: give --count too")
-        if scene is None:
-            raise CliError("name a --scene (or give --count with --vary objects)")
-        from .progress import Progress
-        from .simulate import simulate as run
-
-        with Progress(quiet) as say:
-            run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-                progress=say, white=not no_white, both_axes=both_axes, **imaging)
-        if quiet:
-            return
-        if scene == "calibration":
-            where = str(out) if len(chosen) == 1 else f"{out}/<method>/"
-            click.echo(f"wrote {', '.join(chosen)} board captures (8 poses, "
-                       f"{'both axes at once' if both_axes else 'both orientations'}) to "
-                       f"{where}")
-        else:
-            click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
-                       f"to {out}")
-        return
-    if no_white or both_axes:
-        raise CliError("--no-white and --both-axes are for --scene calibration")
-    from .simulate import simulate_many
-
-    try:
-        report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
-                               camera_size=camera, compensated=compensated, workers=workers,
-                               scheduler=scheduler,
-                               show_progress=sys.stderr.isatty() and not quiet, **imaging)
-    except KeyboardInterrupt:
-        click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
-                   "written", err=True)
-        raise click.exceptions.Abort() from None
-    for name, error in report.failed:
-        click.echo(f"failed {name}: {error}", err=quiet)
-    if not quiet:
-        click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
-                   f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
-                   f"{report.workers} worker{'s' if report.workers != 1 else ''}")
-    if report.failed:
-        raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
-
-
-def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
-                     camera: tuple[int, int] | None, compensated: bool, seed: int,
-                     count: int | None, baseline: float, quiet: bool,
-                     imaging: dict[str, Any]) -> None:
-    """``bistair simulate --cameras 2``."""
-    from .progress import Progress
-    from .stereo import simulate_stereo
-
-    if count is not None:
-        raise CliError("--cameras 2 renders one scene: leave out --count")
-    if scene is None:
-        raise CliError("name a --scene")
-    with Progress(quiet) as say:
-        simulate_stereo(scene, methods, out, camera_size=camera, baseline=baseline,
-                        compensated=compensated, progress=say, seed=seed, **imaging)
-    if quiet:
-        return
-    if scene == "calibration":
-        click.echo(f"wrote board pairs (8 poses, left and right) to {out}")
-    else:
-        click.echo(f"wrote {', '.join(methods)} captures of {scene} from two cameras "
-                   f"{baseline:g} mm apart (L/, R/), stereo.json and the truth to {out}")
 
 
 @cli.command()
@@ -648,263 +374,8 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
         click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
-@cli.command()
-@click.argument("root", type=click.Path(path_type=Path))
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder: OUT/<set name>/ per set and OUT/batch.csv")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
-              help="spec.json of every set [default: spec.json in each set's folder]")
-@click.option("--calibration", type=click.Path(path_type=Path), default=None,
-              help="calibration file: also reconstruct every set (cloud.ply, depth.npy)")
-@click.option("--workers", type=int, default=None,
-              help="processes of the local cluster [default: the cores]")
-@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
-              help="run on an existing Dask cluster instead (its workers must see the same "
-              "paths)")
-@click.option("--resume", is_flag=True, help="skip sets whose outputs are complete")
-@_strategy
-@click.option("--min-modulation", type=float, default=None,
-              help="modulation threshold as a fraction of full scale, between 0 and 1 "
-              "[default: from noise]")
-@click.option("--no-previews", is_flag=True, help="skip the PNG previews")
-@click.option("--depth-range", default=None, metavar="MIN:MAX",
-              help="with --calibration: keep points with depth z in [MIN, MAX] mm")
-@click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
-              metavar="PX", help="with --calibration and specs of both axes: see "
-              "'bistair reconstruct --help'")
-@_force
-@_quiet
-@reports_errors
-def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
-          workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
-          min_modulation: float | None, no_previews: bool, depth_range: str | None,
-          epipolar_tolerance: float, force: bool, quiet: bool) -> None:
-    """Decode (with --calibration also reconstruct) many capture sets on Dask.
-
-    ROOT: a folder whose sub-folders are the capture sets, or a CSV manifest with the
-    columns captures, spec, calibration, out (paths relative to the manifest; empty cells
-    take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
-    into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
-    """
-    from .batch import run_batch
-    from .jobs import parse_depth_range
-
-    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
-                                 ("force", force or None)) if v is not None}
-    try:
-        report = run_batch(root, out, spec_path, calibration, workers=workers,
-                           scheduler=scheduler, resume=resume, previews=not no_previews,
-                           min_depth=low, max_depth=high,
-                           epipolar_tolerance=epipolar_tolerance,
-                           show_progress=sys.stderr.isatty() and not quiet, **options)
-    except KeyboardInterrupt:
-        click.echo(f"Interrupted: the finished sets are in {out} (listed in batch.csv); "
-                   "run again with --resume to go on", err=True)
-        raise click.exceptions.Abort() from None
-    for row in report.failed:
-        click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
-    if not quiet:
-        click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
-
-
-@cli.command("stereo")
-@click.argument("left")
-@click.argument("right")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
-              help="spec.json of the pattern set, for both cameras [default: spec.json beside "
-              "LEFT]")
-@click.option("--calibration", required=True, type=click.Path(path_type=Path),
-              help="the two cameras' calibration (bistair calibrate-stereo, or "
-              "import-calibration --stereo)")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder")
-@click.option("--depth-range", default=None, metavar="MIN:MAX",
-              help="keep points with depth z in [MIN, MAX] mm (left camera frame); also "
-              "narrows the search")
-@click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
-              "matches; the decoder's checks where it offers this), as warnings in info.json")
-@click.option("--strategy", default=None, help="fringe-order strategy of the decoder")
-@click.option("--min-modulation", type=float, default=None,
-              help="modulation threshold as a fraction of full scale [default: from noise]")
-@click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
-              help="Gaussian sigma of a smoothing of the projector coordinates before "
-              "matching (never across surfaces): less depth noise, less lateral detail; 0: none")
-@click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
-@_threads
-@_quiet
-@reports_errors
-def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
-           depth_range: str | None, force: bool, strategy: str | None,
-           min_modulation: float | None, smooth: float, no_previews: bool,
-           quiet: bool) -> None:
-    """Two cameras and a projector: decode both cameras' captures of one pattern set, match
-    equal absolute phase along rectified rows, triangulate.
-
-    LEFT, RIGHT: each camera's captures, a folder, a quoted glob pattern or a .npy stack.
-    Writes OUT/left/ and OUT/right/ (each decode), disparity.npy, depth.npy, depth.png,
-    cloud.ply (left camera frame, mm) and info.json. The projector needs no calibration."""
-    from .jobs import parse_depth_range
-    from .progress import Progress
-    from .stereo import stereo_folder, warnings
-
-    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
-               if v is not None}
-    with Progress(quiet) as say:
-        res = stereo_folder(left, right, out, calibration, spec_path, min_depth=low,
-                            max_depth=high, force=force, smooth=smooth,
-                            previews=not no_previews, progress=say, **options)
-    for message in warnings(res):
-        click.echo(f"Warning: {message}", err=True)
-    if quiet:
-        return
-    info = res.info
-    rejected = info["inconsistent"] + info["ambiguous"] + info["not_monotonic"] + \
-        info["other_axis"] + info["alone"]
-    within = f" at {low:g}-{high:g} mm" if depth_range else ""
-    click.echo(f"{info['matched']} points from {info['left_decoded']} decoded left pixels "
-               f"({100 * info['matched_fraction']:.1f}%; {info['unmatched']} without a match "
-               f"in the right camera{within}, {rejected} rejected by the checks); wrote {out}")
-
-
-@cli.command("calibrate-stereo")
-@click.argument("poses", type=click.Path(path_type=Path))
-@click.option("--board", default=None, metavar="chessboard:COLSxROWS:SQUARE",
-              help="the board: inner corners and square size (mm), or a board.json "
-              "[default: POSES/board.json]")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="stereo calibration file to write (JSON)")
-@click.option("--min-poses", type=int, default=3, show_default=True,
-              help="fewest poses with the board found in both images (3 or more)")
-@_quiet
-@reports_errors
-def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
-                     quiet: bool) -> None:
-    """Calibrate two cameras from image pairs of a board.
-
-    POSES: one folder per pose holding a left and a right image (named left/right, else in
-    name order), or left/ and right/ folders whose images pair up in name order. Poses
-    where the board is not found in both images are skipped."""
-    from .progress import Progress
-    from .stereo import calibrate_stereo_folder
-
-    with Progress(quiet) as say:
-        cal, skipped = calibrate_stereo_folder(poses, out, board, min_poses, progress=say)
-    for name in skipped:
-        click.echo(f"Warning: pose {name} skipped: the board is not found in both images",
-                   err=True)
-    if quiet:
-        return
-    click.echo(f"stereo RMS {cal.rms:.3f} px (left {cal.left.rms:.3f} px, right "
-               f"{cal.right.rms:.3f} px), baseline {cal.baseline:.2f} +/- "
-               f"{cal.uncertainty.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} "
-               f"poses; wrote {out}")
-    for name, dev, sd in (("left", cal.left, cal.uncertainty.camera),
-                          ("right", cal.right, cal.uncertainty.projector)):
-        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
-        click.echo(f"  {name + ':':7s} " + ", ".join(
-            f"{key} {v:.2f} +/- {s:.2f}"
-            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
-    for pose in cal.poses:
-        click.echo(f"  {pose['name']}: {pose['features']} corners, left "
-                   f"{pose['left_rms']:.3f} px, right {pose['right_rms']:.3f} px")
-
-
-@cli.command()
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
-              help="spec.json of the pattern set to project (from 'bistair patterns')")
-@click.option("--display", required=True, metavar="DISPLAY",
-              help="window[:SCREEN] (a full-screen window on the projector's screen, from 0) "
-              "or none (the projector holds the patterns and triggers the camera)")
-@click.option("--camera", required=True, metavar="CAMERA",
-              help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
-              "sim[:SCENE[:WxH]]")
-@click.option("--out", "-o", type=click.Path(path_type=Path), default=None,
-              help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
-@click.option("--settle-ms", type=float, default=None,
-              help="wait after showing each pattern [default: as measured by "
-              "--measure-latency]")
-@click.option("--average", type=int, default=1, show_default=True,
-              help="frames grabbed and averaged per pattern")
-@click.option("--drop", type=int, default=None,
-              help="frames dropped after the wait [default: the camera's buffer]")
-@click.option("--exposure", type=float, default=None,
-              help="camera exposure in its own units (genicam: microseconds)")
-@click.option("--gain", type=float, default=None, help="camera gain in its own units")
-@click.option("--pixel-format", type=click.Choice(["Mono8", "Mono12", "Mono16"]),
-              default=None, help="genicam pixel format")
-@click.option("--decode", "decode_it", is_flag=True,
-              help="also decode the scan into OUT/decode/")
-@click.option("--calibration", type=click.Path(path_type=Path), default=None,
-              help="also reconstruct: OUT/decode/cloud.ply, depth.npy")
-@click.option("--depth-range", default=None, metavar="MIN:MAX",
-              help="with --calibration: keep points with depth z in [MIN, MAX] mm")
-@click.option("--measure-latency", is_flag=True,
-              help="flash black and white, time when the camera sees it and save the settle "
-              "time for this display and camera (no scan)")
-@click.option("--latency-file", type=click.Path(path_type=Path), default=None,
-              help="where measured settle times are kept [default: "
-              "~/.config/bistair/latency.json or $BISTAIR_LATENCY_FILE]")
-@_quiet
-@reports_errors
-def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
-         settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
-         gain: float | None, pixel_format: str | None, decode_it: bool,
-         calibration: Path | None, depth_range: str | None, measure_latency: bool,
-         latency_file: Path | None, quiet: bool) -> None:
-    """Project a pattern set with DISPLAY, grab it with CAMERA, write a capture folder.
-
-    Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
-    grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly."""
-    from .progress import Progress
-
-    settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
-    if measure_latency:
-        from .scan import measure_settle
-
-        with Progress(quiet) as say:
-            latency, path = measure_settle(display, camera, latency_file, progress=say,
-                                           **settings)
-        if not quiet:
-            times = latency.latencies_ms
-            click.echo(f"latency {latency.display} -> {latency.camera}: {min(times):.0f} to "
-                       f"{max(times):.0f} ms over {len(times)} changes (camera levels: black "
-                       f"{100 * latency.black:.1f}%, white {100 * latency.white:.1f}%); settle "
-                       f"{latency.settle_ms:g} ms saved to {path}")
-        return
-    for name, value in (("--spec", spec_path), ("--out", out)):
-        if value is None:
-            raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
-    from .jobs import parse_depth_range
-    from .scan import scan_folder
-
-    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
-    with Progress(quiet) as say:
-        report = scan_folder(spec_path, display, camera, out, decode=decode_it,
-                             calibration=calibration, depth_range=(low, high), progress=say,
-                             settle_ms=settle_ms, average=average, drop=drop,
-                             latency_file=latency_file, **settings)
-    info = report.scan.info
-    for message in info["warnings"]:
-        click.echo(f"Warning: {message}", err=True)
-    if report.decoded is not None:
-        _warn(report.decoded)
-    if quiet:
-        return
-    frames = report.scan.frames
-    click.echo(f"scanned {len(frames)} {report.scan.spec.method} patterns with "
-               f"{info['display']['name']} and {info['camera']['name']} in "
-               f"{info['seconds']:.1f} s (settle {info['settle_ms']:g} ms, "
-               f"{info['settle_source']}; {frames.shape[2]}x{frames.shape[1]} "
-               f"{frames.dtype.itemsize * 8}-bit frames); wrote {out}")
-    result = report.decoded
-    if result is not None:
-        click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
-                   f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}/decode")
-    if report.reconstruction is not None:
-        click.echo(f"{int(report.reconstruction.mask.sum())} points; wrote "
-                   f"{out}/decode/cloud.ply and depth.npy")
+for _command in (simulate, batch, stereo, calibrate_stereo, scan):
+    cli.add_command(_command)
 
 
 def _terminated(signum: int, frame: Any) -> None:
