@@ -22,6 +22,8 @@ from ..core.memory import keep_freed_memory
 from ..errors import BistairError
 from ..spec import BaseSpec, coerce_field, field_kind
 
+BATCH_SETS_FAILED = 3  # bistair batch's exit code when some sets failed (each in batch.csv)
+
 
 class CliError(click.ClickException):
     exit_code = 2
@@ -532,6 +534,7 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     columns captures, spec, calibration, out (paths relative to the manifest; empty cells
     take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
     into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
+    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input.
     """
     from .batch import run_batch
     from .jobs import parse_depth_range
@@ -553,6 +556,8 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
         click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
     if not quiet:
         click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
+    if report.failed:  # scripts can tell: 0 every set decoded, 3 some failed, 2 bad input
+        sys.exit(BATCH_SETS_FAILED)
 
 
 @cli.command()

@@ -132,6 +132,40 @@ def write_signatures(found: dict[str, list[tuple[str, ...]]], path: Path = SIGNA
     return len(lines)
 
 
+def with_every_stack_type(found: dict[str, list[tuple[str, ...]]]
+                          ) -> dict[str, list[tuple[str, ...]]]:
+    """The list, and for every kernel that takes a capture stack (a 3-d array first) the
+    stack types :func:`bistair.core.jit.kernel_frames` passes: uint8, uint16 and float32,
+    writeable or read-only (a ``.npy`` file is read as a read-only map)."""
+    out = {key: list(sigs) for key, sigs in found.items()}
+    for key, sigs in found.items():
+        for sig in sigs:
+            if sig and re.fullmatch(r"(readonly )?array\(\w+, 3d, C\)", sig[0]):
+                for ro in ("", "readonly "):
+                    for dtype in ("uint8", "uint16", "float32"):
+                        new = (f"{ro}array({dtype}, 3d, C)", *sig[1:])
+                        if new not in out[key]:
+                            out[key].append(new)
+                out[key] = [s for s in out[key] if not re.fullmatch(
+                    r"(readonly )?array\((?!uint8|uint16|float32)\w+, 3d, C\)", s[0])]
+    return out
+
+
+def load_listed(prefixes: tuple[str, ...] = ("bistair.",)) -> tuple[int, int]:
+    """Load every listed kernel (of the modules whose names start with one of ``prefixes``)
+    from the caches into this process, compiling nothing (:func:`bistair.core.jit.load_cached`);
+    returns (loaded, listed)."""
+    loaded = listed = 0
+    for key, sigs in read_signatures().items():
+        module_name, _, func_name = key.rpartition(".")
+        if not module_name.startswith(prefixes):
+            continue
+        func = getattr(importlib.import_module(module_name), func_name)
+        listed += len(sigs)
+        loaded += jit.load_cached(func, [tuple(parse_type(t) for t in sig) for sig in sigs])
+    return loaded, listed
+
+
 def load_module(name: str) -> types.ModuleType:
     """Import a kernel module without running the ``__init__`` of packages not imported yet
     (they import scipy and OpenCV, which the build environment lacks): those packages get
@@ -196,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--only", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.record is not None:
-        count = write_signatures(read_signatures(args.record))
+        count = write_signatures(with_every_stack_type(read_signatures(args.record)))
         print(f"bistair: {count} kernel signatures written to {SIGNATURES}")
         return 0
     if args.folder is None:

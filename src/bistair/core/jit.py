@@ -135,6 +135,52 @@ def compiled_kernels() -> dict[str, list[tuple]]:
     return {key: list(d.signatures) for key, d in sorted(_COMPILED.items())}
 
 
+def load_cached(func: Callable, signatures: list[tuple]) -> int:
+    """Load the compiled code of a :func:`kernel` for ``signatures`` (tuples of numba types)
+    from the caches, without compiling what is not there and without running anything;
+    returns how many were loaded.
+
+    A process that starts others by ``fork`` (the local cluster of ``bistair batch``) loads
+    the kernels once, before, and its children start with them.
+
+    Parameters
+    ----------
+    func : callable
+        A function decorated with :func:`kernel`.
+    signatures : list of tuple
+        Argument types, as ``dispatcher(func).signatures`` lists them.
+
+    Returns
+    -------
+    int
+        The signatures now loaded (found in a cache or loaded before).
+
+    Examples
+    --------
+    >>> from bistair.core.phase_jit import _arctan2
+    >>> load_cached(_arctan2, []) == 0
+    True
+    """
+    compiled = dispatcher(func)
+    loaded = 0
+    for sig in signatures:
+        sig = tuple(sig)
+        if sig in compiled.overloads:
+            loaded += 1
+            continue
+        _STATE["quiet"] = True
+        try:
+            cres = compiled._cache.load_overload(sig, compiled.targetctx)
+        finally:
+            _STATE["quiet"] = False
+        if cres is None:
+            continue
+        compiled.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+        compiled.add_overload(cres)
+        loaded += 1
+    return loaded
+
+
 def on_compile(callback: Callable[[], None]) -> None:
     """Call ``callback()`` once, when the first kernel of this process is compiled rather
     than loaded from a cache (seconds per kernel: the caller may want to say why it waits).
@@ -180,7 +226,7 @@ def prebuilt_folder() -> Path | None:
 
 def _compiling() -> None:
     """A kernel is about to be compiled: tell the listeners, once per process."""
-    if _STATE["told"] or _STATE["building"] is not None:
+    if _STATE["told"] or _STATE["building"] is not None or _STATE.get("quiet"):
         return
     _STATE["told"] = True
     listeners = list(_LISTENERS)
@@ -200,7 +246,7 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
         module["prange"] = numba.prange
         for name, value in list(module.items()):
             how = getattr(value, "_inline", None)
-            if how is not None:
+            if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
                 module[name] = numba.njit(cache=True, inline=how)(value)
     compiled = numba.njit(cache=False, parallel=parallel, fastmath=False,
                           error_model="numpy")(fn)
@@ -261,7 +307,10 @@ def _cache_class() -> type:
             if not self._enabled:
                 return None
             key = self._index_key(sig, target_context.codegen())
-            for store in (self._prebuilt, self._cache_file):
+            # while the prebuilt folder is made, only what is in it counts
+            stores = (self._prebuilt,) if _STATE["building"] is not None else (
+                self._prebuilt, self._cache_file)
+            for store in stores:
                 data = None if store is None else store.load(key)
                 if data is not None:
                     return self._impl.rebuild(target_context, data)
@@ -283,6 +332,50 @@ def _cache_class() -> type:
 
     _STATE["cache_class"] = KernelCache
     return KernelCache
+
+
+def kernel_frames(raw: np.ndarray, start: int = 0, count: int | None = None
+                  ) -> tuple[np.ndarray, int]:
+    """A capture stack as the compiled passes take it: ``(stack, start)``, the stack itself
+    if it is uint8, uint16 or float32 and C-contiguous, else frames ``start .. start+count-1``
+    as float32 (and start 0).
+
+    The passes turn every value into float32 before anything else, so the values are the
+    same; they are compiled for these three types only (each type of stack is a kernel
+    compiled and kept of its own).
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The capture stack, any numeric dtype.
+    start : int
+        The first frame the pass reads.
+    count : int, optional
+        How many frames from ``start`` it reads (all the rest if not given).
+
+    Returns
+    -------
+    stack : (F', H, W) array
+        The stack to pass.
+    start : int
+        The first frame's index in it.
+
+    Examples
+    --------
+    >>> raw = np.zeros((4, 2, 3), np.int32)
+    >>> stack, start = kernel_frames(raw, 2, 2)
+    >>> stack.shape, stack.dtype.name, start
+    ((2, 2, 3), 'float32', 0)
+    >>> kernel_frames(raw.astype(np.uint8), 2)[1]
+    2
+    """
+    if raw.dtype in _RAW_TYPES and raw.flags.c_contiguous:
+        return raw, int(start)
+    stop = raw.shape[0] if count is None else int(start) + int(count)
+    return np.ascontiguousarray(raw[int(start):stop], dtype=np.float32), 0
+
+
+_RAW_TYPES = (np.dtype(np.uint8), np.dtype(np.uint16), np.dtype(np.float32))
 
 
 def set_threads(count: int | None) -> int:
