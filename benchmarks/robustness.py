@@ -28,15 +28,13 @@ import statistics
 import time
 from pathlib import Path
 
-import matplotlib
+from markdown_page import markdown_page
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from markdown_page import markdown_page  # noqa: E402
-
-from bistair.codecs.bidirectional import stairs_for  # noqa: E402
-from bistair.evaluation.benchmark import method_specs, run  # noqa: E402
-from bistair.sim import Ellipsoid, Imaging, Rig, Scene, preset, trace  # noqa: E402
+from bistair.codecs.bidirectional import stairs_for
+from bistair.evaluation.benchmark import method_specs, run
+from bistair.evaluation.report import sweep_figure
+from bistair.io.atomic import slug
+from bistair.sim import Ellipsoid, Imaging, Rig, Scene, preset, trace
 
 DEFAULT = dict(gamma=2.2, read_noise=0.01, camera_blur=1.0, projector_blur=0.5, ambient=0.05)
 HARD = dict(gamma=2.2, read_noise=0.03, camera_blur=1.2, projector_blur=1.0, ambient=0.15)
@@ -75,8 +73,26 @@ def run_case(name: str, camera: tuple[int, int], seed: int) -> dict[str, dict]:
         pool = comp.objects[1:] if over == "small objects" else comp.objects
         out[row.label] = {"order_error_rate": row.scores["order_error_rate"],
                           "coverage": row.scores["coverage"],
-                          "worst": min((objects.get(i, 0.0) for i in pool), default=1.0)}
+                          "worst": min((objects.get(i, 0.0) for i in pool), default=1.0),
+                          "refused": "refused" in row.result.info}
     return out
+
+
+def median_of(runs: list[dict], method: str) -> dict:
+    """The median scores of a method over the seeds that decoded, and how many refused."""
+    decoded = [r[method] for r in runs if not r[method]["refused"]]
+    out = {k: statistics.median(r[k] for r in decoded) if decoded else None
+           for k in ("order_error_rate", "coverage", "worst")}
+    return {**out, "refused": len(runs) - len(decoded), "seeds": len(runs)}
+
+
+def cells(r: dict) -> str:
+    """A method's table cells; a refused decode reads "refused", never 0% errors."""
+    if r["order_error_rate"] is None:
+        return "refused | refused | refused"
+    note = f" (refused {r['refused']} of {r['seeds']} seeds)" if r["refused"] else ""
+    return (f"{100 * r['order_error_rate']:.3f}%{note} | {100 * r['coverage']:.2f}% | "
+            f"{100 * r['worst']:.1f}%")
 
 
 def table(camera: tuple[int, int], seeds: int, cases: list[str]) -> dict:
@@ -84,24 +100,20 @@ def table(camera: tuple[int, int], seeds: int, cases: list[str]) -> dict:
     for name in cases:
         t0 = time.perf_counter()
         runs = [run_case(name, camera, seed) for seed in range(seeds)]
-        results[name] = {m: {k: statistics.median(r[m][k] for r in runs)
-                             for k in ("order_error_rate", "coverage", "worst")}
-                         for m in METHODS}
+        results[name] = {m: median_of(runs, m) for m in METHODS}
         print(f"# {name}: {seeds} seeds in {time.perf_counter() - t0:.0f} s", flush=True)
     print(f"\n| case | method | order errors | coverage | worst {'object/surface'} right |")
     print("| --- | --- | --- | --- | --- |")
     for name in cases:
         for m in METHODS:
-            r = results[name][m]
-            print(f"| {name} | {m} | {100 * r['order_error_rate']:.3f}% | "
-                  f"{100 * r['coverage']:.2f}% | {100 * r['worst']:.1f}% |")
+            print(f"| {name} | {m} | {cells(results[name][m])} |")
     print("\ntargets (default bidirectional decoder):")
     for name in cases:
         err, cov, worst = TARGETS[name]
         r = results[name]["bidirectional"]
-        checks = [r["order_error_rate"] <= err]
-        checks += [r["coverage"] >= cov] if cov else []
-        checks += [r["worst"] >= worst] if worst else []
+        checks = [not r["refused"] and r["order_error_rate"] <= err]
+        checks += [not r["refused"] and r["coverage"] >= cov] if cov else []
+        checks += [not r["refused"] and r["worst"] >= worst] if worst else []
         print(f"  {name}: errors <= {100 * err:.1f}%"
               + (f", coverage >= {100 * cov:.0f}%" if cov else "")
               + (f", worst >= {100 * worst:.0f}%" if worst else "")
@@ -135,6 +147,7 @@ def sweep(traced, factor: str, values, make_imaging, make_specs=None):
         comp = run(traced, specs, imaging=make_imaging(value))
         for row in comp.rows:
             rows.append({"factor": factor, "value": value, "method": row.label,
+                         "refused": row.result.info.get("refused"),
                          "frames": row.frames, "coverage": row.scores["coverage"],
                          "order_error_rate": row.scores["order_error_rate"],
                          "phase_rmse": row.scores["phase_rmse"],
@@ -157,24 +170,20 @@ def print_sweep(rows, factor: str, key: str) -> None:
     print(f"\n{factor}: {key}")
     print(f"{'method':<30}" + "".join(f"{v:>10}" for v in values))
     for method in METHODS:
-        cells = [next(100 * r[key] for r in rows if r["factor"] == factor and
-                      r["value"] == v and r["method"] == method) for v in values]
-        print(f"{method:<30}" + "".join(f"{c:9.3f}%" for c in cells))
+        found = [next(r for r in rows if r["factor"] == factor and r["value"] == v and
+                      r["method"] == method) for v in values]
+        print(f"{method:<30}" + "".join("   refused" if r["refused"] else
+                                         f"{100 * r[key]:9.3f}%" for r in found))
 
 
-def plot(rows, factor: str, key: str, out: Path, label: str) -> None:
-    fig, ax = plt.subplots(figsize=(6.4, 4))
-    for method in METHODS:
-        pts = sorted((r["value"], r[key]) for r in rows
-                     if r["factor"] == factor and r["method"] == method)
-        ax.plot([p[0] for p in pts], [100 * p[1] for p in pts], marker="o", label=method)
-    ax.set_xlabel(factor)
-    ax.set_ylabel(label)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / f"{factor}-{key}.png", dpi=90)
-    plt.close(fig)
+def plot(rows, factor: str, key: str, out: Path, label: str) -> Path:
+    """One line per method, a refused decode drawn as refused; the file name a slug."""
+    curves = {method: [(r["value"], None if r["refused"] else r[key]) for r in rows
+                       if r["factor"] == factor and r["method"] == method]
+              for method in METHODS}
+    path = out / f"{slug(factor)}-{key}.png"
+    sweep_figure(curves, factor, label).savefig(path, dpi=90)
+    return path
 
 
 def sweeps(out: Path, camera: tuple[int, int]) -> None:
@@ -200,7 +209,8 @@ def sweeps(out: Path, camera: tuple[int, int]) -> None:
     print("\nobject width (fringes): share decoded right")
     for r in wrows:
         shares = [r["objects"][str(i + 1)] for i in range(len(widths))]
-        print(f"{r['method']:<30}" + "".join(f"{100 * v:7.1f}%" for v in shares))
+        print(f"{r['method']:<30}" + (f"refused: {r['refused']}" if r["refused"] else
+                                      "".join(f"{100 * v:7.1f}%" for v in shares)))
     (out / "robustness.json").write_text(json.dumps(rows + wrows, indent=1))
 
 

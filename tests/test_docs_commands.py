@@ -3,19 +3,21 @@ show (issue 25): the docs cannot go stale.
 
 In a Markdown file, a fenced block of language ``sh`` is a script: each line that is not a
 comment is a command (``\\`` continues it), and the ``# `` lines right after a command are
-its output, line for line (``...`` in a line stands for any text); a ``python`` block runs
-as one script and must succeed. The blocks of a file run
+its output, line for line (``...`` in a line stands for any text; an output that starts
+with ``Error: `` is a refusal: exit code 2); a ``python`` block runs as one script and must
+succeed. The blocks of a file run
 in order in one working directory of their own, beside a ``shared`` folder that points at
 ``../shared`` (the real captures) and with ``examples/`` of the repository, so the commands
 read as a user types them from a clone. A block right after ``<!-- not run: REASON -->``
-(installing, hardware, a user's own files) is not run; its reason is printed.
+(installing, hardware, a user's own files) is not run; its reason is printed. A block right
+after ``<!-- file: NAME -->`` (a calibration file, a board) is written to ``NAME`` for the
+commands after it.
 """
 
 from __future__ import annotations
 
 import os
 import re
-import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -26,13 +28,14 @@ ROOT = Path(__file__).resolve().parents[1]
 SHARED = ROOT.parent / "shared"
 DOCS = [ROOT / "README.md", ROOT / "docs" / "getting-started.md",
         *sorted((ROOT / "docs" / "guide").glob("*.md"))]
-FENCE = re.compile(r"^```(\w*)\s*$")
+FENCE = re.compile(r"^```\s*([\w{}-]*)")
 NOT_RUN = re.compile(r"<!--\s*not run:\s*(.*?)\s*-->")
+FILE = re.compile(r"<!--\s*file:\s*(\S+)\s*-->")
 
 
-def blocks(path: Path) -> list[tuple[int, str | None, list[str]]]:
-    """``(first line, reason not run or None, lines)`` of every ``sh`` block of a file, and
-    of every ``python`` block as one ``python -c`` command."""
+def blocks(path: Path) -> list[tuple[int, str | None, str, list[str]]]:
+    """``(first line, reason not run or None, language, lines)`` of every ``sh`` and
+    ``python`` block of a file, and of every block shown as a file (language ``file:NAME``)."""
     out, lines = [], path.read_text().splitlines()
     i = 0
     while i < len(lines):
@@ -40,14 +43,16 @@ def blocks(path: Path) -> list[tuple[int, str | None, list[str]]]:
         if match is None:
             i += 1
             continue
-        end = next(j for j in range(i + 1, len(lines)) if lines[j].startswith("```"))
-        if match.group(1) in ("sh", "python"):
-            before = next((lines[j] for j in range(i - 1, -1, -1) if lines[j].strip()), "")
+        end = next((j for j in range(i + 1, len(lines)) if lines[j].startswith("```")),
+                   len(lines))
+        before = next((lines[j] for j in range(i - 1, -1, -1) if lines[j].strip()), "")
+        named = FILE.search(before)
+        if named:  # a file the commands after it read, written as shown
+            out.append((i + 1, None, f"file:{named.group(1)}", lines[i + 1:end]))
+        elif match.group(1) in ("sh", "python"):
             skip = NOT_RUN.search(before)
-            body = lines[i + 1:end]
-            if match.group(1) == "python":  # a script, run as one command
-                body = [f"python -c {shlex.quote(chr(10).join(body))}"]
-            out.append((i + 1, skip.group(1) if skip else None, body))
+            out.append((i + 1, skip.group(1) if skip else None, match.group(1),
+                        lines[i + 1:end]))
         i = end + 1
     return out
 
@@ -82,8 +87,28 @@ def matches(expected: str, got: str) -> bool:
     return re.fullmatch(pattern, got) is not None
 
 
+def printed_as_shown(expected: list[str], printed: list[str]) -> bool:
+    """Each shown line matches a printed one in order; a shown line of only ``...`` stands
+    for any number of printed lines."""
+    if not expected:
+        return not printed
+    if expected[0].strip() == "...":
+        return any(printed_as_shown(expected[1:], printed[i:]) for i in range(len(printed) + 1))
+    return bool(printed) and matches(expected[0], printed[0]) and \
+        printed_as_shown(expected[1:], printed[1:])
+
+
 CASES = [pytest.param(path, id=path.relative_to(ROOT).as_posix())
          for path in DOCS if path.exists() and any(b[1] is None for b in blocks(path))]
+
+
+def _steps(language: str, lines: list[str]) -> list[tuple[list[str], str, list[str]]]:
+    """``(argv, shown command, expected output)`` of a block: a ``python`` block is one
+    script."""
+    if language == "python":
+        return [([sys.executable, "-c", "\n".join(lines)], "python script", [])]
+    return [(["bash", "-c", command], command, expected)
+            for command, expected in commands(lines)]
 
 
 @pytest.mark.parametrize("path", CASES)
@@ -95,22 +120,26 @@ def test_commands_print_what_the_docs_show(path, tmp_path):
         (tmp_path / "shared").symlink_to(SHARED)
     env = {**os.environ, "BISTAIR_PROGRESS_DELAY": "3600", "COLUMNS": "100",
            "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
-    for start, skip, lines in blocks(path):
+    for start, skip, language, lines in blocks(path):
         if skip is not None:
             print(f"{path.name}:{start}: not run ({skip})")
             continue
-        for command, expected in commands(lines):
-            if "../shared" in command and not SHARED.is_dir():
+        if language.startswith("file:"):
+            (work / language[5:]).write_text("\n".join(lines) + "\n")
+            continue
+        for argv, command, expected in _steps(language, lines):
+            if "../shared" in " ".join(argv) and not SHARED.is_dir():
                 pytest.skip("../shared is not here")
-            proc = subprocess.run(["bash", "-c", command], cwd=work, env=env, text=True,
-                                  capture_output=True, timeout=600)
+            proc = subprocess.run(argv, cwd=work, env=env, text=True, timeout=600,
+                                  stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
             where = f"{path.name}:{start}: {command}"
-            assert proc.returncode == 0, f"{where}\n{proc.stdout}{proc.stderr}"
-            printed = [line for line in (proc.stdout + proc.stderr).splitlines()
-                       if line.strip()]
+            refused = any(line.startswith("Error: ") for line in expected)  # shown refused
+            assert proc.returncode == (2 if refused else 0), \
+                f"{where}\n{proc.stdout}"
+            printed = [line for line in proc.stdout.splitlines() if line.strip()]
             if expected:
-                assert len(printed) == len(expected) and all(
-                    matches(e, g) for e, g in zip(expected, printed, strict=True)), \
+                assert printed_as_shown([e.strip() for e in expected],
+                                        [g.strip() for g in printed]), \
                     f"{where}\nshown:\n" + "\n".join(expected) + "\nprinted:\n" + \
                     "\n".join(printed)
 
@@ -121,4 +150,6 @@ def test_the_parser_reads_commands_outputs_and_continuations():
     assert commands(lines) == [("bistair a --b 1", ["out 1", "out 2"]), ("bistair c", [])]
     assert matches("wrote 7 ... to pats", "wrote 7 bidirectional patterns to pats")
     assert not matches("wrote 7", "wrote 8")
-    assert shlex.split("a 'b c'") == ["a", "b c"]
+    assert printed_as_shown(["a", "...", "d"], ["a", "b", "c", "d"])
+    assert not printed_as_shown(["a", "d"], ["a", "b", "d"])
+    assert _steps("python", ["x = 1  # one", "print(x)"])[0][0][-1] == "x = 1  # one\nprint(x)"

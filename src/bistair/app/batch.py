@@ -69,6 +69,7 @@ from .engine import (
     run_tasks,
 )
 from .jobs import decode_folder, reconstruct_folder
+from .stereo import check_calibration_file, is_stereo_calibration, stereo_folder, stereo_pair
 
 MARKER = "batch-set.json"  # written last into every complete set folder
 MARKER_FORMAT = "bistair-batch-set"
@@ -289,6 +290,8 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
     start = time.perf_counter()
     try:
         check_output(job.out, job.captures)
+        if is_stereo_calibration(job.calibration) or stereo_pair(job.captures):
+            return _stereo_set(job, options, prefix, start)
         calibration = None if job.calibration is None else load_calibration(job.calibration)
         with replace_folder(job.out, prefix) as tmp:
             result = decode_folder(job.captures, tmp, job.spec, previews=options.previews,
@@ -316,6 +319,30 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
         first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
         return _row(job.name, "error", f"{type(exc).__name__}: {first}".rstrip(": "),
                     seconds=time.perf_counter() - start)
+
+
+def _stereo_set(job: SetJob, options: Options, prefix: str, start: float) -> dict[str, Any]:
+    """:func:`run_set` for a stereo set (``L/`` and ``R/``) with a stereo calibration: what
+    ``bistair stereo`` writes, and the marker. ``valid_fraction``: the share of the left
+    camera's pixels with a point; ``noise``: the left decode's."""
+    pair = stereo_pair(job.captures)
+    if pair is None:
+        raise BistairError(f"a stereo calibration needs a stereo set: {job.captures} holds no "
+                           "L/ and R/ folders")
+    if not is_stereo_calibration(job.calibration):
+        raise BistairError(f"{job.captures} holds L/ and R/: a stereo set needs "
+                           "--calibration with a stereo calibration (two cameras)")
+    with replace_folder(job.out, prefix) as tmp:
+        result = stereo_folder(*pair, tmp, job.calibration, job.spec,
+                               min_depth=options.min_depth, max_depth=options.max_depth,
+                               previews=options.previews, **options.decode)
+        row = _row(job.name, "ok", valid_fraction=round(float(result.mask.mean()), 6),
+                   noise=_noise(result.left), seconds=round(time.perf_counter() - start, 3))
+        files = sorted(str(p.relative_to(tmp)) for p in tmp.rglob("*") if p.is_file())
+        write_json(tmp / MARKER, {"format": MARKER_FORMAT, "version": 1,
+                                  **_inputs(job, options), "files": files, "row": row,
+                                  "warnings": result.info.get("warnings", []), "run": prefix})
+    return row
 
 
 def _row(name: str, status: str, error: str = "", valid_fraction: float | None = None,
@@ -353,12 +380,15 @@ def _stamp(job: SetJob) -> list[list[Any]]:
     """(path, size, mtime in ns) of a set's capture files, its spec file (the given one or
     the captures' ``spec.json``) and its calibration; an unreadable set gives []."""
     try:
-        files = capture_files(job.captures)
+        pair = stereo_pair(job.captures)
+        files = (capture_files(job.captures) if pair is None
+                 else [f for side in pair for f in capture_files(side)])
     except BistairError:
         return []
     if not files:
         return []
-    spec = Path(job.spec) if job.spec else default_spec_path(job.captures, files)
+    first = job.captures if pair is None else pair[0]
+    spec = Path(job.spec) if job.spec else default_spec_path(first, files)
     stamp = []
     for path in [*files, spec, *([Path(job.calibration)] if job.calibration else [])]:
         with contextlib.suppress(OSError):
@@ -429,7 +459,7 @@ def run_batch(source: str | Path, out: str | Path, spec: str | Path | None = Non
     if spec is not None:
         load_spec(spec)  # refuse a bad default spec once, not once per set
     if calibration is not None:
-        load_calibration(calibration)
+        check_calibration_file(calibration)
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")

@@ -19,7 +19,7 @@ from tqdm import tqdm
 from ..evaluation.benchmark import format_table, method_specs, run, table
 from ..evaluation.report import method_figure, write_report
 from ..evaluation.views import cloud_view
-from ..io.atomic import output_folder
+from ..io.atomic import output_folder, slug
 from ..io.jsonfile import write_json
 from ..sim import Imaging, preset, trace
 
@@ -48,7 +48,7 @@ def run_demo(out: str | Path, seed: int = 0, camera_size: tuple[int, int] = (128
     with output_folder(out) as tmp:
         bar.set_postfix_str("figures")
         figures = [(row.label, method_figure(row, comparison.truth,
-                                             tmp / f"{_slug(row.label)}.png"))
+                                             tmp / f"{slug(row.label)}.png"))
                    for row in comparison.rows]
         figures.insert(0, (f"point cloud: {comparison.rows[0].label} with the rig's "
                            "calibration", cloud_view(comparison.rows[0], rig,
@@ -81,7 +81,3 @@ def target_check(rows: list[dict], objects: list[int]) -> str:
           and min(small, default=1.0) >= TARGET["small_objects"])
     return (f"target (order errors <= 0.1%, coverage >= 99%, every small object >= 99% "
             f"right): {'met' if ok else 'NOT met'} by the default bidirectional decoder")
-
-
-def _slug(label: str) -> str:
-    return label.replace(" (", "-").replace(")", "").replace(" ", "-")

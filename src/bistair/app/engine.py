@@ -163,10 +163,12 @@ def _client(workers: int | None, scheduler: str | None, tasks: int | None
     # a traceback of its own.
     handler = signal.signal(signal.SIGINT, signal.SIG_IGN) if _main_thread() else None
     try:
+        # the dashboard on a free port: None still serves it on 8787, with a three-line
+        # warning on the user's terminal whenever another cluster holds that port
         with dask.config.set({**WORKER_CONFIG,
                               "distributed.worker.multiprocessing-method": start_method()}):
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR)
+                                   dashboard_address=":0", silence_logs=logging.ERROR)
     finally:
         if handler is not None:
             signal.signal(signal.SIGINT, handler)

@@ -19,7 +19,6 @@ Examples
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -45,7 +44,7 @@ from ..io.read import (
     read_captures,
     read_with_spec,
 )
-from ..io.writers import RESULT_FILES, write_depth, write_ply, write_result
+from ..io.writers import save_result, write_depth, write_ply
 from ..spec import BaseSpec
 
 
@@ -124,12 +123,7 @@ def decode_folder(captures: Captures, out: str | Path, spec: BaseSpec | str | Pa
     say(_decoding(stack, spec))
     result = require_valid(decode(stack, spec, **options))
     say("writing " + ("outputs and previews" if previews else "outputs"))
-    with output_folder(out) as tmp:
-        write_result(result, tmp, previews=previews)
-        written = {p.name for p in tmp.iterdir()}
-    for name in RESULT_FILES - written:  # an earlier decode's files there: not this one's
-        with contextlib.suppress(OSError):
-            (Path(out) / name).unlink()
+    save_result(result, out, previews=previews)
     return result
 
 
@@ -161,15 +155,19 @@ def require_valid(result: DecodeResult | AxesResult) -> DecodeResult | AxesResul
 
 def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
                   spec: BaseSpec | str | Path | None = None, planes: tuple[str, ...] = (),
-                  geometry: str | None = None) -> np.ndarray:
+                  geometry: str | None = None, progress: Say | None = None) -> np.ndarray:
     """Height above a reference plane (mm) from the captures of the object, of the plane and
     either of planes at known heights (``"FOLDER:HEIGHT"``, two or more) or of the geometry
-    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``."""
+    (``"DISTANCE,BASELINE,FREQUENCY"``); writes ``height.npy`` and ``height.png``.
+    ``progress`` is called with each stage's name as it starts."""
+    say = progress or _silent
+    say("reading the captures")
     stack, spec = read_with_spec(captures, spec)
     if bool(planes) == bool(geometry):
         raise BistairError("give either two or more --plane FOLDER:HEIGHT or --geometry")
 
     def coord(folder: str | Path) -> np.ndarray:
+        say(f"decoding {folder}")
         return decode(read_captures(folder), spec).coord.astype(np.float64)
 
     ref = coord(reference)
@@ -189,14 +187,16 @@ def height_folder(captures: str | Path, reference: str | Path, out: str | Path,
             except ValueError:
                 raise BistairError(f"--plane must be FOLDER:HEIGHT, got {item!r}") from None
         model = HeightModel.fit(ref, [p for p, _ in pairs], [h for _, h in pairs])
+    say(_decoding(stack, spec))
     obj = decode(stack, spec).coord.astype(np.float64)
     if obj.shape != ref.shape:
         raise BistairError(f"captures are {obj.shape[1]}x{obj.shape[0]}, the reference "
                            f"{ref.shape[1]}x{ref.shape[0]}")
     heights = model.height(obj).astype(np.float32)
+    say("writing height.npy and height.png")
     with output_folder(out) as tmp:
         np.save(tmp / "height.npy", heights)
-        write_image(tmp / "height.png", colorize(heights, "viridis"))
+        write_image(tmp / "height.png", colorize(heights, "viridis", unit="mm"))
     return heights
 
 

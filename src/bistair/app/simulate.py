@@ -11,7 +11,8 @@ For a preset scene and one method (or all) it writes::
     OUT/scene.json            the scene, rig (intrinsics, distortion, pose) and imaging
 
 The scene ``calibration`` writes a checkerboard in eight poses instead, in the layout
-``bistair calibrate`` reads (``board.json``, ``pose-NN/columns``, ``pose-NN/rows``).
+``bistair calibrate`` reads (``board.json``, ``pose-NN/columns``, ``pose-NN/rows``): into
+OUT for one method, into ``OUT/<method>/`` for each of several.
 
 :func:`simulate_many` (``bistair simulate --count N``) writes a data set of N scenes in
 that layout, ``DATA/scene-0000/`` ..., in parallel on Dask (see
@@ -52,7 +53,7 @@ from ..geometry.calibration import Calibration, save_calibration
 from ..io.atomic import output_file, output_folder, replace_folder, write_image
 from ..io.jsonfile import write_json
 from ..sim import Imaging, Rig, Scene, Truth, expose, preset, scene_names, trace
-from ..sim.boards import write_board_captures
+from ..sim.boards import write_board_sets
 from ..sim.rig import check_size
 from ..sim.variation import build, check_vary, draw, streams
 from ..spec import BaseSpec
@@ -77,7 +78,8 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     the projector's gamma. ``progress`` is called with each stage's name as it starts.
     For the scene ``calibration``, ``white`` false leaves the white frame out (the board is
     then found in the mean image) and ``both_axes`` writes one capture set of both axes per
-    pose instead of ``columns/`` and ``rows/``.
+    pose instead of ``columns/`` and ``rows/``; several methods write ``out/<method>/`` each,
+    and ``progress`` is called as each pose starts.
 
     Raises
     ------
@@ -93,7 +95,8 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     methods = _check_methods(methods)
     im = _imaging(compensated, imaging)
     if scene == "calibration":
-        return _calibration(methods, out, camera_size, compensated, im, white, both_axes)
+        return _calibration(methods, out, camera_size, compensated, im, white, both_axes,
+                            progress)
     if not white or both_axes:
         raise BistairError("board captures without a white frame or of both axes at once "
                            "are for --scene calibration")
@@ -166,18 +169,21 @@ def _rig_dict(rig: Any) -> dict[str, Any]:
 
 def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, int] | None,
                  compensated: bool, imaging: Any, white: bool = True,
-                 both_axes: bool = False) -> Path:
+                 both_axes: bool = False,
+                 progress: Callable[[str], None] | None = None) -> Path:
     """A 9 x 6 checkerboard (20 mm) in eight poses, both orientations (``columns/`` and
     ``rows/``, or with ``both_axes`` one capture set of both axes per pose), with a white
-    frame unless ``white`` is false, in the layout ``bistair calibrate`` reads (one method:
-    the first named)."""
+    frame unless ``white`` is false, in the layout ``bistair calibrate`` reads: in ``out``
+    for one method, in ``out/<method>/`` for each of several (each pose cast once)."""
     rig = Rig.default(**({} if camera_size is None else {"camera_size": camera_size}))
-    base = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
-                        methods=methods[:1])[methods[0]][0]
+    bases = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
+                         methods=methods)
     axes = ("both",) if both_axes else ("columns", "rows")
-    specs = {o: base.replace(orientation=o, white=int(white)) for o in axes}
-    return write_board_captures(rig, Board("checkerboard", 9, 6, 20.0), specs, out,
-                                imaging=imaging)
+    sets = {"" if len(methods) == 1 else method: {
+        o: bases[method][0].replace(orientation=o, white=int(white)) for o in axes}
+        for method in methods}
+    return write_board_sets(rig, Board("checkerboard", 9, 6, 20.0), sets, out,
+                            imaging=imaging, progress=progress)
 
 
 def _check_methods(methods: Iterable[str]) -> list[str]:

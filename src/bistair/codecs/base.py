@@ -34,7 +34,7 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, Literal, get_args, get_origin
 
 import numpy as np
 
@@ -180,6 +180,18 @@ class Codec:
         return ("min_modulation", "force",
                 *(p.name for p in params if p.kind is p.KEYWORD_ONLY))
 
+    @property
+    def choices(self) -> dict[str, tuple[Any, ...]]:
+        """The values of each order-stage option declared as a ``Literal``, the default
+        first (e.g. ``{"strategy": ("region", "paper")}``), for the command line's help."""
+        params = inspect.signature(self.order_columns, eval_str=True).parameters.values()
+        out = {}
+        for p in params:
+            if p.kind is p.KEYWORD_ONLY and get_origin(p.annotation) is Literal:
+                values = get_args(p.annotation)
+                out[p.name] = (p.default, *(v for v in values if v != p.default))
+        return out
+
     # -- encoding ----------------------------------------------------------------------------
     def encode(self, spec: BaseSpec) -> np.ndarray:
         """Patterns as float32 in [0, 1], shape (frames, height, width), in the order of
@@ -251,7 +263,7 @@ class Codec:
         check_min_modulation(options.get("min_modulation"))
         if spec.orientation == "both":
             x, y = (self.decode(images, axis_spec, **options) for _, axis_spec in spec.axes())
-            return AxesResult(x, y)
+            return AxesResult(x, y, spec=spec)
         force = bool(options.pop("force", False))
         with forcing(force) as forced:
             result = self._decode(images, spec, **options)
@@ -259,6 +271,7 @@ class Codec:
             result.info["forced"] = list(forced)
             result.info["warnings"] = [*result.info.get("warnings", []),
                                        *(f"forced past a check: {p}" for p in forced)]
+        result.spec = spec  # for the reconstruction: the coded axis, the projector's size
         return result
 
     def _decode(self, images: np.ndarray, spec: BaseSpec, **options: Any) -> DecodeResult:

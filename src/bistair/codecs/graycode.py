@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Literal
 
 import numpy as np
 
@@ -348,7 +349,7 @@ def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
-                  strategy: str = "pixel") -> Orders:
+                  strategy: Literal["pixel", "region"] = "pixel") -> Orders:
     """Stage 3: the code is the order, per pixel (``pixel``, the classic decode), or voted
     per fringe region with the pixels far from the code's edges counting most (``region``:
     a code misread beside its edges is outvoted by the rest of its fringe).

@@ -34,6 +34,7 @@ True
 from __future__ import annotations
 
 import dataclasses
+from typing import Literal
 
 import numpy as np
 
@@ -159,7 +160,7 @@ def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
-                  strategy: str = "region") -> Orders:
+                  strategy: Literal["region", "pixel"] = "region") -> Orders:
     """Stage 3: the code per pixel (``pixel``) or voted per fringe region (``region``).
 
     Parameters

@@ -8,17 +8,25 @@ Examples
 >>> res = make_result("demo", phi, order, period=30.0, modulation=np.ones((2, 3)))
 >>> [round(float(c), 3) for c in res.coord[0]], int(res.mask.sum())
 ([4.775, 34.775, 64.775], 5)
+>>> res  # one line, whatever the size
+DecodeResult('demo', shape (2, 3), 83.33% valid)
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ..hooks import call
+from ..spec import BaseSpec
 from .measure import FringeSet
 from .result_jit import assemble
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 # the arrays a decode writes as NAME.npy (DecodeResult.arrays)
 ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")
@@ -43,6 +51,11 @@ class DecodeResult:
     method : the codec's name.
     info : figures about the decode (thresholds, counts, consistency checks).
     texture : the fully lit frame (fraction of full scale) when the spec has ``white``.
+    spec : the spec the captures were decoded with (set by :func:`bistair.decode`), for
+        :func:`bistair.reconstruct`.
+
+    ``repr`` is one line (method, shape, valid share, noise); :meth:`save` writes what
+    ``bistair decode`` writes, :meth:`plot` draws the six-panel figure.
     """
 
     phase: np.ndarray
@@ -57,26 +70,56 @@ class DecodeResult:
     method: str
     info: dict[str, Any] = field(default_factory=dict)
     texture: np.ndarray | None = None  # the white frame if the spec has one (camera axes)
+    spec: BaseSpec | None = None  # the spec it was decoded with, if known
+
+    def __repr__(self) -> str:
+        return f"DecodeResult({_summary(self, f'{_share(self.mask)} valid')})"
 
     def arrays(self) -> dict[str, np.ndarray]:
         """The arrays written as ``NAME.npy`` (:data:`ARRAY_NAMES`)."""
         return {name: getattr(self, name) for name in ARRAY_NAMES}
+
+    def save(self, folder: str | Path, previews: bool = True) -> Path:
+        """Write what ``bistair decode`` writes (arrays, previews, ``info.json``) into
+        ``folder``, atomically: :func:`bistair.save_result`."""
+        return call("save", self, folder, previews=previews)
+
+    def plot(self) -> Figure:
+        """The six-panel figure (wrapped phase, absolute phase, coordinate, order,
+        modulation, mask) with colour bars in their units: :func:`bistair.plot_result`."""
+        return call("plot", self)
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
         swap = {name: np.ascontiguousarray(getattr(self, name).T) for name in
                 ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
-                            texture=self.texture)
+                            texture=self.texture, spec=self.spec)
 
 
 @dataclass
 class AxesResult:
     """A decode of both projector axes: ``x`` (the columns, ``coord_x``) and ``y`` (the
-    rows, ``coord_y``), each a :class:`DecodeResult`."""
+    rows, ``coord_y``), each a :class:`DecodeResult`; ``spec`` the spec of both axes it was
+    decoded with, if known. ``repr``, :meth:`save` and :meth:`plot` as for a
+    :class:`DecodeResult`."""
 
     x: DecodeResult
     y: DecodeResult
+    spec: BaseSpec | None = None
+
+    def __repr__(self) -> str:
+        both = (f"{_share(self.mask)} valid on both axes (x {_share(self.x.mask)}, "
+                f"y {_share(self.y.mask)})")
+        return f"AxesResult({_summary(self.x, both)})"
+
+    def save(self, folder: str | Path, previews: bool = True) -> Path:
+        """Write what ``bistair decode`` writes for both axes into ``folder``, atomically."""
+        return call("save", self, folder, previews=previews)
+
+    def plot(self) -> Figure:
+        """The six panels of each axis (x above y), with colour bars in their units."""
+        return call("plot", self)
 
     @property
     def mask(self) -> np.ndarray:
@@ -113,6 +156,24 @@ class AxesResult:
                for name, arr in res.arrays().items()}
         out["mask"] = self.mask
         return out
+
+
+def _share(mask: np.ndarray) -> str:
+    return f"{100 * float(mask.mean()) if mask.size else 0.0:.2f}%"
+
+
+def _summary(result: DecodeResult, valid: str) -> str:
+    """``method, shape, valid share, noise[, refused][, warnings]``, for a repr."""
+    info = result.info
+    parts = [repr(result.method), f"shape {result.mask.shape}", valid]
+    if isinstance(info.get("noise"), int | float):
+        parts.append(f"noise {100 * info['noise']:.2f}% of full scale")
+    if "refused" in info:
+        parts.append("refused")
+    warnings = len(info.get("warnings", []))
+    if warnings:
+        parts.append(f"{warnings} warning{'s' if warnings > 1 else ''}")
+    return ", ".join(parts)
 
 
 def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,

@@ -122,7 +122,8 @@ def rmse_against(result: DecodeResult, reference: DecodeResult) -> float:
 
 
 def table(comparison: Comparison) -> list[dict[str, Any]]:
-    """The comparison as plain rows (method, frames, coverage, ..., objects)."""
+    """The comparison as plain rows (method, frames, coverage, ..., objects, and
+    ``refused``: the reason a decode refused the captures, else ``None``)."""
     out = []
     for row in comparison.rows:
         s = row.scores
@@ -134,18 +135,23 @@ def table(comparison: Comparison) -> list[dict[str, Any]]:
             "phase_rmse": s["phase_rmse"],
             "rmse_vs_reference": row.rmse_reference,
             "objects": {i: s.get("objects", {}).get(i, 0.0) for i in comparison.objects},
+            "refused": row.result.info.get("refused"),  # why the decode refused, or None
         })
     return out
 
 
 def format_table(rows: list[dict[str, Any]], objects: list[int]) -> str:
-    """A fixed-width text table of :func:`table` rows (small objects = all but the largest)."""
+    """A fixed-width text table of :func:`table` rows (small objects = all but the largest);
+    a refused decode reads ``refused`` and why, not 0% coverage."""
     small = objects[1:]
     head = (f"{'method':<30} {'frames':>6} {'coverage':>9} {'order err':>10} "
             f"{'RMSE truth':>11} {'RMSE ref':>9}  " + " ".join(f"{'obj ' + str(i):>7}"
                                                              for i in small))
     lines = [head, "-" * len(head)]
     for r in rows:
+        if r.get("refused"):
+            lines.append(f"{r['method']:<30} {r['frames']:>6}   refused: {r['refused']}")
+            continue
         lines.append(
             f"{r['method']:<30} {r['frames']:>6} {100 * r['coverage']:8.2f}% "
             f"{100 * r['order_error_rate']:9.3f}% {r['phase_rmse']:9.4f}rad "

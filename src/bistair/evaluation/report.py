@@ -15,7 +15,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch, Rectangle  # noqa: E402
 from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 from ..core.phase import TWO_PI  # noqa: E402
@@ -107,9 +108,75 @@ def draw_method(row: Row, truth: Any) -> Figure:
             bar.locator = MaxNLocator(integer=True)
             bar.update_ticks()
     s = row.scores
-    fig.suptitle(f"{row.label}: {row.frames} frames, coverage {100 * s['coverage']:.2f}%, "
+    refused = res.info.get("refused")
+    fig.suptitle(f"{row.label}: {row.frames} frames, refused: {refused}" if refused else
+                 f"{row.label}: {row.frames} frames, coverage {100 * s['coverage']:.2f}%, "
                  f"order errors {100 * s['order_error_rate']:.3f}%, "
                  f"RMSE {s['phase_rmse']:.4f} rad (black: no value)", fontsize=11)
+    return fig
+
+
+def sweep_figure(curves: dict[str, Sequence[tuple[float, float | None]]], xlabel: str,
+                 ylabel: str) -> Figure:
+    """One line per method of a score (a share, drawn in %) against a factor; a decode that
+    refused the captures (a ``None`` score) is drawn as refused: a cross in the method's
+    colour in a hatched "refused" band above the scores, the line broken there, never as a
+    score of 0.
+
+    Parameters
+    ----------
+    curves : method label -> ``(factor value, share or None)`` points.
+    xlabel, ylabel : the axes' labels.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        The plot, with a legend entry "refused decode" when any decode refused.
+
+    Examples
+    --------
+    >>> fig = sweep_figure({"a": [(1, 0.0), (2, None), (3, 0.01)], "b": [(1, 0.02)]},
+    ...                    "noise", "order error rate (%)")
+    >>> ax = fig.axes[0]
+    >>> ax.lines[0].get_ydata().tolist()  # the refused point is no score
+    [0.0, nan, 1.0]
+    >>> [t.get_text() for t in ax.get_legend().get_texts()], [t.get_text() for t in ax.texts]
+    (['a', 'b', 'refused decode'], ['refused'])
+    >>> ax.collections[0].get_offsets()[:, 0].tolist()  # the cross, where it refused
+    [2.0]
+    """
+    fig = Figure(figsize=(6.4, 4), layout="constrained")
+    ax = fig.subplots()
+    refused_at: list[tuple[list[float], str]] = []
+    scores = []
+    for method, points in curves.items():
+        pts = sorted(points, key=lambda p: p[0])
+        ys = [np.nan if p[1] is None else 100 * p[1] for p in pts]
+        line, = ax.plot([p[0] for p in pts], ys, marker="o", label=method)
+        scores += [y for y in ys if np.isfinite(y)]
+        if any(p[1] is None for p in pts):
+            refused_at.append(([x for x, y in pts if y is None], line.get_color()))
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    if refused_at:  # a band above the scores: no cross can be read as a score
+        low, high = (min(scores), max(scores)) if scores else (0.0, 1.0)
+        span = (high - low) or 1.0
+        ax.set_ylim(low - 0.05 * span, low + span / 0.78)
+        ax.set_yticks([t for t in ax.get_yticks() if low - 0.05 * span <= t <= high])
+        ax.add_patch(Rectangle((0, 0.84), 1, 0.16, transform=ax.transAxes, facecolor="0.94",
+                               edgecolor="0.75", hatch="//", zorder=0))
+        ax.text(0.01, 0.92, "refused", transform=ax.transAxes, va="center", fontsize=8,
+                color="0.35")
+        top = ax.get_xaxis_transform()  # x in data, y in axes fraction
+        for k, (xs, colour) in enumerate(refused_at):
+            ax.scatter(xs, [0.97 - 0.1 * k / max(1, len(refused_at) - 1)] * len(xs),
+                       transform=top, marker="X", s=60, color=colour, zorder=3)
+        handles.append(Line2D([], [], color="0.3", marker="X", linestyle="none",
+                              markersize=8))
+        labels.append("refused decode")
+    ax.legend(handles, labels, fontsize=7, loc="center right")
     return fig
 
 
@@ -143,7 +210,8 @@ def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, 
     path : the HTML file to write.
     title, intro : the page's heading and first paragraph (``intro`` may hold HTML).
     rows, objects : :func:`~bistair.evaluation.benchmark.table` rows and the object ids,
-        largest first (all but the first are the small objects).
+        largest first (all but the first are the small objects); a refused row reads
+        "refused" and why across its score cells.
     figures : ``(heading, PNG file)`` per figure, e.g. the method's label such as
         ``"bidirectional (paper decoder)"``.
     notes : a paragraph after the table.
@@ -159,6 +227,11 @@ def write_report(path: str | Path, title: str, intro: str, rows: list[dict[str, 
         "RMSE vs reference (rad)", *(f"object {i} right" for i in small)))
     body = []
     for r in rows:
+        if r.get("refused"):  # no scores: the decode refused the captures
+            body.append(f"<tr><td>{html.escape(r['method'])}</td><td>{r['frames']}</td>"
+                        f"<td colspan=\"{4 + len(small)}\" style=\"text-align:left\">"
+                        f"refused: {html.escape(r['refused'])}</td></tr>")
+            continue
         cells = [html.escape(r["method"]), str(r["frames"]), f"{100 * r['coverage']:.2f}%",
                  f"{100 * r['order_error_rate']:.3f}%", f"{r['phase_rmse']:.4f}",
                  f"{r['rmse_vs_reference']:.4f}",

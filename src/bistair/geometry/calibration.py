@@ -211,6 +211,12 @@ class Calibration:
             raise BistairError(f"not a bistair calibration (no \"format\": \"{FORMAT}\")")
         if data.get("version") != VERSION:
             raise BistairError(f"calibration version {data.get('version')!r} is not supported")
+        kind = data.get("kind", "camera-projector")
+        if kind == "stereo":
+            raise BistairError("a stereo calibration (two cameras: for bistair stereo), not a "
+                               "camera-projector one")
+        if kind != "camera-projector":
+            raise BistairError(f"calibration kind {kind!r} is not a camera-projector one")
         devices = [_device(data, name) for name in ("camera", "projector")]
         rot = _array(data, "R", ((3, 3),))
         if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) or np.linalg.det(rot) < 0:

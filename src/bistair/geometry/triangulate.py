@@ -28,6 +28,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import cv2
@@ -35,8 +36,10 @@ import numpy as np
 
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
+from ..io.atomic import output_folder
+from ..io.writers import write_depth, write_ply
 from ..spec import BaseSpec
-from .calibration import Calibration, Device
+from .calibration import Calibration, Device, load_calibration
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
 
@@ -56,6 +59,26 @@ class Reconstruction:
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
         return self.points[self.mask], self.colors[self.mask]
+
+    def __repr__(self) -> str:
+        found = self.depth[self.mask]
+        depths = (f", depth {float(found.min()):.1f} to {float(found.max()):.1f} mm"
+                  if found.size else "")
+        count = int(self.mask.sum())
+        return (f"Reconstruction({count} point{'s' if count != 1 else ''} of shape "
+                f"{self.mask.shape}{depths})")
+
+    def save(self, ply: str | Path, depth_folder: str | Path | None = None) -> Path:
+        """Write the coloured point cloud (binary PLY, camera frame, mm) and, with
+        ``depth_folder``, ``depth.npy`` and ``depth.png`` there, as ``bistair reconstruct``
+        does (atomically); returns ``ply``."""
+        pts, cols = self.cloud()
+        if depth_folder is None:
+            return write_ply(ply, pts, cols)
+        with output_folder(depth_folder) as tmp:
+            write_depth(self.depth, tmp)
+            write_ply(ply, pts, cols)
+        return Path(ply)
 
 
 def _project_coded(dev: Device, pts: np.ndarray, axis: int) -> tuple[np.ndarray, np.ndarray]:
@@ -369,17 +392,21 @@ def check_depth_range(min_depth: float, max_depth: float) -> None:
                            f"{min_depth}:{max_depth}")
 
 
-def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
-                spec: BaseSpec | str, orientation: str | None = None, min_depth: float = 0.0,
-                max_depth: float = np.inf, epipolar_tolerance: float = 1.5,
-                **options: Any) -> Reconstruction:
-    """Triangulate every valid pixel of a decode.
+def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration | str | Path,
+                spec: BaseSpec | str | None = None, orientation: str | None = None,
+                min_depth: float = 0.0, max_depth: float = np.inf,
+                epipolar_tolerance: float = 1.5, **options: Any) -> Reconstruction:
+    """Triangulate every valid pixel of a decode (also ``bistair.reconstruct``).
 
-    ``spec`` is the spec of the captures (or just its orientation); ``orientation``, if
-    given, is what the caller expects the spec to code. Depths outside ``[min_depth,
-    max_depth]`` are dropped (``0 <= min_depth < max_depth``). ``options`` go to
-    :func:`triangulate`. Colours are the white frame if the spec has one, else the fringes'
-    average.
+    ``spec`` is the spec of the captures (or just its orientation), by default the one the
+    result was decoded with (``result.spec``, set by :func:`bistair.decode`). It says which
+    projector axis the coordinates run along (columns or rows; a decode of both axes needs a
+    spec of both), its projector size is checked against the calibration's, and its
+    ``offset`` scales the fringes' average into the points' grey colours when there is no
+    white frame. ``orientation``, if given, is what the caller expects the spec to code.
+    Depths outside ``[min_depth, max_depth]`` are dropped (``0 <= min_depth <
+    max_depth``). ``options`` go to :func:`triangulate`. Colours are the white frame if the
+    spec has one, else the fringes' average.
 
     A decode of both axes (:class:`~bistair.core.result.AxesResult`, spec orientation
     ``"both"``) is triangulated with both projector coordinates where both are valid
@@ -392,11 +419,12 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
     ----------
     result : DecodeResult or AxesResult
         The decode, ``(height, width)`` of the calibrated camera.
-    calibration : Calibration
-        The rig, ``X_p = R @ X_c + T`` (mm).
-    spec : BaseSpec or str
+    calibration : Calibration, str or Path
+        The rig, ``X_p = R @ X_c + T`` (mm), or its calibration file
+        (:func:`~bistair.geometry.calibration.load_calibration`).
+    spec : BaseSpec, str or None, optional
         The captures' spec, or just its orientation (``"columns"``, ``"rows"``,
-        ``"both"``); see :func:`check_fit`.
+        ``"both"``); see :func:`check_fit`. By default ``result.spec``.
     orientation : str or None, optional
         What the caller expects the spec to code, if anything.
     min_depth, max_depth : float, optional
@@ -417,8 +445,9 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
     ------
     BistairError
         Whatever :func:`check_fit` and :func:`check_depth_range` refuse, a tolerance that
-        is not positive, or a coded axis that carries almost no depth in this rig (the
-        baseline across it).
+        is not positive, a coded axis that carries almost no depth in this rig (the
+        baseline across it), no spec given for a result that does not carry one, or a
+        calibration file that cannot be read.
 
     Examples
     --------
@@ -438,7 +467,16 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration,
     ([0.38, 0.38, 600.0], 1, {'outside_range': 0})
     >>> reconstruct(res, cal, "columns", max_depth=500.0).info
     {'outside_range': 1}
+    >>> rec
+    Reconstruction(1 point of shape (480, 640), depth 600.0 to 600.0 mm)
     """
+    if spec is None:
+        spec = result.spec
+        if spec is None:
+            raise BistairError("give the captures' spec: this result does not carry the "
+                               "spec it was decoded with")
+    if not isinstance(calibration, Calibration):
+        calibration = load_calibration(calibration)
     coded = check_fit(result, calibration, spec, orientation)
     check_depth_range(min_depth, max_depth)
     if not epipolar_tolerance > 0:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
 import tempfile
 from collections.abc import Iterator
@@ -63,6 +64,28 @@ def write_image(path: str | Path, image: np.ndarray) -> None:
     else:
         iio.imwrite(path, image)
 
+
+
+def slug(label: str) -> str:
+    """A file name for a label: every run of characters other than letters, digits, ``.``,
+    ``_`` and ``-`` becomes one ``-`` (no spaces, parentheses or slashes in names).
+
+    Parameters
+    ----------
+    label : str
+        A method's or factor's label, e.g. ``"bidirectional (paper decoder)"``.
+
+    Returns
+    -------
+    str
+        The label as a file name stem (``"-"`` for a label with nothing to keep).
+
+    Examples
+    --------
+    >>> slug("bidirectional (paper decoder)"), slug("gamma (uncompensated)"), slug("a/b c")
+    ('bidirectional-paper-decoder', 'gamma-uncompensated', 'a-b-c')
+    """
+    return re.sub(r"[^A-Za-z0-9._-]+", "-", label).strip("-") or "-"
 
 
 def check_output(out: str | Path, captures: Captures | None = None) -> Path:

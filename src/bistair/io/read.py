@@ -402,9 +402,14 @@ def default_spec_path(captures: Captures, files: Sequence[Path] | None = None) -
     return first / "spec.json" if first.is_dir() else files[0].parent / "spec.json"
 
 
-def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
+def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None = None
                    ) -> tuple[np.ndarray, BaseSpec]:
-    """The capture stack and the spec that describes it.
+    """The capture stack and the spec that describes it; ``bistair.read_captures``.
+
+    The captures are given as ``bistair decode`` takes them: a folder, image files, quoted
+    glob patterns (``"scan/pat*.png"``), a list of these, or a ``.npy`` stack. In a
+    notebook: ``stack, spec = bistair.read_captures("caps/")``, then
+    ``bistair.decode(stack, spec)``.
 
     ``spec`` defaults to ``spec.json`` in the captures' folder (the folder given, or the
     folder of the first file). Frames the spec marks ``ignore`` are not read: the spec
@@ -415,9 +420,9 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     captures : str, Path or sequence of str or Path
         Folders, image files, glob patterns or a ``.npy`` stack (see
         :func:`capture_files`).
-    spec : BaseSpec, str, Path or None
-        The spec itself, the path of its JSON file, or ``None`` for ``spec.json`` beside
-        the captures.
+    spec : BaseSpec, str, Path or None, optional
+        The spec itself, the path of its JSON file, or ``None`` (the default) for
+        ``spec.json`` beside the captures.
 
     Returns
     -------
@@ -444,7 +449,7 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None
     >>> _ = (tmp / "spec.json").write_text(spec.to_json())
     >>> for i in range(spec.frame_count):
     ...     write_image(tmp / f"{i:02d}.png", np.full((3, 5), i, np.uint8))
-    >>> stack, used = read_with_spec(tmp, None)
+    >>> stack, used = read_with_spec(tmp)
     >>> stack.shape, stack[:, 0, 0].tolist(), used.frames[0]
     ((6, 3, 5), [1, 2, 3, 4, 5, 6], 'shift-0')
     >>> read_with_spec(sorted(tmp.glob("*.png"))[:3], spec)

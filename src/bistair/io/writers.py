@@ -17,6 +17,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -24,7 +25,7 @@ import numpy as np
 from plyfile import PlyData, PlyElement
 
 from ..core.result import ARRAY_NAMES, AxesResult, DecodeResult
-from .atomic import output_file
+from .atomic import output_file, output_folder
 from .jsonfile import write_json
 from .previews import PREVIEW_NAMES, colorize, write_previews
 
@@ -80,6 +81,56 @@ def write_result(result: DecodeResult | AxesResult, folder: str | Path,
     elif previews:
         write_previews(result, folder)
     write_json(folder / "info.json", result.info)
+
+
+def save_result(result: DecodeResult | AxesResult, folder: str | Path,
+                previews: bool = True) -> Path:
+    """Write what ``bistair decode`` writes into ``folder``, atomically: the arrays,
+    ``info.json`` and, with ``previews``, the PNG previews (:func:`write_result`); the
+    files an earlier decode left there and this one does not write are removed, other files
+    are left alone. Also ``result.save(folder)``.
+
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        The decode.
+    folder : str or Path
+        The output folder (created if needed).
+    previews : bool, optional
+        Also write the PNG previews.
+
+    Returns
+    -------
+    Path
+        ``folder``.
+
+    Raises
+    ------
+    BistairError
+        Raised by :func:`~bistair.io.atomic.output_folder` if the folder cannot be written;
+        nothing is written then.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.core.result import make_result
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> res = make_result("demo", np.full((2, 3), 1.0), np.zeros((2, 3), int), 30.0,
+    ...                   modulation=np.ones((2, 3)))
+    >>> out = save_result(res, tmp / "result")
+    >>> sorted(p.name for p in out.iterdir())[:4]
+    ['coord.npy', 'info.json', 'ks.png', 'mask.npy']
+    >>> sorted(p.name for p in save_result(res, out, previews=False).iterdir())[:4]
+    ['coord.npy', 'info.json', 'mask.npy', 'modulation.npy']
+    >>> shutil.rmtree(tmp)
+    """
+    with output_folder(folder) as tmp:
+        write_result(result, tmp, previews=previews)
+        written = {p.name for p in tmp.iterdir()}
+    for name in RESULT_FILES - written:  # an earlier decode's files there: not this one's
+        with contextlib.suppress(OSError):
+            (Path(folder) / name).unlink()
+    return Path(folder)
 
 
 def write_ply(path: str | Path, points: np.ndarray, colors: np.ndarray | None = None) -> Path:
@@ -143,7 +194,8 @@ def write_depth(depth: np.ndarray, folder: str | Path) -> None:
     """Write ``depth.npy`` (float32, NaN where invalid) and the ``depth.png`` preview.
 
     The preview maps the 1st to 99th percentile of the valid depths to the reversed turbo
-    colormap (near red, far blue), invalid pixels black. Both files are written in place
+    colormap (near red, far blue), invalid pixels black, with a colour bar in mm beside it
+    (:func:`~bistair.io.previews.with_colorbar`). Both files are written in place
     (make the folder with :func:`bistair.io.atomic.output_folder` for atomic output).
 
     Parameters
@@ -167,4 +219,5 @@ def write_depth(depth: np.ndarray, folder: str | Path) -> None:
     np.save(folder / "depth.npy", depth)
     ok = np.isfinite(depth)
     lo, hi = np.percentile(depth[ok], [1, 99]) if ok.any() else (0.0, 1.0)
-    iio.imwrite(folder / "depth.png", colorize(depth, "turbo_r", float(lo), float(hi)))
+    iio.imwrite(folder / "depth.png", colorize(depth, "turbo_r", float(lo), float(hi),
+                                               unit="mm"))

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import cv2
@@ -50,26 +50,42 @@ def board_plane(board: Board, rx: float, ry: float, rz: float, *centre: float) -
 
 def write_board_captures(rig: Rig, board: Board, specs: dict[str, BaseSpec], out: str | Path,
                          poses: Sequence[Sequence[float]] = POSES,
-                         imaging: Imaging | None = None, suffix: str = ".png") -> Path:
+                         imaging: Imaging | None = None, suffix: str = ".png",
+                         progress: Callable[[str], None] | None = None) -> Path:
     """Render ``board`` in every pose for the ``"columns"`` and ``"rows"`` specs and write
     ``board.json`` and ``pose-NN/{columns,rows}/`` into ``out``; or for one ``"both"`` spec
     (both axes in one capture set), ``pose-NN/`` with the captures and their ``spec.json``.
     The board is found in the white frame of specs that have one, else in the mean image
-    (``bistair calibrate``)."""
+    (``bistair calibrate``). ``progress`` is called as each pose starts."""
+    return write_board_sets(rig, board, {"": specs}, out, poses, imaging, suffix, progress)
+
+
+def write_board_sets(rig: Rig, board: Board, sets: dict[str, dict[str, BaseSpec]],
+                     out: str | Path, poses: Sequence[Sequence[float]] = POSES,
+                     imaging: Imaging | None = None, suffix: str = ".png",
+                     progress: Callable[[str], None] | None = None) -> Path:
+    """:func:`write_board_captures` for several pattern sets at once, each pose ray-cast
+    once: ``sets`` maps a sub-folder of ``out`` (``""`` for ``out`` itself) to its specs by
+    orientation, and each sub-folder gets its own ``board.json`` and ``pose-NN/``.
+    ``progress`` is called with ``"rendering board pose N of M"`` as each pose starts."""
     imaging = imaging or Imaging()
-    patterns = {o: encode(s) for o, s in specs.items()}
+    patterns = {(name, o): encode(s) for name, specs in sets.items() for o, s in specs.items()}
     with output_folder(out) as tmp:
-        (tmp / "board.json").write_text(json.dumps(board.to_dict(), indent=2) + "\n")
+        for name in sets:
+            (tmp / name).mkdir(parents=True, exist_ok=True)
+            (tmp / name / "board.json").write_text(json.dumps(board.to_dict(), indent=2) + "\n")
         for i, pose in enumerate(poses):
+            if progress is not None:
+                progress(f"rendering board pose {i + 1} of {len(poses)}")
             traced = trace(rig, Scene([board_plane(board, *pose)]),
                            dataclasses.replace(imaging, seed=imaging.seed + i))
-            for orientation, spec in specs.items():
-                folder = tmp / f"pose-{i:02d}"
+            for (name, orientation), pats in patterns.items():
+                folder = tmp / name / f"pose-{i:02d}"
                 folder = folder if orientation == "both" else folder / orientation
                 folder.mkdir(parents=True)
-                for j, img in enumerate(expose(traced, patterns[orientation])):
+                for j, img in enumerate(expose(traced, pats)):
                     write_image(folder / f"{j:02d}{suffix}", img)
-                (folder / "spec.json").write_text(spec.to_json())
+                (folder / "spec.json").write_text(sets[name][orientation].to_json())
     return Path(out)
 
 

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Literal
 
 import numpy as np
 
@@ -229,7 +230,7 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
-                  strategy: str = "region") -> Orders:
+                  strategy: Literal["region", "paper"] = "region") -> Orders:
     """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy.
 
     The orders are then checked against the stair phase (:func:`stair_fit`).

@@ -1,0 +1,175 @@
+"""What the commands of the ``bistair`` command line share: one-line errors and exit
+code 2, the common options (``--quiet``, ``--force``, ``--threads``, ``--strategy``),
+parameter types that say what they take, and the printing of a decode's warnings."""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from typing import Any
+
+import click
+
+from ..errors import BistairError
+
+
+class CliError(click.ClickException):
+    exit_code = 2
+
+
+
+def reports_errors(func: Callable) -> Callable:
+    """Turn :class:`BistairError` into a one-line message and exit code 2."""
+
+    @functools.wraps(func)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return func(*args, **kwargs)
+        except BistairError as exc:
+            raise CliError(str(exc)) from None
+        except MemoryError:
+            raise CliError("not enough memory for these captures") from None
+
+    return wrapper
+
+
+
+def _quiet(func: Callable) -> Callable:
+    """``--quiet``: no progress and no summary; errors and warnings are still printed."""
+    return click.option("--quiet", "-q", is_flag=True,
+                        help="print only errors and warnings (no progress, no summary)")(func)
+
+
+
+def _force(func: Callable) -> Callable:
+    """``--force``: decode where a thresholded check would refuse."""
+    return click.option("--force", is_flag=True,
+                        help="decode where a thresholded check would refuse the captures: its "
+                        "reasons are printed as warnings and kept in info.json ('forced'); "
+                        "hard errors (frame count, unreadable files, no valid pixel) stay "
+                        "errors")(func)
+
+
+
+def _threads(func: Callable) -> Callable:
+    """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
+
+    def limit(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
+        if value is not None:
+            import cv2
+
+            from ..core.jit import set_threads
+
+            set_threads(value)
+            cv2.setNumThreads(value)
+        return value
+
+    return click.option("--threads", type=click.IntRange(min=1), default=None,
+                        expose_value=False, callback=limit,
+                        help="use at most N threads [default: every core]")(func)
+
+
+
+class _Text(click.ParamType):
+    """A value kept as text for the command to parse, shown in the help by its form
+    (``WxH``, ``NUMBER``: a number, a fraction such as 1920/58 or ``-2*pi/3``, ...)."""
+
+    def __init__(self, metavar: str) -> None:
+        self.name = metavar.lower()
+        self.metavar = metavar
+
+    def get_metavar(self, param: click.Parameter, ctx: click.Context | None = None) -> str:
+        return self.metavar
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        return value
+
+
+
+class _Size(_Text):
+    """``WIDTHxHEIGHT`` as ``(width, height)``."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if isinstance(value, tuple):
+            return value
+        try:
+            width, height = (int(v) for v in str(value).lower().split("x"))
+        except ValueError:
+            self.fail("expected WIDTHxHEIGHT, e.g. 1280x1024", param, ctx)
+        return width, height
+
+
+
+class _Strategy(_Text):
+    """A fringe-order strategy of some method's decoder (each decoder checks its own)."""
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if value not in {v for values in _strategies().values() for v in values}:
+            self.fail(f"{value!r} is no decoder's strategy ({_strategy_help()})", param, ctx)
+        return value
+
+
+
+def _strategies() -> dict[str, tuple[str, ...]]:
+    """Each method's strategies, its default first (from the codecs' order stages)."""
+    from ..codecs import REGISTRY
+
+    return {name: codec.choices["strategy"] for name, codec in REGISTRY.items()
+            if "strategy" in codec.choices}
+
+
+
+def _strategy_help() -> str:
+    from ..codecs import REGISTRY
+
+    listed = "; ".join(f"{name}: {' [default] | '.join(values)}"
+                       for name, values in _strategies().items())
+    alone = [name for name in REGISTRY if name not in _strategies()]
+    return listed + (f" ({' and '.join(alone)}: none)" if alone else "")
+
+
+
+def _method_help() -> str:
+    from ..codecs import REGISTRY
+
+    return ", ".join(REGISTRY)
+
+
+
+class _LazyHelp(click.Option):
+    """An option whose help names what the registry holds, made when the help is shown (so
+    that ``bistair --help`` and every command itself do not import the codecs for it)."""
+
+    def __init__(self, *args: Any, help_from: Callable[[], str], **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.help_from, self.help_text = help_from, kwargs.get("help") or ""
+
+    def get_help_record(self, ctx: click.Context) -> tuple[str, str] | None:
+        self.help = self.help_text.format(self.help_from())
+        return super().get_help_record(ctx)
+
+
+
+def _strategy(func: Callable) -> Callable:
+    """``--strategy``: a fringe-order strategy, listed per method in the help."""
+    return click.option("--strategy", type=_Strategy("STRATEGY"), default=None, cls=_LazyHelp,
+                        help_from=_strategy_help,
+                        help="fringe-order strategy of the method's decoder: {}")(func)
+
+
+
+def _show(value: Any) -> str:
+    """A default as the command line shows it: 30 rather than 30.0."""
+    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
+
+
+
+def _warn(result: Any) -> None:
+    """Print a decode's warnings on stderr, one line each."""
+    infos = [result.info] if not hasattr(result, "x") else [result.x.info, result.y.info]
+    for info in infos:
+        for message in info.get("warnings", []):
+            click.echo(f"Warning: {message}", err=True)

@@ -1,0 +1,113 @@
+"""``bistair scan``: project a pattern set and grab it with a camera.
+
+Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .cli_options import (
+    CliError,
+    _quiet,
+    _warn,
+    reports_errors,
+)
+
+
+@click.command()
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set to project (from 'bistair patterns')")
+@click.option("--display", required=True, metavar="DISPLAY",
+              help="window[:SCREEN] (a full-screen window on the projector's screen, from 0) "
+              "or none (the projector holds the patterns and triggers the camera)")
+@click.option("--camera", required=True, metavar="CAMERA",
+              help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
+              "sim[:SCENE[:WxH]]")
+@click.option("--out", "-o", type=click.Path(path_type=Path), default=None,
+              help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
+@click.option("--settle-ms", type=float, default=None,
+              help="wait after showing each pattern [default: as measured by "
+              "--measure-latency]")
+@click.option("--average", type=int, default=1, show_default=True,
+              help="frames grabbed and averaged per pattern")
+@click.option("--drop", type=int, default=None,
+              help="frames dropped after the wait [default: the camera's buffer]")
+@click.option("--exposure", type=float, default=None,
+              help="camera exposure in its own units (genicam: microseconds)")
+@click.option("--gain", type=float, default=None, help="camera gain in its own units")
+@click.option("--pixel-format", type=click.Choice(["Mono8", "Mono12", "Mono16"]),
+              default=None, help="genicam pixel format")
+@click.option("--decode", "decode_it", is_flag=True,
+              help="also decode the scan into OUT/decode/")
+@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+              help="also reconstruct: OUT/decode/cloud.ply, depth.npy")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="with --calibration: keep points with depth z in [MIN, MAX] mm")
+@click.option("--measure-latency", is_flag=True,
+              help="flash black and white, time when the camera sees it and save the settle "
+              "time for this display and camera (no scan)")
+@click.option("--latency-file", type=click.Path(path_type=Path), default=None,
+              help="where measured settle times are kept [default: "
+              "~/.config/bistair/latency.json or $BISTAIR_LATENCY_FILE]")
+@_quiet
+@reports_errors
+def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
+         settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
+         gain: float | None, pixel_format: str | None, decode_it: bool,
+         calibration: Path | None, depth_range: str | None, measure_latency: bool,
+         latency_file: Path | None, quiet: bool) -> None:
+    """Project a pattern set with DISPLAY, grab it with CAMERA, write a capture folder.
+
+    Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
+    grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly."""
+    from .progress import Progress
+
+    settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
+    if measure_latency:
+        from .scan import measure_settle
+
+        with Progress(quiet) as say:
+            latency, path = measure_settle(display, camera, latency_file, progress=say,
+                                           **settings)
+        if not quiet:
+            times = latency.latencies_ms
+            click.echo(f"latency {latency.display} -> {latency.camera}: {min(times):.0f} to "
+                       f"{max(times):.0f} ms over {len(times)} changes (camera levels: black "
+                       f"{100 * latency.black:.1f}%, white {100 * latency.white:.1f}%); settle "
+                       f"{latency.settle_ms:g} ms saved to {path}")
+        return
+    for name, value in (("--spec", spec_path), ("--out", out)):
+        if value is None:
+            raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
+    from .jobs import parse_depth_range
+    from .scan import scan_folder
+
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    with Progress(quiet) as say:
+        report = scan_folder(spec_path, display, camera, out, decode=decode_it,
+                             calibration=calibration, depth_range=(low, high), progress=say,
+                             settle_ms=settle_ms, average=average, drop=drop,
+                             latency_file=latency_file, **settings)
+    info = report.scan.info
+    for message in info["warnings"]:
+        click.echo(f"Warning: {message}", err=True)
+    if report.decoded is not None:
+        _warn(report.decoded)
+    if quiet:
+        return
+    frames = report.scan.frames
+    click.echo(f"scanned {len(frames)} {report.scan.spec.method} patterns with "
+               f"{info['display']['name']} and {info['camera']['name']} in "
+               f"{info['seconds']:.1f} s (settle {info['settle_ms']:g} ms, "
+               f"{info['settle_source']}; {frames.shape[2]}x{frames.shape[1]} "
+               f"{frames.dtype.itemsize * 8}-bit frames); wrote {out}")
+    result = report.decoded
+    if result is not None:
+        click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
+                   f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}/decode")
+    if report.reconstruction is not None:
+        click.echo(f"{int(report.reconstruction.mask.sum())} points; wrote "
+                   f"{out}/decode/cloud.ply and depth.npy")

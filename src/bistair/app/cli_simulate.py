@@ -1,0 +1,160 @@
+"""``bistair simulate``: preset scenes, data sets and two cameras on the virtual rig.
+
+Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from .cli_options import (
+    CliError,
+    _LazyHelp,
+    _method_help,
+    _quiet,
+    _Size,
+    reports_errors,
+)
+
+
+@click.command()
+@click.option("--scene", default=None, metavar="SCENE", help="preset scene (paper-sim, "
+              "two-masks, mask-prism, two-sculptures, plane, sphere-on-plane, "
+              "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
+              "checkerboard in eight poses)")
+@click.option("--method", "methods", required=True, multiple=True, metavar="METHOD",
+              cls=_LazyHelp, help_from=_method_help,
+              help="method to render (repeatable): {} or all")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
+              "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
+              "(OUT/<method>/ each for several methods)")
+@click.option("--camera", type=_Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
+              "[default: 1280x1024]")
+@click.option("--noise", type=float, default=0.01, show_default=True,
+              help="read noise, fraction of full scale")
+@click.option("--blur", type=float, default=1.0, show_default=True,
+              help="camera defocus, Gaussian sigma in pixels")
+@click.option("--gamma", type=float, default=2.2, show_default=True, help="projector gamma")
+@click.option("--compensated/--uncompensated", default=True, show_default=True,
+              help="patterns pre-compensate the projector gamma")
+@click.option("--ambient", type=float, default=0.05, show_default=True,
+              help="ambient light on the scene, fraction of the projector's full white")
+@click.option("--bits", type=click.Choice(["8", "10", "12", "16"]), default="8",
+              show_default=True, help="camera bit depth")
+@click.option("--seed", type=int, default=0, show_default=True,
+              help="seed of the noise (with --count, of the whole data set)")
+@click.option("--count", type=int, default=None,
+              help="a data set: COUNT scenes in OUT/scene-NNNN/ and OUT/index.csv, rendered "
+              "in parallel")
+@click.option("--vary", default=None, metavar="optics,objects,pose",
+              help="with --count: what each scene draws at random (see README)")
+@click.option("--workers", type=int, default=None,
+              help="with --count: processes of the local cluster [default: the cores]")
+@click.option("--scheduler", default=None, metavar="tcp://HOST:PORT",
+              help="with --count: run on an existing Dask cluster instead")
+@click.option("--no-white", is_flag=True,
+              help="--scene calibration: no white frame (the board is found in the mean image)")
+@click.option("--both-axes", is_flag=True,
+              help="--scene calibration: one capture set of both axes per pose")
+@click.option("--cameras", type=click.IntRange(1, 2), default=1, show_default=True,
+              help="2: a second camera (OUT/<method>/L and R, stereo.json, truth/L and R)")
+@click.option("--baseline", type=float, default=200.0, show_default=True,
+              help="with --cameras 2: mm between the cameras (the projector between them)")
+@_quiet
+@reports_errors
+def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
+             camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
+             compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
+             vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
+             both_axes: bool, cameras: int, baseline: float, quiet: bool) -> None:
+    """Render a preset scene on the virtual rig: one capture folder per method + the truth.
+
+    With --count N, a data set of N scenes (deterministic for a --seed whatever the number
+    of workers), each varied as --vary says. With --cameras 2, two cameras and the
+    projector between them, for 'bistair stereo'."""
+    from ..codecs import REGISTRY
+
+    chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
+    imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
+                   bits=int(bits))
+    if cameras == 2:
+        if no_white or both_axes:
+            raise CliError("--no-white and --both-axes are for one camera's --scene "
+                           "calibration")
+        _simulate_stereo(scene, chosen, out, camera, compensated, seed, count, baseline,
+                         quiet, imaging)
+        return
+    if count is None:
+        for name, value in (("--vary", vary), ("--workers", workers),
+                            ("--scheduler", scheduler)):
+            if value is not None:
+                raise CliError(f"{name} applies to a data set: give --count too")
+        if scene is None:
+            raise CliError("name a --scene (or give --count with --vary objects)")
+        from .progress import Progress
+        from .simulate import simulate as run
+
+        with Progress(quiet) as say:
+            run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
+                progress=say, white=not no_white, both_axes=both_axes, **imaging)
+        if quiet:
+            return
+        if scene == "calibration":
+            where = str(out) if len(chosen) == 1 else f"{out}/<method>/"
+            click.echo(f"wrote {', '.join(chosen)} board captures (8 poses, "
+                       f"{'both axes at once' if both_axes else 'both orientations'}) to "
+                       f"{where}")
+        else:
+            click.echo(f"wrote {', '.join(chosen)} captures of {scene} and its ground truth "
+                       f"to {out}")
+        return
+    if no_white or both_axes:
+        raise CliError("--no-white and --both-axes are for --scene calibration")
+    from .simulate import simulate_many
+
+    try:
+        report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
+                               camera_size=camera, compensated=compensated, workers=workers,
+                               scheduler=scheduler,
+                               show_progress=sys.stderr.isatty() and not quiet, **imaging)
+    except KeyboardInterrupt:
+        click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
+                   "written", err=True)
+        raise click.exceptions.Abort() from None
+    for name, error in report.failed:
+        click.echo(f"failed {name}: {error}", err=quiet)
+    if not quiet:
+        click.echo(f"wrote {count - len(report.failed)} of {count} scenes ({len(report.rows)} "
+                   f"capture sets) and index.csv to {out} in {report.seconds:.1f} s on "
+                   f"{report.workers} worker{'s' if report.workers != 1 else ''}")
+    if report.failed:
+        raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
+
+
+
+def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
+                     camera: tuple[int, int] | None, compensated: bool, seed: int,
+                     count: int | None, baseline: float, quiet: bool,
+                     imaging: dict[str, Any]) -> None:
+    """``bistair simulate --cameras 2``."""
+    from .progress import Progress
+    from .stereo import simulate_stereo
+
+    if count is not None:
+        raise CliError("--cameras 2 renders one scene: leave out --count")
+    if scene is None:
+        raise CliError("name a --scene")
+    with Progress(quiet) as say:
+        simulate_stereo(scene, methods, out, camera_size=camera, baseline=baseline,
+                        compensated=compensated, progress=say, seed=seed, **imaging)
+    if quiet:
+        return
+    if scene == "calibration":
+        click.echo(f"wrote board pairs (8 poses, left and right) to {out}")
+    else:
+        click.echo(f"wrote {', '.join(methods)} captures of {scene} from two cameras "
+                   f"{baseline:g} mm apart (L/, R/), stereo.json and the truth to {out}")

@@ -1,0 +1,116 @@
+"""``bistair stereo`` and ``bistair calibrate-stereo``: two cameras and a projector.
+
+Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+import numpy as np
+
+from .cli_options import _quiet, _strategy, _threads, reports_errors
+
+
+@click.command("stereo")
+@click.argument("left")
+@click.argument("right")
+@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+              help="spec.json of the pattern set, for both cameras [default: spec.json beside "
+              "LEFT]")
+@click.option("--calibration", required=True, type=click.Path(path_type=Path),
+              help="the two cameras' calibration (bistair calibrate-stereo, or "
+              "import-calibration --stereo)")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="output folder")
+@click.option("--depth-range", default=None, metavar="MIN:MAX",
+              help="keep points with depth z in [MIN, MAX] mm (left camera frame); also "
+              "narrows the search")
+@click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
+              "matches; the decoder's checks where it offers this), as warnings in info.json")
+@_strategy
+@click.option("--min-modulation", type=float, default=None,
+              help="modulation threshold as a fraction of full scale [default: from noise]")
+@click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
+              help="Gaussian sigma of a smoothing of the projector coordinates before "
+              "matching (never across surfaces): less depth noise, less lateral detail; 0: none")
+@click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
+@_threads
+@_quiet
+@reports_errors
+def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
+           depth_range: str | None, force: bool, strategy: str | None,
+           min_modulation: float | None, smooth: float, no_previews: bool,
+           quiet: bool) -> None:
+    """Two cameras and a projector: decode both cameras' captures of one pattern set, match
+    equal absolute phase along rectified rows, triangulate.
+
+    LEFT, RIGHT: each camera's captures, a folder, a quoted glob pattern or a .npy stack.
+    Writes OUT/left/ and OUT/right/ (each decode), disparity.npy, depth.npy, depth.png,
+    cloud.ply (left camera frame, mm) and info.json. The projector needs no calibration."""
+    from .jobs import parse_depth_range
+    from .progress import Progress
+    from .stereo import stereo_folder, warnings
+
+    low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
+               if v is not None}
+    with Progress(quiet) as say:
+        res = stereo_folder(left, right, out, calibration, spec_path, min_depth=low,
+                            max_depth=high, force=force, smooth=smooth,
+                            previews=not no_previews, progress=say, **options)
+    for message in warnings(res):
+        click.echo(f"Warning: {message}", err=True)
+    if quiet:
+        return
+    info = res.info
+    rejected = info["inconsistent"] + info["ambiguous"] + info["not_monotonic"] + \
+        info["other_axis"] + info["alone"]
+    within = f" at {low:g}-{high:g} mm" if depth_range else ""
+    click.echo(f"{info['matched']} points from {info['left_decoded']} decoded left pixels "
+               f"({100 * info['matched_fraction']:.1f}%; {info['unmatched']} without a match "
+               f"in the right camera{within}, {rejected} rejected by the checks); wrote {out}")
+
+
+
+@click.command("calibrate-stereo")
+@click.argument("poses", type=click.Path(path_type=Path))
+@click.option("--board", default=None, metavar="chessboard:COLSxROWS:SQUARE",
+              help="the board: inner corners and square size (mm), or a board.json "
+              "[default: POSES/board.json]")
+@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+              help="stereo calibration file to write (JSON)")
+@click.option("--min-poses", type=int, default=3, show_default=True,
+              help="fewest poses with the board found in both images (3 or more)")
+@_quiet
+@reports_errors
+def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
+                     quiet: bool) -> None:
+    """Calibrate two cameras from image pairs of a board.
+
+    POSES: one folder per pose holding a left and a right image (named left/right, else in
+    name order), or left/ and right/ folders whose images pair up in name order. Poses
+    where the board is not found in both images are skipped."""
+    from .progress import Progress
+    from .stereo import calibrate_stereo_folder
+
+    with Progress(quiet) as say:
+        cal, skipped = calibrate_stereo_folder(poses, out, board, min_poses, progress=say)
+    for name in skipped:
+        click.echo(f"Warning: pose {name} skipped: the board is not found in both images",
+                   err=True)
+    if quiet:
+        return
+    click.echo(f"stereo RMS {cal.rms:.3f} px (left {cal.left.rms:.3f} px, right "
+               f"{cal.right.rms:.3f} px), baseline {cal.baseline:.2f} +/- "
+               f"{cal.uncertainty.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} "
+               f"poses; wrote {out}")
+    for name, dev, sd in (("left", cal.left, cal.uncertainty.camera),
+                          ("right", cal.right, cal.uncertainty.projector)):
+        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
+        click.echo(f"  {name + ':':7s} " + ", ".join(
+            f"{key} {v:.2f} +/- {s:.2f}"
+            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
+    for pose in cal.poses:
+        click.echo(f"  {pose['name']}: {pose['features']} corners, left "
+                   f"{pose['left_rms']:.3f} px, right {pose['right_rms']:.3f} px")

@@ -1,0 +1,321 @@
+"""The binocular jobs behind the command line: reconstruct from two cameras
+(``bistair stereo``), calibrate two cameras from board pairs (``bistair calibrate-stereo``),
+import an OpenCV stereo calibration (``bistair import-calibration --stereo``) and render a
+two-camera scene (``bistair simulate --cameras 2``).
+
+Each reads its inputs, works in memory and writes its outputs atomically, so a failed job
+leaves nothing behind.
+
+``bistair stereo`` writes into ``OUT``::
+
+    left/, right/      each camera's decode, as ``bistair decode`` writes it
+    disparity.npy      float32 on the rectified left grid, NaN where unmatched
+    depth.npy          float32 z (mm) on the left camera's own image grid, NaN where unknown
+    depth.png          its preview
+    cloud.ply          x, y, z (mm) in the left camera's frame, grey from the white frame
+                       (else the fringes' average)
+    info.json          the matching's counts, the rectification, both decodes' warnings
+
+Examples
+--------
+>>> parse_board("chessboard:9x6:20")
+Board(type='checkerboard', columns=9, rows=6, spacing=20.0)
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..codecs import encode
+from ..errors import BistairError
+from ..evaluation.benchmark import method_specs
+from ..geometry.board import BOARD_TYPES, Board
+from ..geometry.calibration import Calibration, load_calibration, save_calibration
+from ..geometry.stereo import StereoResult, stereo
+from ..geometry.stereo_calibrate import calibrate_stereo_images
+from ..geometry.stereo_calibration import (
+    StereoCalibration,
+    is_stereo_file,
+    load_stereo_calibration,
+    save_stereo_calibration,
+)
+from ..geometry.stereo_opencv import read_opencv_stereo
+from ..io.atomic import check_output, output_folder, write_image
+from ..io.jsonfile import write_json
+from ..io.read import find_spec, list_images, natural_key, read_image, read_with_spec
+from ..io.writers import write_depth, write_ply, write_result
+from ..sim import preset, scene_names, trace
+from ..sim.render import expose
+from ..sim.stereo import StereoRig, write_board_pairs
+from ..spec import BaseSpec
+from .jobs import parse_keys, parse_size
+from .simulate import _imaging, write_truth
+
+Say = Callable[[str], None]
+SIDES = (("L", "R"), ("left", "right"))  # the folders of a stereo capture set
+
+
+def _silent(stage: str) -> None:
+    """The progress callback of a job nobody watches."""
+
+
+# -- reconstruct -----------------------------------------------------------------------------
+def stereo_folder(left: Any, right: Any, out: str | Path,
+                  calibration: StereoCalibration | str | Path,
+                  spec: BaseSpec | str | Path | None = None, min_depth: float = 0.0,
+                  max_depth: float = np.inf, force: bool = False, smooth: float = 1.0,
+                  previews: bool = True, progress: Say | None = None,
+                  **options: Any) -> StereoResult:
+    """Decode two cameras' captures (each a folder, image files, a glob pattern or a ``.npy``
+    stack, as for ``bistair decode``) of one pattern set, match and triangulate, and write
+    the files of the module docstring into ``out``.
+
+    ``spec`` defaults to ``spec.json`` beside the left captures and is used for both;
+    ``calibration`` must be a stereo calibration (``"kind": "stereo"``). ``force`` goes to
+    the decoder when it takes it and keeps a reconstruction with few matches; ``smooth``:
+    see :func:`~bistair.geometry.stereo.reconstruct_stereo`. ``options`` are decoder
+    options. Nothing is written on error.
+    """
+    say = progress or _silent
+    for side in (left, right):
+        check_output(out, side)
+    if isinstance(calibration, Calibration):
+        raise BistairError("a camera-projector calibration was given: stereo needs the two "
+                           "cameras' calibration (bistair calibrate-stereo)")
+    if not isinstance(calibration, StereoCalibration):
+        calibration = load_stereo_calibration(calibration)
+    spec = find_spec(left, spec)
+    stacks = []
+    for name, captures in (("left", left), ("right", right)):
+        say(f"reading the {name} captures")
+        try:
+            stacks.append(read_with_spec(captures, spec))
+        except BistairError as exc:
+            raise BistairError(f"{name}: {exc}") from None
+    (lstack, used), (rstack, _) = stacks
+    say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
+        f"({used.method}) and matching")
+    result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
+                    max_depth=max_depth, force=force, smooth=smooth, **options)
+    say(f"writing {int(result.mask.sum())} points")
+    with output_folder(out) as tmp:
+        write_stereo(result, tmp, previews)
+    return result
+
+
+def write_stereo(result: StereoResult, folder: Path, previews: bool = True) -> None:
+    """Write a binocular reconstruction into the existing ``folder`` (module docstring)."""
+    for name, res in (("left", result.left), ("right", result.right)):
+        (folder / name).mkdir(exist_ok=True)
+        write_result(res, folder / name, previews=previews)
+    np.save(folder / "disparity.npy", result.disparity)
+    write_depth(result.depth, folder)
+    write_ply(folder / "cloud.ply", *result.cloud())
+    write_json(folder / "info.json", {**result.info, "warnings": warnings(result)})
+
+
+def warnings(result: StereoResult) -> list[str]:
+    """The warnings of both decodes (``left: ...``, ``right: ...``) and of the matching."""
+    out = []
+    for name, res in (("left", result.left), ("right", result.right)):
+        infos = [res.info] if not hasattr(res, "x") else [res.x.info, res.y.info]
+        out += [f"{name}: {w}" for info in infos for w in info.get("warnings", [])]
+    return out + list(result.info.get("warnings", []))
+
+
+def stereo_pair(captures: str | Path) -> tuple[Path, Path] | None:
+    """The left and right capture folders of a stereo set (``L/`` and ``R/``, or ``left/``
+    and ``right/``), ``None`` if ``captures`` is not such a folder."""
+    folder = Path(captures)
+    for names in SIDES:
+        if all((folder / n).is_dir() for n in names):
+            return folder / names[0], folder / names[1]
+    return None
+
+
+def is_stereo_calibration(path: str | Path | None) -> bool:
+    """Whether ``path`` names a stereo calibration file (``False`` for ``None``)."""
+    return path is not None and is_stereo_file(path)
+
+
+def check_calibration_file(path: str | Path) -> StereoCalibration | Calibration:
+    """Read a calibration file of either kind (one-line error if it is neither)."""
+    return load_stereo_calibration(path) if is_stereo_file(path) else load_calibration(path)
+
+
+# -- calibrate -------------------------------------------------------------------------------
+def parse_board(text: str) -> Board:
+    """``"chessboard:COLSxROWS:SQUARE"`` (inner corners, mm; also ``checkerboard``,
+    ``circles``, ``asymmetric-circles``) as a :class:`~bistair.geometry.board.Board`."""
+    parts = text.strip().split(":")
+    kind = parts[0].strip().lower()
+    kind = "checkerboard" if kind == "chessboard" else kind
+    try:
+        if len(parts) != 3 or kind not in BOARD_TYPES:
+            raise ValueError
+        cols, rows = parse_size(parts[1], "board")
+        square = float(parts[2])
+    except (ValueError, BistairError):
+        raise BistairError(f"--board must be chessboard:COLSxROWS:SQUARE (inner corners, "
+                           f"square in mm), e.g. chessboard:9x6:20, got {text!r}") from None
+    return Board(kind, cols, rows, square)
+
+
+def board_pairs(folder: str | Path) -> tuple[list[str], list[Path], list[Path]]:
+    """The poses of a stereo calibration folder: ``(names, left images, right images)``.
+
+    Either ``left/`` and ``right/`` folders whose images pair up in natural name order, or
+    one sub-folder per pose holding two images: the one whose name says ``left`` (or ``l``)
+    and the one that says ``right`` (or ``r``), else the first and second in name order.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise BistairError(f"calibration captures {folder} not found")
+    if (folder / "left").is_dir() and (folder / "right").is_dir():
+        left, right = (list_images(folder / side) for side in ("left", "right"))
+        if len(left) != len(right) or not left:
+            raise BistairError(f"{folder}/left has {len(left)} images and {folder}/right "
+                               f"{len(right)}: they pair up one to one")
+        return [p.stem for p in left], left, right
+    names, lefts, rights = [], [], []
+    for sub in sorted((p for p in folder.iterdir() if p.is_dir()),
+                      key=lambda p: natural_key(p.name)):
+        images = list_images(sub)
+        if len(images) != 2:
+            raise BistairError(f"pose {sub.name} holds {len(images)} images: one left and one "
+                               "right image are needed")
+        sides = [_side(p.stem) for p in images]
+        if sides == ["right", "left"]:
+            images = images[::-1]
+        names.append(sub.name)
+        lefts.append(images[0])
+        rights.append(images[1])
+    if not names:
+        raise BistairError(f"no poses in {folder}: give one folder per pose holding a left and "
+                           "a right image, or left/ and right/ folders of pairs")
+    return names, lefts, rights
+
+
+def _side(stem: str) -> str | None:
+    words = stem.lower().replace("-", "_").replace(".", "_").split("_")
+    if "left" in words or "l" in words or stem.lower().startswith("left"):
+        return "left"
+    if "right" in words or "r" in words or stem.lower().startswith("right"):
+        return "right"
+    return None
+
+
+def calibrate_stereo_folder(folder: str | Path, out: str | Path | None = None,
+                            board: Board | str | Path | None = None, min_poses: int = 3,
+                            progress: Say | None = None
+                            ) -> tuple[StereoCalibration, list[str]]:
+    """Calibrate two cameras from board image pairs (:func:`board_pairs`) and write the
+    stereo calibration to ``out`` (atomically) if given; returns it and the poses skipped
+    (board not found in both images). ``board``: a Board, ``"chessboard:9x6:20"``, a
+    ``board.json``, or by default ``FOLDER/board.json``."""
+    say = progress or _silent
+    names, lefts, rights = board_pairs(folder)
+    if board is None:
+        board = Board.load(Path(folder) / "board.json")
+    elif isinstance(board, str) and ":" in board:
+        board = parse_board(board)
+    elif not isinstance(board, Board):
+        board = Board.load(board)
+    say(f"reading {len(names)} image pairs")
+    left = [read_image(p) for p in lefts]
+    right = [read_image(p) for p in rights]
+    say(f"finding the board and calibrating from {len(names)} poses")
+    cal, skipped = calibrate_stereo_images(left, right, board, names, min_poses)
+    if out is not None:
+        save_stereo_calibration(cal, out)
+    return cal, skipped
+
+
+def import_stereo_calibration(files: Sequence[str | Path], out: str | Path,
+                              camera_size: tuple[int, int] | str | None = None,
+                              keys: Mapping[str, str] | str | None = None
+                              ) -> StereoCalibration:
+    """Read an OpenCV FileStorage stereo calibration (left camera first) and write it as a
+    bistair stereo calibration ``out`` (atomically); ``keys`` renames parts (a mapping or
+    ``"left=K1,T=T"``). Nothing is written on error."""
+    if isinstance(camera_size, str):
+        camera_size = parse_size(camera_size, "--camera-size")
+    if isinstance(keys, str):
+        keys = parse_keys(keys)
+    cal = read_opencv_stereo(list(files), camera_size, keys)
+    save_stereo_calibration(cal, out)
+    return cal
+
+
+# -- simulate --------------------------------------------------------------------------------
+def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
+                    camera_size: tuple[int, int] | None = None, baseline: float = 200.0,
+                    compensated: bool = True, progress: Say | None = None,
+                    **imaging: Any) -> Path:
+    """Render ``scene`` on the two-camera rig (:class:`~bistair.sim.stereo.StereoRig`:
+    cameras ``baseline`` mm apart, the projector between them) for each method and write::
+
+        OUT/<method>/L/, OUT/<method>/R/   each camera's captures and spec.json
+        OUT/truth/L/, OUT/truth/R/         each camera's truth (as bistair simulate)
+        OUT/stereo.json                    the cameras' exact calibration
+        OUT/calibration.json               the left camera and the projector's
+        OUT/scene.json                     the scene, rig and imaging
+
+    The scene ``calibration`` writes a 9 x 6 chessboard (20 mm) in eight poses instead,
+    ``OUT/pose-NN/left.png`` and ``right.png`` with ``board.json`` (what ``bistair
+    calibrate-stereo`` reads). ``imaging`` goes to :class:`~bistair.sim.Imaging`.
+    """
+    say = progress or _silent
+    if not 10 <= baseline <= 2000:
+        raise BistairError(f"--baseline must be 10 to 2000 mm, got {baseline:g}")
+    if scene not in (*scene_names(), "calibration"):
+        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
+                           "calibration)")
+    im = _imaging(compensated, imaging)
+    size = {} if camera_size is None else {"camera_size": camera_size}
+    if scene == "calibration":
+        srig = StereoRig.default(baseline=baseline, **size)
+        return write_board_pairs(srig, Board("checkerboard", 9, 6, 20.0), out, imaging=im)
+    rig, geometry = preset(scene, **size)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             baseline=baseline)
+    specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
+                         methods=methods)
+    patterns = {method: encode(spec) for method, (spec, _) in specs.items()}
+    with output_folder(out) as tmp:
+        truths = {}
+        for i, (side, folder) in enumerate((("left", "L"), ("right", "R"))):
+            say(f"tracing the scene from the {side} camera")
+            cam = dataclasses.replace(im, seed=im.seed + i)
+            traced = trace(srig.rig(side), geometry, cam)
+            truths[folder] = traced.truth
+            for method, (spec, _) in specs.items():
+                say(f"rendering {method} ({side})")
+                sub = tmp / method / folder
+                sub.mkdir(parents=True)
+                for k, img in enumerate(expose(traced, patterns[method], cam)):
+                    write_image(sub / f"{k:02d}.png", img)
+                (sub / "spec.json").write_text(spec.to_json())
+        (tmp / "truth").mkdir()
+        first = next(iter(specs.values()))[0]
+        for folder, truth in truths.items():
+            write_truth(tmp / "truth" / folder, truth, first)
+        save_stereo_calibration(StereoCalibration.from_rig(srig), tmp / "stereo.json")
+        save_calibration(Calibration.from_rig(srig.rig("left")), tmp / "calibration.json")
+        write_json(tmp / "scene.json", {
+            "scene": scene, "methods": list(methods), "compensated": compensated,
+            "cameras": 2, "baseline": baseline, "imaging": dataclasses.asdict(im),
+            "rig": {name: _device(getattr(srig, name))
+                    for name in ("left", "right", "projector")}})
+    return Path(out)
+
+
+def _device(dev: Any) -> dict[str, Any]:
+    return {"width": dev.width, "height": dev.height, "K": dev.K.tolist(),
+            "dist": list(dev.dist), "R": dev.R.tolist(), "t": dev.t.tolist()}
+

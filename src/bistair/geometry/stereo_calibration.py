@@ -1,0 +1,258 @@
+"""A calibrated pair of cameras (binocular structured light): the type and its file.
+
+The two cameras use OpenCV's pinhole model and distortion ``(k1, k2, p1, p2, k3)``
+(:class:`~bistair.geometry.calibration.Device`); ``R, T`` map the left camera's frame to the
+right one's, ``X_right = R @ X_left + T`` (millimetres; what ``cv2.stereoCalibrate``
+returns with the left camera first). The projector is not part of it.
+
+File (JSON): bistair's calibration format with ``"kind": "stereo"``::
+
+    {"format": "bistair-calibration", "version": 1, "kind": "stereo",
+     "left":  {"width": W, "height": H, "K": 3x3, "dist": [k1, k2, p1, p2, k3], "rms": px},
+     "right": {... the same ...},
+     "R": 3x3, "T": [tx, ty, tz], "baseline": |T| (mm), "rms": stereo RMS (px),
+     "poses": [{"name": ..., "features": n, "left_rms": px, "right_rms": px}, ...],
+     "poses_used": n, "poses_total": m, "board": {...},
+     "uncertainty": {"left": {"fx": ..., ...}, "right": {...}, "rotation_deg": [...],
+                     "T": [...], "baseline": mm, "noise": {"left": px, "right": px}}}
+
+A camera-projector calibration (:mod:`bistair.geometry.calibration`, no ``kind`` or
+``"kind": "camera-projector"``) keeps its own layout; each reader refuses the other kind with
+one line.
+
+Examples
+--------
+>>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+>>> cal = StereoCalibration(cam, cam, np.eye(3), [-120.0, 0.0, 0.0])
+>>> data = cal.to_dict()
+>>> data["kind"], data["baseline"], StereoCalibration.from_dict(data).right.size
+('stereo', 120.0, (640, 480))
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import BistairError
+from ..io.atomic import output_file
+from ..io.jsonfile import read_json
+from .calibration import FORMAT, VERSION, Calibration, Device, Uncertainty, _array, _device
+
+KIND = "stereo"
+_SIDES = (("left", "camera"), ("right", "projector"))  # our names, Uncertainty's
+
+
+@dataclass(frozen=True, eq=False)
+class StereoCalibration:
+    """Two calibrated cameras; ``X_right = R @ X_left + T`` (mm). ``uncertainty`` holds one
+    standard deviation of every quantity (its ``camera`` is the left camera, its
+    ``projector`` the right one)."""
+
+    left: Device
+    right: Device
+    R: np.ndarray
+    T: np.ndarray
+    rms: float | None = None
+    poses: tuple[dict[str, Any], ...] = ()
+    board: dict[str, Any] | None = None
+    poses_total: int | None = None
+    uncertainty: Uncertainty | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "R", np.asarray(self.R, float).reshape(3, 3))
+        object.__setattr__(self, "T", np.asarray(self.T, float).reshape(3))
+
+    @property
+    def baseline(self) -> float:
+        """Distance between the camera centres (mm)."""
+        return float(np.linalg.norm(self.T))
+
+    def replace(self, **changes: Any) -> StereoCalibration:
+        """A copy with some fields changed."""
+        return dataclasses.replace(self, **changes)
+
+    @classmethod
+    def from_pair(cls, pair: Calibration) -> StereoCalibration:
+        """The same numbers read as two cameras: the pair's camera is the left camera, its
+        "projector" the right one (e.g. from
+        :func:`~bistair.geometry.calibrate.calibrate_points`)."""
+        poses = tuple({"name": p["name"], "features": p["features"],
+                       "left_rms": p["camera_rms"], "right_rms": p["projector_rms"]}
+                      for p in pair.poses)
+        return cls(pair.camera, pair.projector, pair.R, pair.T, pair.rms, poses, pair.board,
+                   pair.poses_total, pair.uncertainty)
+
+    @classmethod
+    def from_rig(cls, rig: Any) -> StereoCalibration:
+        """The exact calibration of a :class:`bistair.sim.stereo.StereoRig` (left camera at
+        the world origin)."""
+        left, right = rig.left, rig.right
+        if not (np.allclose(left.R, np.eye(3)) and np.allclose(left.t, 0)):
+            raise BistairError("the rig's left camera must sit at the world origin")
+        return cls(Device(left.width, left.height, left.K, left.dist_coeffs),
+                   Device(right.width, right.height, right.K, right.dist_coeffs),
+                   right.R, right.t)
+
+    def to_dict(self) -> dict[str, Any]:
+        sigma = None
+        if self.uncertainty is not None:
+            sigma = self.uncertainty.to_dict()
+            for ours, theirs in _SIDES:
+                sigma[ours] = sigma.pop(theirs)
+                sigma["noise"][ours] = sigma["noise"].pop(theirs)
+        return {"format": FORMAT, "version": VERSION, "kind": KIND,
+                "left": self.left.to_dict(), "right": self.right.to_dict(),
+                "R": self.R.tolist(), "T": self.T.tolist(), "baseline": self.baseline,
+                "rms": self.rms, "poses": list(self.poses), "poses_used": len(self.poses),
+                "poses_total": self.poses_total, "board": self.board, "uncertainty": sigma}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> StereoCalibration:
+        """Validate and build from the dictionary of a stereo calibration file."""
+        if not isinstance(data, Mapping) or data.get("format") != FORMAT:
+            raise BistairError(f"not a bistair calibration (no \"format\": \"{FORMAT}\")")
+        if data.get("version") != VERSION:
+            raise BistairError(f"calibration version {data.get('version')!r} is not supported")
+        if data.get("kind") != KIND:
+            raise BistairError("a camera-projector calibration, not a stereo one (two "
+                               "cameras, \"kind\": \"stereo\"; make one with bistair "
+                               "calibrate-stereo or import-calibration --stereo)")
+        devices = [_device(data, side) for side, _ in _SIDES]
+        rot = _array(data, "R", ((3, 3),))
+        if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) or np.linalg.det(rot) < 0:
+            raise BistairError("calibration field 'R' is not a rotation matrix")
+        sigma = data.get("uncertainty")
+        if isinstance(sigma, Mapping):
+            sigma = dict(sigma)
+            noise = dict(sigma.get("noise") or {})
+            for ours, theirs in _SIDES:
+                sigma[theirs] = sigma.pop(ours, None)
+                noise[theirs] = noise.pop(ours, None)
+            sigma = Uncertainty.from_dict({**sigma, "noise": noise})
+        elif sigma is not None:
+            raise BistairError("calibration field 'uncertainty' must be an object or null")
+        rms = data.get("rms")
+        return cls(*devices, rot, _array(data, "T", ((3,),)),
+                   float(rms) if isinstance(rms, int | float) and math.isfinite(rms) else None,
+                   tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"),
+                   sigma)
+
+
+def save_stereo_calibration(calibration: StereoCalibration, path: str | Path) -> Path:
+    """Write a stereo calibration file atomically (layout in the module docstring).
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        What to save.
+    path : str or Path
+        The JSON file (its folder is created if needed; an existing file is replaced).
+
+    Returns
+    -------
+    Path
+        ``path``.
+
+    Raises
+    ------
+    BistairError
+        Raised by :func:`~bistair.io.atomic.output_file` if the file cannot be written.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> path = save_stereo_calibration(StereoCalibration(cam, cam, np.eye(3), [-120, 0, 0]),
+    ...                                tmp / "stereo.json")
+    >>> json.loads(path.read_text())["kind"]
+    'stereo'
+    >>> shutil.rmtree(tmp)
+    """
+    path = Path(path)
+    with output_file(path) as tmp:
+        tmp.write_text(json.dumps(calibration.to_dict(), indent=2) + "\n")
+    return path
+
+
+def load_stereo_calibration(path: str | Path) -> StereoCalibration:
+    """Read and validate a stereo calibration file.
+
+    Parameters
+    ----------
+    path : str or Path
+        A JSON file written by :func:`save_stereo_calibration` (``bistair calibrate-stereo``,
+        ``bistair import-calibration --stereo``).
+
+    Returns
+    -------
+    StereoCalibration
+
+    Raises
+    ------
+    BistairError
+        A missing, unreadable or malformed file, or a camera-projector calibration; the
+        message names the file.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> from bistair.geometry.calibration import save_calibration
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> _ = save_stereo_calibration(StereoCalibration(cam, cam, np.eye(3), [-120, 0, 0]),
+    ...                             tmp / "stereo.json")
+    >>> load_stereo_calibration(tmp / "stereo.json").baseline
+    120.0
+    >>> _ = save_calibration(Calibration(cam, cam, np.eye(3), [-120, 0, 0]), tmp / "mono.json")
+    >>> load_stereo_calibration(tmp / "mono.json")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: calibration file .../mono.json: a camera-projector calibration, ...
+    >>> shutil.rmtree(tmp)
+    """
+    path = Path(path)
+    data = read_json(path, "calibration file")
+    try:
+        return StereoCalibration.from_dict(data)
+    except BistairError as exc:
+        raise BistairError(f"calibration file {path}: {exc}") from None
+
+
+def is_stereo_file(path: str | Path) -> bool:
+    """Whether a calibration file says it is a stereo calibration (``"kind": "stereo"``).
+
+    Parameters
+    ----------
+    path : str or Path
+        A calibration JSON file.
+
+    Returns
+    -------
+    bool
+        ``True`` for a stereo calibration; ``False`` for any other JSON object.
+
+    Raises
+    ------
+    BistairError
+        A missing or unreadable file, or one that is not JSON.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> _ = (tmp / "a.json").write_text('{"kind": "stereo"}')
+    >>> is_stereo_file(tmp / "a.json")
+    True
+    >>> shutil.rmtree(tmp)
+    """
+    data = read_json(path, "calibration file")
+    return isinstance(data, Mapping) and data.get("kind") == KIND

@@ -1,0 +1,191 @@
+"""The compiled passes of binocular matching against exact answers: resampling without
+mixing surfaces, where pixels land on the rectified grid (against OpenCV), the row search for
+equal phase (against a plain search on random rising rows), its refusals (gaps, steps,
+falls, two places), the row-support check and the points."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+
+from bistair.geometry.stereo_jit import (
+    ALONE,
+    AMBIGUOUS,
+    INCONSISTENT,
+    MATCHED,
+    NOT_MONOTONIC,
+    OTHER_AXIS,
+    UNMATCHED,
+    grid_depth,
+    match_pair,
+    rectified_positions,
+    remap_valid,
+    supported,
+)
+
+
+def test_remap_interpolates_one_surface_and_never_two():
+    rng = np.random.default_rng(0)
+    plane = (3.0 * np.arange(40)[None, :] + 0.5 * np.arange(30)[:, None]).astype(np.float32)
+    mx = rng.uniform(0, 39, (20, 25)).astype(np.float32)
+    my = rng.uniform(0, 29, (20, 25)).astype(np.float32)
+    got = remap_valid(plane, mx, my, 10.0)
+    np.testing.assert_allclose(got, 3.0 * mx + 0.5 * my, atol=1e-3)  # bilinear is exact
+    step = plane.copy()
+    step[:, 20:] += 100.0  # a second surface
+    got = remap_valid(step, mx, my, 10.0)
+    between = (mx > 19) & (mx < 20)
+    assert np.isnan(got[between]).all() and np.isfinite(got[~between]).all()
+    hole = plane.copy()
+    hole[10, 10] = np.nan
+    got = remap_valid(hole, np.float32([[10.0, 10.5, 11.0]]), np.float32([[10.0, 10.0, 10.0]]),
+                      10.0)
+    assert np.isnan(got[0, :2]).all() and got[0, 2] == plane[10, 11]
+    off = remap_valid(plane, np.float32([[-0.5, 39.5, 5.0]]), np.float32([[5.0, 5.0, np.nan]]),
+                      10.0)
+    assert np.isnan(off).all()
+
+
+def test_rectified_positions_agree_with_opencv():
+    K = np.array([[610.0, 0.0, 322.5], [0, 608.0, 241.0], [0, 0, 1]])  # OpenCV: no skew
+    dist = np.array([-0.28, 0.11, 0.0012, -0.0008, -0.02])
+    rot = cv2.Rodrigues(np.array([0.02, -0.15, 0.01]))[0]
+    u, v, rx, ry = rectified_positions(K, dist, rot, 600.0, 330.0, 250.0, (640, 480))
+    pix = np.stack(np.meshgrid(np.arange(0, 640, 7.0), np.arange(0, 480, 5.0)), -1).reshape(-1, 2)
+    proj = np.array([[600.0, 0, 330.0], [0, 600.0, 250.0], [0, 0, 1]])
+    want = cv2.undistortPoints(pix.reshape(-1, 1, 2), K, dist, R=rot, P=proj,
+                               criteria=(cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100,
+                                         1e-14)).reshape(-1, 2)
+    rows, cols = pix[:, 1].astype(int), pix[:, 0].astype(int)
+    np.testing.assert_allclose(u[rows, cols], want[:, 0], atol=2e-3)
+    np.testing.assert_allclose(v[rows, cols], want[:, 1], atol=2e-3)
+    rays = cv2.undistortPoints(pix.reshape(-1, 1, 2), K, dist, criteria=(
+        cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 100, 1e-14)).reshape(-1, 2)
+    np.testing.assert_allclose(rx[rows, cols], rays[:, 0], atol=2e-6)
+    np.testing.assert_allclose(ry[rows, cols], rays[:, 1], atol=2e-6)
+
+
+def rising_row(rng: np.random.Generator, width: int) -> np.ndarray:
+    """A strictly rising random row (steps 0.3 to 1.7)."""
+    return np.cumsum(rng.uniform(0.3, 1.7, width)).astype(np.float32)
+
+
+def test_match_pair_finds_every_value_where_a_plain_search_does():
+    rng = np.random.default_rng(1)
+    h, w = 40, 200
+    right = np.stack([rising_row(rng, w) for _ in range(h)])
+    left = np.full((h, 120), np.nan, np.float32)
+    # where each left value lies on its right row: rising along the row, as on a surface
+    truth = np.sort(rng.uniform(5, w - 6, (h, 120)), axis=1)
+    for y in range(h):
+        left[y] = np.interp(truth[y], np.arange(w), right[y])
+    left[:, ::7] = np.nan
+    xs = np.arange(120)[None, :]
+    d, status = match_pair(left, right, -400.0, 400.0, reach=1)
+    ok = np.isfinite(left)
+    assert (status[ok] == MATCHED).all() and (status[~ok] == 0).all()
+    np.testing.assert_allclose(d[ok], (xs - truth)[ok], atol=2e-3)  # disparity x - x_r
+
+
+def test_the_line_through_four_samples_on_a_smooth_phase():
+    x = np.arange(400.0)
+    phase = 0.8 * x + 1e-3 * x**2 + 2.0 * np.sin(x / 40)  # rising, curved as on a surface
+    truth = np.linspace(20, 370, 300)
+    left = np.interp(truth, x, phase).astype(np.float32)[None, :]  # its values at truth
+    d, status = match_pair(left, phase.astype(np.float32)[None, :], -400.0, 400.0)
+    assert (status == MATCHED).all()
+    exact = np.interp(np.interp(truth, x, phase), phase, x)  # the piecewise-linear answer
+    assert np.abs((np.arange(300) - d[0]) - exact).max() < 0.01
+
+
+@pytest.mark.parametrize("reach", [1, 2])
+def test_matches_are_exact_on_linear_rows_and_windows_are_kept(reach):
+    x = np.arange(300, dtype=np.float32)
+    right = np.tile(0.8 * x + 3.0, (3, 1))
+    left = np.tile(0.8 * (x[:100] + 57.25) + 3.0, (3, 1))  # lies 57.25 columns on
+    d, status = match_pair(left, right, 0.0, 300.0, shift=2.0, reach=reach)
+    assert (status == MATCHED).all()
+    np.testing.assert_allclose(d, -57.25 - 2.0, atol=1e-3)
+    _, status = match_pair(left, right, 0.0, 50.0, reach=reach)  # outside the window
+    assert (status == UNMATCHED).all()
+
+
+def test_gaps_steps_falls_and_two_places_are_refused():
+    nan = math.nan
+    right = np.float32([[0, 1, 2, 3, nan, nan, nan, nan, 4, 5, 6]])
+    d, status = match_pair(np.float32([[2.5, 3.5, 4.5]]), right, -20.0, 20.0)
+    assert status.tolist() == [[MATCHED, UNMATCHED, MATCHED]]  # 3.5 lies in a 5-column gap
+    np.testing.assert_allclose(d[0, [0, 2]], [0 - 2.5, 2 - 8.5], atol=1e-6)
+    stepped = np.float32([[0, 1, 2, 3, 40, 41, 42, 43]])  # two surfaces, no gap
+    for values, want in (([19.5, 20.0], UNMATCHED), ([41.0, 41.5], MATCHED)):
+        _, status = match_pair(np.float32([values]), stepped, -20.0, 20.0, jump=5.0)
+        assert status[0, 1] == want
+    _, status = match_pair(np.float32([[19.5, 20.0]]), stepped, -20.0, 20.0)  # no jump limit
+    assert status[0, 1] == MATCHED
+    _, status = match_pair(np.float32([[2.0] + [nan] * 4 + [2.5]]), right, -20.0, 20.0)
+    assert status[0, [0, 5]].tolist() == [INCONSISTENT] * 2  # no run on the left row
+    fall = np.float32([[0, 1, 2, 3, 4, 1, 2, 3, 4, 5]])  # the phase runs back by 3 px
+    _, status = match_pair(np.float32([[2.5, 4.5, 4.7]]), fall, -20.0, 20.0)
+    assert status[0, :2].tolist() == [NOT_MONOTONIC, MATCHED]
+    noisy = np.float32([[0, 1, 2, 1.9, 3, 4, 5]])  # noise: back by a tenth of a step
+    _, status = match_pair(np.float32([[1.95, 3.5]]), noisy, -20.0, 20.0, wiggle=1.0)
+    assert status.tolist() == [[NOT_MONOTONIC, MATCHED]]  # crossed at 1.95 and 3.05
+    d, status = match_pair(np.float32([[1.95, 3.5]]), noisy, -20.0, 20.0, wiggle=1.5)
+    assert status.tolist() == [[MATCHED, MATCHED]]
+    assert d[0, 0] == pytest.approx(-(1.95 + 3 + 0.05 / 1.1) / 2, abs=1e-6)  # the midpoint
+    twice = np.float32([[0, 1, 2, 3, nan, nan, nan, nan, 0, 1, 2, 3]])
+    _, status = match_pair(np.float32([[1.5, 1.7]]), twice, -20.0, 20.0)
+    assert status[0, 0] == AMBIGUOUS
+    _, status = match_pair(np.float32([[1.5, 1.7]]), twice, -20.0, 3.0)  # the window decides
+    assert status[0, 0] == MATCHED
+
+
+def test_the_match_back_and_the_second_coordinate():
+    x = np.arange(20, dtype=np.float32)
+    right = (x + 100).reshape(1, -1)
+    left = np.full((1, 30), np.nan, np.float32)
+    left[0, :20] = x + 100
+    left[0, 25:27] = [104.0, 104.5]  # the same values again further on the left row
+    d, status = match_pair(left, right, -40.0, 40.0)
+    assert status[0, 4] == INCONSISTENT and status[0, 3] == MATCHED
+    other_l = np.zeros((1, 30), np.float32)
+    other_r = np.zeros((1, 20), np.float32)
+    other_r[0, 10:] = 5.0  # the second coordinate disagrees from column 10 of the right
+    _, status = match_pair(left[:, :20], right, -40.0, 40.0, other=other_l[:, :20],
+                           other_right=other_r)
+    assert (status[0, 2:9] == MATCHED).all() and (status[0, 11:18] == OTHER_AXIS).all()
+    other_r[0, 10:] = np.nan  # not decoded there: nothing to disagree with
+    _, status = match_pair(left[:, :20], right, -40.0, 40.0, other=other_l[:, :20],
+                           other_right=other_r)
+    assert (status[0, 2:18] == MATCHED).all()
+
+
+def test_a_match_one_row_thin_is_dropped():
+    d = np.full((5, 4), 100.0, np.float32)
+    d[2, 1] = 160.0  # a lone row of another surface
+    d[3:, 3] = np.nan
+    d[2, 3] = 130.0
+    kept, status = supported(d, np.full((5, 4), MATCHED, np.int8))
+    assert np.isnan(kept[2, 1]) and status[2, 1] == ALONE
+    assert np.isnan(kept[2, 3]) and status[2, 3] == ALONE  # its only neighbour differs
+    assert np.isfinite(np.delete(kept.ravel(), [9, 11, 15, 19])).all()
+
+
+def test_grid_depth_triangulates_and_turns_back():
+    rot = cv2.Rodrigues(np.array([0.0, 0.1, 0.02]))[0]  # camera -> rectified frame
+    f, cx, cy, tx = 500.0, 320.0, 240.0, -100.0
+    point = np.array([30.0, -20.0, 700.0])  # camera frame
+    rect = rot @ point
+    u, v = f * rect[0] / rect[2] + cx, f * rect[1] / rect[2] + cy
+    d = -f * tx / rect[2]
+    disparity = np.full((480, 640), d, np.float32)
+    depth, outside = grid_depth(disparity, np.float32([[u, 5.0]]), np.float32([[v, 5.0]]),
+                                np.array([[True, False]]), f, cx, cy, tx, rot)
+    assert depth[0, 0] == pytest.approx(700.0, abs=2e-3) and np.isnan(depth[0, 1])
+    assert outside == 0
+    depth, outside = grid_depth(disparity, np.float32([[u]]), np.float32([[v]]),
+                                np.ones((1, 1), bool), f, cx, cy, tx, rot, max_depth=600.0)
+    assert np.isnan(depth).all() and outside == 1
