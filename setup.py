@@ -27,7 +27,10 @@ class BuildWithKernels(build_py):
         root = Path("src").resolve() if getattr(self, "editable_mode", False) \
             else Path(self.build_lib).resolve()
         folder = root / "bistair" / "_kernels"
-        env = {**os.environ, "PYTHONPATH": str(root)}
+        # the package first, then what pip's isolated build environment puts on the path
+        # (numpy and numba of [build-system] requires: the new environment has none yet)
+        path = [str(root), *filter(None, os.environ.get("PYTHONPATH", "").split(os.pathsep))]
+        env = {**os.environ, "PYTHONPATH": os.pathsep.join(path)}
         env.pop("BISTAIR_KERNELS", None)
         print(f"compiling the decode kernels into {folder} (BISTAIR_NO_PREBUILD=1 skips it)",
               flush=True)
