@@ -36,7 +36,7 @@ docs: $(DOCS_STAMP)
 	$(BIN)/python -m sphinx -W --keep-going -b html docs docs/_build/html
 
 clean:
-	rm -rf $(VENV) demo-out .pytest_cache build src/*.egg-info docs/_build docs/auto_examples \
+	rm -rf $(VENV) demo-out .pytest_cache build src/*.egg-info src/bistair/_kernels docs/_build docs/auto_examples \
 		docs/api/*.rst docs/sg_execution_times.rst
 	# numba's cache files are keyed by file and line: they pile up after code moves
 	find src tests -path '*/__pycache__/*' \( -name '*.nbi' -o -name '*.nbc' \) -delete

@@ -2,37 +2,36 @@
 
 Renders (once, kept in ``--data``) 20 scenes of 1280 x 1024 (1.3 MP) with
 ``bistair simulate --count`` (bidirectional, optics, objects and pose varied), then decodes
-them, in rounds, three ways: a plain loop of :func:`bistair.app.jobs.decode_folder` in this
-process (what a loop over ``bistair decode`` does, without its start-up), and
-:func:`bistair.app.batch.run_batch` on a local cluster of 1 and of 2 workers (wall time
-from the call to its return: cluster start and stop, every set, ``batch.csv``). Each writes
-the same files (previews included). The machine is shared and its speed varies from minute
-to minute, so the three are interleaved in each round and the figures printed are the
-median and the best of the rounds and each round's ratios to its own plain loop; the load
-average is printed alongside.
+them, in rounds, three ways, each in a new Python process as a user runs them: a plain loop
+of :func:`bistair.app.jobs.decode_folder` (a script's loop over the sets), and
+:func:`bistair.app.batch.run_batch` (what ``bistair batch`` runs) on a local cluster of 1
+and of 2 workers. Each is timed from after its imports to its end: the loop pays the
+kernels' loading in its first decode, the batch its cluster's start and stop, its workers'
+start and the kernels' loading in them, every set and ``batch.csv``. Each writes the same
+files, with the previews and again without them (``--no-previews``). The machine is shared
+and its speed varies from minute to minute, so the ways are interleaved in each round and
+the figures printed are the median and the best of the rounds and each round's ratios to
+its own plain loop; the load average and a probe of the free cores are printed alongside.
 
     python benchmarks/batch_speed.py [--sets 20] [--rounds 3] [--data bench-out/batch-data]
 
-Targets (issue 12): overhead per set at most 10% of the loop's time per set; near-linear
-in workers (2 workers close to twice the scans per second of 1, given 2 free cores).
+Targets (issue 23): overhead per set at most 10% of the loop's time per set (1 worker
+against the loop); 2 workers at least 1.6 times the plain loop's scans per second.
 """
 
 from __future__ import annotations
 
 import argparse
 import csv
+import json
 import os
 import shutil
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
-from bistair.app.batch import run_batch
-from bistair.app.engine import dask_client
-from bistair.app.jobs import decode_folder
 from bistair.app.simulate import simulate_many
 
 CAMERA = (1280, 1024)
@@ -57,20 +56,40 @@ def data_set(folder: Path, sets: int) -> list[Path]:
     return [folder / r["captures"] for r in report.rows]
 
 
-def plain_loop(captures: list[Path], out: Path) -> float:
-    start = time.perf_counter()
-    for folder in captures:
-        decode_folder(folder, out / folder.parent.name)
-    return time.perf_counter() - start
+# Each way runs in a new process: its imports first, then the timed work; it prints
+# {"seconds": ...} last.
+LOOP = """
+import json, sys, time
+from pathlib import Path
+from bistair.app.jobs import decode_folder
+from bistair.core.memory import keep_freed_memory
+keep_freed_memory()  # as the command line and each batch task do
+folders, out, previews = json.loads(sys.argv[1]), Path(sys.argv[2]), sys.argv[3] == "1"
+start = time.perf_counter()
+for folder in folders:
+    decode_folder(folder, out / Path(folder).parent.name, previews=previews)
+print(json.dumps({"seconds": time.perf_counter() - start}))
+"""
+BATCH = """
+import json, sys, time
+from bistair.app.batch import run_batch
+from bistair.core.memory import keep_freed_memory
+keep_freed_memory()  # as the command line does
+manifest, out, previews, workers = sys.argv[1], sys.argv[2], sys.argv[3] == "1", int(sys.argv[4])
+start = time.perf_counter()
+report = run_batch(manifest, out, workers=workers, previews=previews)
+seconds = time.perf_counter() - start
+if report.failed:
+    raise SystemExit(f"batch failed: {report.failed[0]}")
+print(json.dumps({"seconds": seconds}))
+"""
 
 
-def batch(manifest: Path, out: Path, workers: int) -> float:
-    start = time.perf_counter()
-    report = run_batch(manifest, out, workers=workers)
-    seconds = time.perf_counter() - start
-    if report.failed:
-        raise SystemExit(f"batch failed: {report.failed[0]}")
-    return seconds
+def timed(code: str, *args: str) -> float:
+    done = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"failed:\n{done.stdout}\n{done.stderr}")
+    return json.loads(done.stdout.strip().splitlines()[-1])["seconds"]
 
 
 PROBE = """
@@ -97,11 +116,7 @@ def free_cores() -> float:
     return 2 * alone / run(2)
 
 
-def cluster_start_stop(workers: int) -> float:
-    start = time.perf_counter()
-    with dask_client(workers):
-        pass
-    return time.perf_counter() - start
+WAYS = ("loop", "1", "2")
 
 
 def main() -> None:
@@ -109,6 +124,7 @@ def main() -> None:
     parser.add_argument("--sets", type=int, default=20)
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--data", type=Path, default=Path("bench-out/batch-data"))
+    parser.add_argument("--previews", choices=("both", "yes", "no"), default="both")
     args = parser.parse_args()
     captures = data_set(args.data, args.sets)
     n = len(captures)
@@ -116,40 +132,43 @@ def main() -> None:
     manifest = work / "sets.csv"
     manifest.write_text("captures,out\n" + "".join(f"{c.absolute()},{c.parent.name}\n"
                                                    for c in captures))
-    times: dict[str, list[float]] = {k: [] for k in ("loop", "1", "2", "start1", "start2")}
+    folders = json.dumps([str(c.absolute()) for c in captures])
+    kinds = {"both": (True, False), "yes": (True,), "no": (False,)}[args.previews]
+    times: dict[tuple[bool, str], list[float]] = {(p, w): [] for p in kinds for w in WAYS}
     cores: list[float] = []
     loads = [os.getloadavg()[0]]
     try:
         for r in range(args.rounds):
-            for key in ("loop", "1", "2"):
-                out = work / f"out-{key}"
-                shutil.rmtree(out, ignore_errors=True)
-                t = plain_loop(captures, out) if key == "loop" else batch(manifest, out,
-                                                                          int(key))
-                times[key].append(t)
-                print(f"round {r + 1}: {'plain loop' if key == 'loop' else key + ' worker(s)'}"
-                      f" {t:.1f} s", flush=True)
-            for w in (1, 2):
-                times[f"start{w}"].append(cluster_start_stop(w))
+            for previews in kinds:
+                for way in WAYS:
+                    out = work / "out"
+                    shutil.rmtree(out, ignore_errors=True)
+                    flag = "1" if previews else "0"
+                    t = (timed(LOOP, folders, str(out), flag) if way == "loop"
+                         else timed(BATCH, str(manifest), str(out), flag, way))
+                    times[(previews, way)].append(t)
+                    print(f"round {r + 1}, previews {'on' if previews else 'off'}: "
+                          f"{'plain loop' if way == 'loop' else way + ' worker(s)'} {t:.1f} s",
+                          flush=True)
             cores.append(free_cores())
             loads.append(os.getloadavg()[0])
     finally:
         shutil.rmtree(work, ignore_errors=True)
     print()
     print(f"{n} sets of {CAMERA[0]}x{CAMERA[1]} ({CAMERA[0] * CAMERA[1] / 1e6:.1f} MP), "
-          f"{METHOD}, previews written; {args.rounds} interleaved round(s); "
+          f"{METHOD}; {args.rounds} interleaved round(s), each way in a new process; "
           f"{os.cpu_count()} CPUs, load average {min(loads):.1f}-{max(loads):.1f} during the "
           "run (other work on the machine slows every figure)")
-    for label, pick in (("median", statistics.median), ("best", min)):
-        report(label, {k: pick(v) for k, v in times.items()}, n)
-    print()
-    print("per round, against that round's plain loop: 1 worker " + ", ".join(
-        f"{lp / t:.2f}" for lp, t in zip(times["loop"], times["1"], strict=True))
-          + "; 2 workers " + ", ".join(
-        f"{lp / t:.2f}" for lp, t in zip(times["loop"], times["2"], strict=True)))
-    print("2 workers against 1, per round: " + ", ".join(
-        f"{a / b:.2f}" for a, b in zip(times["1"], times["2"], strict=True))
-          + "; the cores two processes got at the end of each round (a NumPy probe, 2.00 = "
+    for previews in kinds:
+        for label, pick in (("median", statistics.median), ("best", min)):
+            report(f"{label} of the rounds, previews {'on' if previews else 'off'}",
+                   {w: pick(times[(previews, w)]) for w in WAYS}, n)
+        loop = times[(previews, "loop")]
+        print("per round, against that round's plain loop: 1 worker " + ", ".join(
+            f"{a / b:.2f}" for a, b in zip(loop, times[(previews, "1")], strict=True))
+              + "; 2 workers " + ", ".join(
+            f"{a / b:.2f}" for a, b in zip(loop, times[(previews, "2")], strict=True)))
+    print("\nthe cores two processes got at the end of each round (a NumPy probe, 2.00 = "
           "two free cores): " + ", ".join(f"{c:.2f}" for c in cores))
 
 
@@ -157,22 +176,18 @@ def report(label: str, med: dict[str, float], n: int) -> None:
     """The table and the two targets for one pick of the rounds (median or best)."""
     loop = med["loop"]
     print()
-    print(f"{label} of the rounds{'':8s}{'wall s':>8s}{'scans/s':>10s}{'vs loop':>9s}")
-    print(f"{'plain loop':30s}{loop:8.1f}{n / loop:10.3f}{1.0:9.2f}")
-    for w in (1, 2):
-        t = med[str(w)]
-        print(f"{f'batch, {w} worker' + ('s' if w > 1 else ''):30s}{t:8.1f}{n / t:10.3f}"
-              f"{loop / t:9.2f}")
+    print(f"{label:<42}{'wall s':>8s}{'scans/s':>10s}{'vs loop':>9s}")
+    print(f"{'plain loop':42s}{loop:8.1f}{n / loop:10.3f}{1.0:9.2f}")
+    for w in ("1", "2"):
+        t = med[w]
+        name = f"batch, {w} worker" + ("s" if w != "1" else "")
+        print(f"{name:42s}{t:8.1f}{n / t:10.3f}{loop / t:9.2f}")
     per_set = loop / n
     over = (med["1"] - loop) / n
-    fixed = med["start1"]
     print(f"overhead per set, 1 worker against the plain loop: {over:+.3f} s = "
           f"{100 * over / per_set:+.1f}% of the loop's {per_set:.2f} s per set "
-          f"(target <= 10%); of it the cluster's start and stop, {fixed:.1f} s once, is "
-          f"{fixed / n:.3f} s per set over {n} sets; the rest "
-          f"{100 * (over - fixed / n) / per_set:+.1f}%")
-    print(f"2 workers against 1: {med['1'] / med['2']:.2f} times the scans per second "
-          f"(linear: 2.00; cluster start and stop {med['start2']:.1f} s)")
+          f"(target <= 10%); 2 workers: {loop / med['2']:.2f} times the loop's scans per "
+          f"second (target >= 1.6), {med['1'] / med['2']:.2f} times 1 worker's")
 
 
 if __name__ == "__main__":

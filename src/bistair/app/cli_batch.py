@@ -17,6 +17,8 @@ from .cli_options import (
     reports_errors,
 )
 
+BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batch.csv)
+
 
 @click.command()
 @click.argument("root", type=click.Path(path_type=Path))
@@ -55,6 +57,7 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     columns captures, spec, calibration, out (paths relative to the manifest; empty cells
     take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
     into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
+    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input.
     """
     from .batch import run_batch
     from .jobs import parse_depth_range
@@ -76,3 +79,5 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
         click.echo(f"failed {row['name']}: {row['error']}", err=quiet)
     if not quiet:
         click.echo(f"{report.summary()}; wrote {out / 'batch.csv'}")
+    if report.failed:  # scripts can tell: 0 every set decoded, 3 some failed, 2 bad input
+        sys.exit(BATCH_SETS_FAILED)

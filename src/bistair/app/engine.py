@@ -26,6 +26,7 @@ import contextlib
 import logging
 import os
 import signal
+import sys
 import threading
 import uuid
 from collections.abc import Callable, Iterable, Iterator, Sequence
@@ -164,7 +165,8 @@ def _client(workers: int | None, scheduler: str | None, tasks: int | None
     try:
         # the dashboard on a free port: None still serves it on 8787, with a three-line
         # warning on the user's terminal whenever another cluster holds that port
-        with dask.config.set(WORKER_CONFIG):
+        with dask.config.set({**WORKER_CONFIG,
+                              "distributed.worker.multiprocessing-method": start_method()}):
             cluster = LocalCluster(n_workers=count, threads_per_worker=1, processes=True,
                                    dashboard_address=":0", silence_logs=logging.ERROR)
     finally:
@@ -178,6 +180,27 @@ def _client(workers: int | None, scheduler: str | None, tasks: int | None
             client.close()
     finally:
         cluster.close()
+
+
+def start_method() -> str:
+    """How the local cluster starts its worker processes: ``fork`` where it is safe (Linux,
+    and numba's OpenMP threads not started in this process: forked after that, a worker
+    would abort), else ``spawn``.
+
+    A forked worker starts with this process's modules imported and its compiled kernels
+    loaded, in some 0.1 s; a spawned one imports bistair, numba, OpenCV and SciPy and loads
+    the kernels again (seconds, on every worker), which a batch of fast decodes would pay
+    as a large share of its time.
+
+    >>> start_method() in ("fork", "spawn")
+    True
+    """
+    if not sys.platform.startswith("linux"):
+        return "spawn"
+    parallel = sys.modules.get("numba.np.ufunc.parallel")
+    if parallel is not None and getattr(parallel, "_is_initialized", True):
+        return "spawn"
+    return "fork"
 
 
 def _main_thread() -> bool:

@@ -12,7 +12,9 @@ Short work prints nothing: the first line appears once the command has run ``del
 seconds (1 s on a terminal, 5 s elsewhere, or the environment variable
 ``BISTAIR_PROGRESS_DELAY``); from then on every stage is reported as it starts, and in a
 log a stage that runs long is repeated every 30 s.
-Errors and warnings are printed whatever the setting.
+Errors and warnings are printed whatever the setting. When a compiled kernel is not found
+in a cache and has to be compiled (:func:`bistair.core.jit.on_compile`), one line says so
+at once (:data:`COMPILE_NOTICE`), unless quiet.
 """
 
 from __future__ import annotations
@@ -23,6 +25,12 @@ import threading
 import time
 from types import TracebackType
 from typing import IO
+
+from ..core.jit import on_compile
+
+COMPILE_NOTICE = ("compiling the decode kernels for this machine: a minute or two, once "
+                  "(they are kept; an install from source compiles them beforehand)")
+_ACTIVE: list[Progress] = []  # the open Progress that prints the compile notice
 
 
 def _delay(live: bool) -> float:
@@ -81,6 +89,9 @@ class Progress:
         if not self.quiet:
             self._thread = threading.Thread(target=self._tick, daemon=True)
             self._thread.start()
+        if not _ACTIVE:
+            on_compile(_compile_notice)  # once per process (the first kernel compiled)
+        _ACTIVE.append(self)
         return self
 
     def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None,
@@ -89,6 +100,8 @@ class Progress:
 
     def close(self) -> None:
         """Stop the clock and erase the live line (before the result or an error is printed)."""
+        if self in _ACTIVE:
+            _ACTIVE.remove(self)
         self._stop.set()
         if self._thread is not None:
             self._thread.join()
@@ -101,12 +114,20 @@ class Progress:
     def warn(self, message: str) -> None:
         """Print one warning line now, also when quiet (above the live line, which the clock
         draws again)."""
+        self._line(f"Warning: {message}")
+
+    def note(self, message: str) -> None:
+        """Print one line ``bistair: <message>`` now, unless quiet (above the live line)."""
+        if not self.quiet:
+            self._line(f"bistair: {message}")
+
+    def _line(self, text: str) -> None:
         with self._lock:
             if self.live and self.width:
                 self._write("\r" + " " * self.width + "\r")
                 self.width = 0
             try:
-                self.stream.write(f"Warning: {message}\n")
+                self.stream.write(text + "\n")
                 self.stream.flush()
             except (OSError, ValueError):
                 pass
@@ -142,3 +163,10 @@ class Progress:
             self.stream.flush()
         except (OSError, ValueError):  # a closed pipe: progress is not worth failing for
             self.quiet = True
+
+
+def _compile_notice() -> None:
+    """The first kernel of the process is being compiled: one line from the open Progress
+    (the innermost), if any."""
+    if _ACTIVE:
+        _ACTIVE[-1].note(COMPILE_NOTICE)

@@ -44,6 +44,7 @@ import numpy as np
 
 from ..core.captures import Prepared, check_decodable, modulation_threshold
 from ..core.checks import EdgeCheck
+from ..core.jit import kernel_frames
 from ..core.measure import FringeSet, along_fringe_noise
 from .base import CodeMap
 from .graycode_jit import alone_cells, alone_levels
@@ -161,8 +162,9 @@ def measure_alone(prepared: Prepared, spec: GrayCodeSpec,
     bits = spec.code_bits
     noise = alone_noise(prepared, bits, bool(spec.inverse))
     threshold = modulation_threshold(noise, min_modulation)
-    avg, mod = alone_levels(prepared.raw, bits, bool(spec.inverse), float(prepared.scale),
-                            _frame(prepared.white), _frame(prepared.black))
+    avg, mod = alone_levels(kernel_frames(prepared.raw)[0], bits, bool(spec.inverse),
+                            float(prepared.scale), _frame(prepared.white),
+                            _frame(prepared.black))
     valid = mod >= np.float32(threshold)
     check_decodable(valid, prepared.clipped, min_modulation, mod)
     phi = np.full(valid.shape, np.float32(cell_phase(spec.period)), np.float32)
@@ -211,7 +213,7 @@ def code_alone(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     # (noise sqrt(1.5) sigma)
     clear = max(CLEAR * fs.noise * (math.sqrt(2.0) if spec.inverse else math.sqrt(1.5)),
                 MIN_CLEAR)
-    cell = alone_cells(prepared.raw, spec.code_bits, bool(spec.inverse),
+    cell = alone_cells(kernel_frames(prepared.raw)[0], spec.code_bits, bool(spec.inverse),
                        float(prepared.scale), fs.avg, fs.valid, float(clear))
     far = cell >= spec.fringes
     beyond = int(np.count_nonzero(far))

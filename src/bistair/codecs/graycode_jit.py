@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel
+from ..core.jit import _numba_inline, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -75,7 +75,8 @@ def code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndar
     >>> code_bits(raw, 0, 1, 1 / 255, np.float32([[0.5, 0.5]]), inverse=True).tolist()
     [[0, 0]]
     """
-    return _code_bits(raw, int(start), int(bits), float(np.float32(scale)),
+    raw, start = kernel_frames(raw, start, 2 * bits if inverse else bits)
+    return _code_bits(raw, start, int(bits), float(np.float32(scale)),
                       np.asarray(avg, np.float32), bool(inverse))
 
 

@@ -1,14 +1,22 @@
-"""The numba decorator, thread control and the compiled helpers several passes share.
+"""The numba decorator, the compiled kernels' cache, thread control and the compiled helpers
+several passes share.
 
 The compiled passes of a concept module ``X.py`` live beside it in ``X_jit.py``
 (:mod:`.phase_jit`, :mod:`.measure_jit`, :mod:`.stair_jit`, :mod:`.regions_jit`,
 :mod:`.resolve_jit`, :mod:`.checks_jit`, :mod:`.result_jit`); a pass that one codec alone
 uses lives beside that codec. Every pass is plain Python over arrays, marked with
-:func:`kernel` and compiled with numba on its first call (``cache=True``: once per machine,
-kept in ``__pycache__``); numba itself is imported only then, so importing bistair or
-starting the command line does not pay for it. Passes that loop over image rows or chunks
-run them on every core (``prange``); :func:`set_threads` limits that. Each pass gives, bit
-for bit, what the NumPy it replaced gives (the exceptions say so in their docstrings).
+:func:`kernel` and compiled with numba on its first call; numba itself is imported only
+then, so importing bistair or starting the command line does not pay for it. Passes that
+loop over image rows or chunks run them on every core (``prange``); :func:`set_threads`
+limits that. Each pass gives, bit for bit, what the NumPy it replaced gives (the exceptions
+say so in their docstrings).
+
+Compiled kernels are looked up, in order, in the folder of kernels compiled when bistair was
+installed (``bistair/_kernels``, made by :mod:`.prebuild`; the environment variable
+``BISTAIR_KERNELS`` names another folder, or ``none``) and in numba's own cache
+(``__pycache__`` beside the source, ``NUMBA_CACHE_DIR`` or the user's cache folder), where a
+kernel compiled here is kept. A kernel found in neither is compiled, which takes seconds;
+:func:`on_compile` lets a caller say so (core itself prints nothing).
 
 Examples
 --------
@@ -18,23 +26,32 @@ Examples
 
 from __future__ import annotations
 
+import atexit
+import hashlib
 import math
 import os
+import sys
 from collections.abc import Callable
 from functools import wraps
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 prange = range  # numba's prange once the first kernel compiles
 _COMPILED: dict[str, Any] = {}
+PREBUILT = Path(__file__).resolve().parents[1] / "_kernels"  # made at install time
+KERNELS_ENV = "BISTAIR_KERNELS"
+RECORD_ENV = "BISTAIR_RECORD_KERNELS"  # a file: the signatures compiled, added at exit
+_LISTENERS: list[Callable[[], None]] = []
+_STATE: dict[str, Any] = {"told": False, "building": None, "cache_class": None}
 
 
 def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
     """Compile the decorated function with ``numba.njit`` on its first call.
 
-    The compiled function is kept per function (module and name) and cached on disk
-    (``cache=True``); the plain Python function stays available as the wrapper's
+    The compiled function is kept per function (module and name) and cached on disk (see
+    the module's docstring); the plain Python function stays available as the wrapper's
     ``py_func``. Helpers marked for inlining are compiled into the kernels when the first
     kernel of their module compiles (and ``prange`` becomes numba's there).
 
@@ -65,23 +82,300 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
         def call(*args: Any) -> Any:
             compiled = _COMPILED.get(key)
             if compiled is None:
-                numba = _numba()  # heavy: imported when the first kernel runs
-                module = fn.__globals__  # the kernel's own module (a *_jit.py)
-                if module.get("prange") is range:  # its first kernel: helpers compiled once
-                    module["prange"] = numba.prange
-                    for name, value in list(module.items()):
-                        how = getattr(value, "_inline", None)
-                        if how is not None:
-                            module[name] = numba.njit(cache=True, inline=how)(value)
-                compiled = numba.njit(cache=True, parallel=parallel, fastmath=False,
-                                      error_model="numpy")(fn)
-                _COMPILED[key] = compiled
+                compiled = _COMPILED[key] = _dispatcher(fn, parallel)
             return compiled(*args)
 
         call.py_func = fn  # type: ignore[attr-defined]
+        call.parallel = parallel  # type: ignore[attr-defined]
         return call
 
     return wrap
+
+
+def dispatcher(func: Callable) -> Any:
+    """The numba dispatcher of a :func:`kernel` (made, not compiled, if it has not run yet).
+
+    Parameters
+    ----------
+    func : callable
+        A function decorated with :func:`kernel`.
+
+    Returns
+    -------
+    numba.core.registry.CPUDispatcher
+        Its dispatcher: ``signatures`` lists what it has compiled or loaded in this process,
+        ``compile(signature)`` compiles (or loads) one.
+
+    Examples
+    --------
+    >>> from bistair.core.phase_jit import _arctan2
+    >>> type(dispatcher(_arctan2)).__name__
+    'CPUDispatcher'
+    """
+    fn = func.py_func
+    key = f"{fn.__module__}.{fn.__qualname__}"
+    if key not in _COMPILED:
+        _COMPILED[key] = _dispatcher(fn, func.parallel)
+    return _COMPILED[key]
+
+
+def compiled_kernels() -> dict[str, list[tuple]]:
+    """The kernels compiled or loaded in this process and their signatures (numba types).
+
+    Returns
+    -------
+    dict
+        ``module.function`` -> list of argument type tuples.
+
+    Examples
+    --------
+    >>> isinstance(compiled_kernels(), dict)
+    True
+    """
+    return {key: list(d.signatures) for key, d in sorted(_COMPILED.items())}
+
+
+def load_cached(func: Callable, signatures: list[tuple]) -> int:
+    """Load the compiled code of a :func:`kernel` for ``signatures`` (tuples of numba types)
+    from the caches, without compiling what is not there and without running anything;
+    returns how many were loaded.
+
+    A process that starts others by ``fork`` (the local cluster of ``bistair batch``) loads
+    the kernels once, before, and its children start with them.
+
+    Parameters
+    ----------
+    func : callable
+        A function decorated with :func:`kernel`.
+    signatures : list of tuple
+        Argument types, as ``dispatcher(func).signatures`` lists them.
+
+    Returns
+    -------
+    int
+        The signatures now loaded (found in a cache or loaded before).
+
+    Examples
+    --------
+    >>> from bistair.core.phase_jit import _arctan2
+    >>> load_cached(_arctan2, []) == 0
+    True
+    """
+    compiled = dispatcher(func)
+    loaded = 0
+    for sig in signatures:
+        sig = tuple(sig)
+        if sig in compiled.overloads:
+            loaded += 1
+            continue
+        _STATE["quiet"] = True
+        try:
+            cres = compiled._cache.load_overload(sig, compiled.targetctx)
+        finally:
+            _STATE["quiet"] = False
+        if cres is None:
+            continue
+        compiled.targetctx.insert_user_function(cres.entry_point, cres.fndesc, [cres.library])
+        compiled.add_overload(cres)
+        loaded += 1
+    return loaded
+
+
+def on_compile(callback: Callable[[], None]) -> None:
+    """Call ``callback()`` once, when the first kernel of this process is compiled rather
+    than loaded from a cache (seconds per kernel: the caller may want to say why it waits).
+
+    Parameters
+    ----------
+    callback : callable
+        Called without arguments, at most once per process (not if a kernel has already
+        been compiled; a callback given twice is called once).
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> on_compile(lambda: None)
+    """
+    if not _STATE["told"] and callback not in _LISTENERS:
+        _LISTENERS.append(callback)
+
+
+def prebuilt_folder() -> Path | None:
+    """The folder of kernels compiled at install time that this process reads: the
+    environment variable ``BISTAIR_KERNELS`` (``none`` for no folder), else the package's
+    ``_kernels``.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The folder (it may not exist: then nothing is found there).
+
+    Examples
+    --------
+    >>> prebuilt_folder() is None or prebuilt_folder().name != ""
+    True
+    """
+    value = os.environ.get(KERNELS_ENV)
+    if value is None or value == "":
+        return PREBUILT
+    return None if value.lower() == "none" else Path(value)
+
+
+def _compiling() -> None:
+    """A kernel is about to be compiled: tell the listeners, once per process."""
+    if _STATE["told"] or _STATE["building"] is not None or _STATE.get("quiet"):
+        return
+    _STATE["told"] = True
+    listeners = list(_LISTENERS)
+    _LISTENERS.clear()
+    for callback in listeners:
+        callback()
+
+
+def _dispatcher(fn: Callable, parallel: bool) -> Any:
+    """The numba dispatcher of kernel ``fn`` with its cache (see the module docstring)."""
+    numba = _numba()
+    if os.environ.get(RECORD_ENV) and not _STATE.get("recording"):
+        _STATE["recording"] = True
+        atexit.register(_record, os.environ[RECORD_ENV])
+    module = fn.__globals__  # the kernel's own module (a *_jit.py)
+    if module.get("prange") is range:  # its first kernel: helpers compiled once
+        module["prange"] = numba.prange
+        for name, value in list(module.items()):
+            how = getattr(value, "_inline", None)
+            if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
+                module[name] = numba.njit(cache=True, inline=how)(value)
+    compiled = numba.njit(cache=False, parallel=parallel, fastmath=False,
+                          error_model="numpy")(fn)
+    try:
+        compiled._cache = _cache_class()(fn)
+    except (RuntimeError, OSError):  # numba finds no folder to keep compiled code in
+        pass  # compiled in every process, as numba's cache=True would refuse to
+    return compiled
+
+
+def _record(path: str) -> None:
+    """Add this process's kernel signatures to ``path``, one line each (for
+    :mod:`bistair.app.kernels`, which lists what is compiled at install time)."""
+    lines = "".join(f"{key} ({', '.join(str(t) for t in sig)})\n"
+                    for key, sigs in compiled_kernels().items() for sig in sigs)
+    with open(path, "a") as fh:
+        fh.write(lines)
+
+
+def _source_stamp(fn: Callable) -> str:
+    """A hash of the kernel's source file and of the files of the compiled helpers its
+    module takes from other modules (compiled into it): a kernel compiled from other
+    sources is never loaded."""
+    module = sys.modules[fn.__module__]
+    files = {Path(module.__file__), Path(__file__)}  # this file: the compile options
+    for value in vars(module).values():
+        origin = getattr(getattr(value, "py_func", value), "__module__", None)
+        if getattr(value, "_inline", None) is not None or (
+                origin and origin.startswith("bistair.") and hasattr(value, "py_func")):
+            files.add(Path(sys.modules[origin].__file__))
+    digest = hashlib.sha256()
+    for path in sorted(files):
+        digest.update(path.name.encode())
+        digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
+def _cache_class() -> type:
+    """numba's ``FunctionCache`` that looks in the prebuilt folder first (made once: numba
+    is imported on first use)."""
+    if _STATE["cache_class"] is not None:
+        return _STATE["cache_class"]
+    from numba.core.caching import FunctionCache, IndexDataCacheFile
+
+    class KernelCache(FunctionCache):
+        """Loads from the prebuilt folder, then numba's own cache; saves to numba's own
+        (or, while :mod:`.prebuild` runs, to the folder it builds)."""
+
+        def __init__(self, py_func: Callable) -> None:
+            super().__init__(py_func)
+            folder = _STATE["building"] or prebuilt_folder()
+            name = f"{py_func.__module__}.{py_func.__qualname__}.py{sys.version_info[0]}" \
+                   f"{sys.version_info[1]}"
+            self._prebuilt = (None if folder is None else
+                              IndexDataCacheFile(str(folder), name, _source_stamp(py_func)))
+
+        def _load_overload(self, sig: Any, target_context: Any) -> Any:
+            if not self._enabled:
+                return None
+            key = self._index_key(sig, target_context.codegen())
+            # while the prebuilt folder is made, only what is in it counts
+            stores = (self._prebuilt,) if _STATE["building"] is not None else (
+                self._prebuilt, self._cache_file)
+            for store in stores:
+                data = None if store is None else store.load(key)
+                if data is not None:
+                    return self._impl.rebuild(target_context, data)
+            _compiling()
+            return None
+
+        def _save_overload(self, sig: Any, data: Any) -> None:
+            if not self._enabled or not self._impl.check_cachable(data):
+                return
+            key = self._index_key(sig, data.codegen)
+            if _STATE["building"] is not None:
+                self._prebuilt.save(key, self._impl.reduce(data))
+                return
+            try:
+                self._impl.locator.ensure_cache_path()
+                self._cache_file.save(key, self._impl.reduce(data))
+            except OSError:  # a cache folder that went away or is read-only: not kept
+                return
+
+    _STATE["cache_class"] = KernelCache
+    return KernelCache
+
+
+def kernel_frames(raw: np.ndarray, start: int = 0, count: int | None = None
+                  ) -> tuple[np.ndarray, int]:
+    """A capture stack as the compiled passes take it: ``(stack, start)``, the stack itself
+    if it is uint8, uint16 or float32 and C-contiguous, else frames ``start .. start+count-1``
+    as float32 (and start 0).
+
+    The passes turn every value into float32 before anything else, so the values are the
+    same; they are compiled for these three types only (each type of stack is a kernel
+    compiled and kept of its own).
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The capture stack, any numeric dtype.
+    start : int
+        The first frame the pass reads.
+    count : int, optional
+        How many frames from ``start`` it reads (all the rest if not given).
+
+    Returns
+    -------
+    stack : (F', H, W) array
+        The stack to pass.
+    start : int
+        The first frame's index in it.
+
+    Examples
+    --------
+    >>> raw = np.zeros((4, 2, 3), np.int32)
+    >>> stack, start = kernel_frames(raw, 2, 2)
+    >>> stack.shape, stack.dtype.name, start
+    ((2, 2, 3), 'float32', 0)
+    >>> kernel_frames(raw.astype(np.uint8), 2)[1]
+    2
+    """
+    if raw.dtype in _RAW_TYPES and raw.flags.c_contiguous:
+        return raw, int(start)
+    stop = raw.shape[0] if count is None else int(start) + int(count)
+    return np.ascontiguousarray(raw[int(start):stop], dtype=np.float32), 0
+
+
+_RAW_TYPES = (np.dtype(np.uint8), np.dtype(np.uint16), np.dtype(np.float32))
 
 
 def set_threads(count: int | None) -> int:

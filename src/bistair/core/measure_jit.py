@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import chunk_count, kernel
+from .jit import chunk_count, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -120,7 +120,8 @@ def fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
     >>> energy.shape, round(float(energy[0, 0]), 4), bool(ok.all())
     ((2, 2), 0.01, True)
     """
-    return _fit_residual_energy(raw, int(start), int(steps), float(np.float32(scale)),
+    raw, start = kernel_frames(raw, start, steps)
+    return _fit_residual_energy(raw, start, int(steps), float(np.float32(scale)),
                                 *(np.ascontiguousarray(a, np.float32) for a in (phi, avg, mod)),
                                 np.asarray(shifts, np.float32))
 

@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from .jit import TWO_PI32, _numba_inline, chunk_count, kernel
+from .jit import TWO_PI32, _numba_inline, chunk_count, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
 # atan(u) / u = P(u^2) on |u| <= tan(pi/8): a Chebyshev fit, relative error 2.6e-14
@@ -270,5 +270,6 @@ def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.
     >>> [(a.astype(float).round(3) + 0.0).tolist() for a in sums]
     [[[1.0, 0.0]], [[1.0, 0.0]], [[0.5, 0.5]]]
     """
-    return _nstep_sums(raw, int(start), int(steps), float(np.float32(scale)),
+    raw, start = kernel_frames(raw, start, steps)
+    return _nstep_sums(raw, start, int(steps), float(np.float32(scale)),
                        np.asarray(sin_w, np.float32), np.asarray(cos_w, np.float32))

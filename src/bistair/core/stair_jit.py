@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from .jit import PI32, kernel
+from .jit import PI32, kernel, kernel_frames
 from .phase_jit import _atan2
 
 prange = range  # numba's prange once the first kernel of this module compiles
@@ -109,4 +109,5 @@ def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     >>> theta.astype(float).round(3).tolist(), mod.astype(float).round(3).tolist()
     ([[0.004, -1.567]], [[0.5, 0.5]])
     """
-    return _pair_phase(raw, int(first), float(np.float32(scale)), np.asarray(avg, np.float32))
+    raw, first = kernel_frames(raw, first, 2)
+    return _pair_phase(raw, first, float(np.float32(scale)), np.asarray(avg, np.float32))
