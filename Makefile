@@ -12,9 +12,10 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
+# the tests on up to four processes (pytest-xdist), each test file in one of them
 test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --maxprocesses 4 --dist loadfile
 
 demo: $(STAMP)
 	$(BIN)/bistair demo --out demo-out

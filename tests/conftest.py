@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import sys
 from pathlib import Path
 
@@ -13,6 +14,13 @@ from bistair.evaluation.metrics import score as score_of
 from bistair.sim.warp import Blob, WarpScene, render_warp
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
+# The tests that interrupt a command (Ctrl-C: SIGINT) need it to reach the command's Python.
+# pytest-xdist's workers (`make test` runs them) ignore SIGINT, and an ignored signal stays
+# ignored in the processes they start, whose Python then never raises KeyboardInterrupt; a
+# handler here is reset to the default in those processes, so they get Python's own.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 CFPE = SHARED / "data" / "cfpe"
 
 
