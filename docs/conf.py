@@ -39,7 +39,10 @@ exclude_patterns = ["_build", "auto_examples/*.ipynb", "auto_examples/*.py",
 myst_enable_extensions = ["colon_fence", "deflist"]
 myst_heading_anchors = 3
 
-autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False}
+# each function and class on the page of the module that defines it (a package's re-exports
+# in __all__ are not repeated: `bistair.sim.render` is a module, not also the function)
+autodoc_default_options = {"members": True, "undoc-members": False, "show-inheritance": False,
+                           "ignore-module-all": True}
 autodoc_typehints = "none"  # numpydoc's Parameters sections say the types
 autosummary_generate = False
 numpydoc_show_class_members = False
@@ -172,3 +175,17 @@ def _write_spec_fields() -> None:
 
 
 _write_spec_fields()
+
+
+def _skip_foreign(app, what, name, obj, skip, options):  # noqa: ANN001, ANN202
+    """Leave out what another package defines (SciPy's ``cKDTree`` imported into a module,
+    the ``set`` matplotlib writes into every Figure subclass)."""
+    module = getattr(obj, "__module__", None)
+    if isinstance(module, str) and not module.startswith("bistair"):
+        return True
+    return None
+
+
+def setup(app):  # noqa: ANN001, ANN201
+    app.connect("autodoc-skip-member", _skip_foreign)
+

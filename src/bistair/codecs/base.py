@@ -3,13 +3,13 @@
 A codec is a spec class and four functions on the coded axis laid out along image columns
 (captures of the rows orientation are decoded transposed):
 
-================================================  =========================================
-``encode_columns(spec)``                          ``(F, other, coded)`` patterns in [0, 1]
-``measure_columns(prepared, spec, min_mod)``      stage 1, the phase map: a
-                                                  :class:`~bistair.core.measure.FringeSet`
-``code_columns(prepared, spec, fringes, min_mod)``  stage 2, the code map: a :class:`CodeMap`
-``order_columns(fringes, code, spec, **options)`` stage 3, the orders: an :class:`Orders`
-================================================  =========================================
+====================================================  =========================================
+``encode_columns(spec)``                              ``(F, other, coded)`` patterns in [0, 1]
+``measure_columns(prepared, spec, min_mod)``          stage 1, the phase map: a
+                                                      :class:`~bistair.core.measure.FringeSet`
+``code_columns(prepared, spec, fringes, min_mod)``    stage 2, the code map: a :class:`CodeMap`
+``order_columns(fringes, code, spec, **options)``     stage 3, the orders: an :class:`Orders`
+====================================================  =========================================
 
 :class:`Codec` wraps them with what every capture goes through (frame count, scaling, frame
 order, orientation, projector gamma, bit depth) and exposes the stages like OpenCV's

@@ -38,9 +38,9 @@ ORDER_LEGEND = (((150, 150, 150), "right order"), ((255, 0, 0), "wrong order"),
 
 
 def draw_method(row: Row, truth: Any) -> Figure:
-    """Wrapped phase, code (``k_s``), fringe order, absolute phase, |error| and order errors
-    of one method against the truth, each continuous panel with its colour bar and the order
-    errors with a legend.
+    """Wrapped phase, code (``k_s``), fringe order, absolute phase, the error's size and order
+    errors of one method against the truth, each continuous panel with its colour bar and the
+    order errors with a legend.
 
     Parameters
     ----------
