@@ -29,7 +29,8 @@ bench: $(STAMP)
 DOCS_STAMP := $(VENV)/.docs-installed
 
 $(DOCS_STAMP): $(STAMP) pyproject.toml
-	$(BIN)/python -m pip install --quiet -e '.[dev,docs]'
+	# (the kernels were compiled by the first install: not again)
+	BISTAIR_NO_PREBUILD=1 $(BIN)/python -m pip install --quiet -e '.[dev,docs]'
 	touch $(DOCS_STAMP)
 
 # the documentation site into docs/_build/html (warnings are errors; the gallery runs)
