@@ -14,14 +14,14 @@ $(STAMP): pyproject.toml
 
 # the tests on up to four processes (pytest-xdist), each test file in one of them
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py
 	$(BIN)/python -m pytest -q -n auto --maxprocesses 4 --dist loadfile
 
 demo: $(STAMP)
 	$(BIN)/bistair demo --out demo-out
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples docs/conf.py
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/decode_speed.py

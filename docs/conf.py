@@ -137,44 +137,10 @@ _write_api()
 
 
 # -- every spec field of every method, from the spec classes (docs/guide/spec-fields.md) ----
-def _write_spec_fields() -> None:
-    import dataclasses
+sys.path.insert(0, str(Path(__file__).parent))
+from spec_fields import write_spec_fields_page  # noqa: E402
 
-    from bistair.codecs import REGISTRY
-    from bistair.spec import BaseSpec
-
-    base = {f.name for f in dataclasses.fields(BaseSpec)}
-    lines = ["# Every spec field", "",
-             "Written from the spec classes when the documentation is built. A spec read "
-             "from a file must name every field that shapes the patterns (marked *shapes*); "
-             "the others may be left out and take their defaults. Numbers may be written as "
-             "fractions or with `pi` (`\"1920/58\"`, `\"-2*pi/3\"`); `frames` lists the "
-             "captures in order (the method's frame names, and `white`, `black`, `ignore`).",
-             "", "## Every method", "", "| field | default | shapes | meaning |",
-             "| --- | --- | --- | --- |"]
-
-    def row(f: dataclasses.Field) -> str:
-        default = f.default if f.default is not dataclasses.MISSING else ""
-        needed = f.metadata.get("shapes", True) and f.metadata.get("cli", True) is not False
-        shapes = "yes" if needed else ""
-        meaning = f.metadata.get("help", "").replace("|", "\\|")
-        name = "frames" if f.name == "frame_order" else f.name
-        return f"| `{name}` | `{default!r}` | {shapes} | {meaning} |"
-
-    lines += [row(f) for f in dataclasses.fields(BaseSpec)]
-    for name, codec in REGISTRY.items():
-        own = [f for f in dataclasses.fields(codec.spec_class) if f.name not in base]
-        lines += ["", f"## `{name}`", "", codec.summary + ".", "",
-                  "| field | default | shapes | meaning |", "| --- | --- | --- | --- |",
-                  *(row(f) for f in own)]
-    page = Path(__file__).parent / "guide" / "spec-fields.md"
-    page.parent.mkdir(exist_ok=True)
-    content = "\n".join(lines) + "\n"
-    if not page.exists() or page.read_text() != content:
-        page.write_text(content)
-
-
-_write_spec_fields()
+write_spec_fields_page()
 
 
 def _skip_foreign(app, what, name, obj, skip, options):  # noqa: ANN001, ANN202

@@ -36,6 +36,41 @@ def test_patterns_writes_six_images_and_the_spec(pats):
     assert img.shape == (240, 480) and img.dtype == np.uint8
 
 
+def test_patterns_into_a_folder_of_a_longer_set_leave_only_the_new_frames(pats, monkeypatch,
+                                                                          capsys):
+    (pats / "notes.txt").write_text("mine")  # a file of the user's: kept
+    code, _, err = run(monkeypatch, capsys, "patterns", "bidirectional", "--width", 480,
+                       "--height", 240, "--period", 20, "--partitions", 4, "--stairs", 6,
+                       "--white", 1, "--out", pats)
+    assert code == 0, err
+    assert (pats / "06.png").exists()  # the white frame of the set of 7
+    code, _, err = run(monkeypatch, capsys, "patterns", "bidirectional", "--width", 480,
+                       "--height", 240, "--period", 20, "--partitions", 4, "--stairs", 6,
+                       "--out", pats)
+    assert code == 0, err
+    names = sorted(p.name for p in pats.iterdir())
+    assert names == ["00.png", "01.png", "02.png", "03.png", "04.png", "05.png", "notes.txt",
+                     "spec.json"]
+
+
+def test_bare_command_shows_the_help(monkeypatch, capsys):
+    code, out, err = run(monkeypatch, capsys)
+    assert code == 0 and err == ""
+    assert out.startswith("Usage: bistair") and "decode" in out
+
+
+def test_swapped_stair_pair_is_named_in_the_refusal(pats, tmp_path, monkeypatch, capsys):
+    spec = json.loads((pats / "spec.json").read_text())
+    frames = spec["frames"]
+    i, j = frames.index("stair-cos"), frames.index("stair-sin")
+    frames[i], frames[j] = frames[j], frames[i]
+    (tmp_path / "swapped.json").write_text(json.dumps(spec))
+    code, _, err = run(monkeypatch, capsys, "decode", pats, "--spec", tmp_path / "swapped.json",
+                       "--out", tmp_path / "o")
+    assert code == 2 and not (tmp_path / "o").exists()
+    assert "stair-cos and stair-sin" in err, err  # named, whichever check sees it
+
+
 def test_sixteen_bit_patterns(tmp_path, monkeypatch, capsys):
     code, _, _ = run(monkeypatch, capsys, "patterns", "bidirectional", "--width", 360,
                      "--height", 120, "--period", 20, "--partitions", 3, "--bits", 16,

@@ -386,8 +386,9 @@ def _terminated(signum: int, frame: Any) -> None:
 def main() -> None:
     signal.signal(signal.SIGTERM, _terminated)
     keep_freed_memory()  # a short-lived process: freed arrays serve the next ones
+    args = sys.argv[1:] or ["--help"]  # a bare `bistair` shows the help, as --help does
     try:
-        cli(standalone_mode=False)
+        cli(args, prog_name="bistair", standalone_mode=False)
     except click.exceptions.Abort:
         click.echo("Aborted.", err=True)
         sys.exit(1)

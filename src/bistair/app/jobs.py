@@ -19,6 +19,8 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
+import re
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -49,13 +51,20 @@ from ..spec import BaseSpec
 
 
 def save_patterns(spec: BaseSpec, out: str | Path) -> Path:
-    """Write ``00.png`` ... and ``spec.json`` into ``out``; returns ``out``."""
+    """Write ``00.png`` ... and ``spec.json`` into ``out``; returns ``out``. Numbered
+    images an earlier pattern set left there (``06.png`` of a set of 7 after one of 6)
+    are removed, so that the folder holds exactly the frames to project."""
     images = to_bit_depth(encode(spec), spec.bits)
     width = max(2, len(str(len(images) - 1)))
     with output_folder(out) as tmp:
         for i, img in enumerate(images):
             write_image(tmp / f"{i:0{width}d}.png", img)
         (tmp / "spec.json").write_text(spec.to_json())
+        written = {p.name for p in tmp.iterdir()}
+    for old in Path(out).iterdir():
+        if old.name not in written and re.fullmatch(r"\d+\.(png|tiff?|bmp)", old.name):
+            with contextlib.suppress(OSError):
+                old.unlink()
     return Path(out)
 
 

@@ -426,7 +426,9 @@ def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     """
     check = code.check or edge_alignment(fs.phi, code.edges, fs.valid, code.edge_phase,
                                          code.cycle)
-    problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase)
+    pair = tuple(f for f in spec.method_frames() if f.endswith(("-cos", "-sin")))
+    problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase,
+                                 pair)
     if problem is None:
         return []
     kind, message = problem

@@ -184,7 +184,8 @@ def edge_alignment(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray,
 
 
 def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
-                       edge_phase: float = 0.0) -> tuple[str, str] | None:
+                       edge_phase: float = 0.0, code_pair: tuple[str, ...] = ()
+                       ) -> tuple[str, str] | None:
     """What a check says of the spec's phase convention: ``None`` when it fits (or the
     evidence is too thin), else ``("refuse" | "warn", one-line message)``.
 
@@ -202,6 +203,9 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
         The spec's shift direction, +1 or -1 (to suggest the other).
     edge_phase : float
         The wrapped phase (radians) at which the code's edges should sit.
+    code_pair : tuple of str
+        The names of a cos/sin pair of code frames, if the code has one: exchanged, they
+        reverse the code as reversed shifts do, so the message names them too.
 
     Returns
     -------
@@ -216,6 +220,9 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     ('refuse', 'is phase_offset pi?')
     >>> convention_problem(EdgeCheck(500, 0.02, 0.9, 400, 0.97), 0.0, 1)[0]
     'refuse'
+    >>> convention_problem(EdgeCheck(500, 0.02, 0.9, 400, 0.97), 0.0, 1, 0.0,
+    ...                    ("stair-cos", "stair-sin"))[1]  # doctest: +ELLIPSIS
+    '... (or are the shift frames in reverse order, or stair-cos and stair-sin exchanged)?'
     >>> convention_problem(EdgeCheck(500, 0.4, 0.9, 400, 0.0), 0.0, 1)[0]
     'warn'
     >>> convention_problem(EdgeCheck(20, 3.1, 0.9, 20, 0.0), 0.0, 1) is None  # too few steps
@@ -226,7 +233,9 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     if check.wraps >= MIN_EDGES and check.reversed > 0.8:
         return ("refuse", f"the phase falls where the code grows "
                 f"({100 * check.reversed:.0f}% of its steps): is shift_sign {-shift_sign:+d} "
-                "(or are the shift frames in reverse order)?")
+                "(or are the shift frames in reverse order"
+                + (f", or {code_pair[0]} and {code_pair[1]} exchanged" if len(code_pair) == 2
+                   else "") + ")?")
     if check.spread < 0.5 or abs(check.crossing) <= 0.25:
         return None
     guess = (phase_offset + check.crossing + np.pi) % TWO_PI - np.pi
