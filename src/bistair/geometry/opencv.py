@@ -224,12 +224,15 @@ def read_opencv_calibration(paths: Sequence[str | Path],
     return Calibration(camera, projector, _rotation(*parts["R"]), _translation(*parts["T"]))
 
 
-def _key_names(keys: Mapping[str, str] | None) -> dict[str, str]:
-    names = dict(DEFAULT_KEYS)
+def _key_names(keys: Mapping[str, str] | None, defaults: Mapping[str, str] = DEFAULT_KEYS,
+               roles: Mapping[str, str] = ROLES) -> dict[str, str]:
+    """The file key of every part: ``defaults`` with the user's ``keys`` (parts among
+    ``roles``, names not empty) in their place."""
+    names = dict(defaults)
     for role, key in (keys or {}).items():
-        if role not in ROLES:
+        if role not in roles:
             raise BistairError(f"unknown part {role!r} in the keys (parts: "
-                               f"{', '.join(ROLES)})")
+                               f"{', '.join(roles)})")
         if not isinstance(key, str) or not key.strip():
             raise BistairError(f"the key name for {role} is empty")
         names[role] = key.strip()

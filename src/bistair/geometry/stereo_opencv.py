@@ -39,6 +39,7 @@ from .opencv import (
     _camera_size,
     _distortion,
     _intrinsics,
+    _key_names,
     _rotation,
     _size_pair,
     _translation,
@@ -104,14 +105,7 @@ def read_opencv_stereo(paths: Sequence[str | Path],
     bistair.errors.BistairError: no key 'K2' (right camera matrix) in .../s.yml (it has M1, ...
     >>> shutil.rmtree(tmp)
     """
-    names = dict(DEFAULT_STEREO_KEYS)
-    for role, key in (keys or {}).items():
-        if role not in STEREO_ROLES:
-            raise BistairError(f"unknown part {role!r} in the keys (parts: "
-                               f"{', '.join(STEREO_ROLES)})")
-        if not isinstance(key, str) or not key.strip():
-            raise BistairError(f"the key name for {role} is empty")
-        names[role] = key.strip()
+    names = _key_names(keys, DEFAULT_STEREO_KEYS, STEREO_ROLES)
     files = [(Path(p), read_filestorage(p)) for p in paths]
     if not files:
         raise BistairError("no calibration files given")
