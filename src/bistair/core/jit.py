@@ -32,7 +32,7 @@ import math
 import os
 import sys
 from collections.abc import Callable
-from functools import wraps
+from functools import cache, wraps
 from pathlib import Path
 from typing import Any
 
@@ -270,7 +270,14 @@ def _source_stamp(fn: Callable) -> str:
     """A hash of the kernel's source file and of the files of the compiled helpers its
     module takes from other modules (compiled into it): a kernel compiled from other
     sources is never loaded."""
-    module = sys.modules[fn.__module__]
+    return _module_stamp(fn.__module__)
+
+
+@cache
+def _module_stamp(name: str) -> str:
+    """:func:`_source_stamp` of every kernel of module ``name`` (the same files for all of
+    them: hashed once a process)."""
+    module = sys.modules[name]
     files = {Path(module.__file__), Path(__file__)}  # this file: the compile options
     for value in vars(module).values():
         origin = getattr(getattr(value, "py_func", value), "__module__", None)
