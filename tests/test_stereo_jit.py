@@ -1,7 +1,8 @@
 """The compiled passes of binocular matching against exact answers: resampling without
 mixing surfaces, where pixels land on the rectified grid (against OpenCV), the row search for
 equal phase (against a plain search on random rising rows), its refusals (gaps, steps,
-falls, two places), the row-support check and the points."""
+falls, two places), the row-support check, the points, and the smoothing within runs
+(against its definition, sample by sample)."""
 
 from __future__ import annotations
 
@@ -23,6 +24,7 @@ from bistair.geometry.stereo_jit import (
     match_pair,
     rectified_positions,
     remap_valid,
+    smooth_runs,
     supported,
 )
 
@@ -189,3 +191,53 @@ def test_grid_depth_triangulates_and_turns_back():
     depth, outside = grid_depth(disparity, np.float32([[u]]), np.float32([[v]]),
                                 np.ones((1, 1), bool), f, cx, cy, tx, rot, max_depth=600.0)
     assert np.isnan(depth).all() and outside == 1
+
+
+def _line_through(line: np.ndarray, x: int, radius: int, weights: np.ndarray,
+                  jump: float) -> float:
+    """The definition of :func:`smooth_runs` at one sample: the weighted least-squares line
+    through its neighbours up to ``radius`` away, each side up to the first invalid one or
+    step over ``jump``, at the sample."""
+    ks = [0]
+    for direction in (-1, 1):
+        for k in range(1, radius + 1):
+            j, prev = x + direction * k, x + direction * (k - 1)
+            if not 0 <= j < len(line) or not abs(float(line[j]) - float(line[prev])) <= jump:
+                break
+            ks.append(direction * k)
+    k = np.array(ks, float)
+    if len(k) == 1:
+        return float(line[x])
+    fit = np.polyfit(k, line[x + k.astype(int)].astype(float), 1, w=np.sqrt(weights[
+        np.abs(k).astype(int)]))
+    return float(fit[1])
+
+
+@pytest.mark.parametrize("sigma", [0.6, 1.0, 2.0])
+def test_smoothing_is_the_least_squares_line_within_each_run(sigma):
+    rng = np.random.default_rng(5)
+    h, w = 40, 60
+    yy, xx = np.mgrid[0:h, 0:w].astype(float)
+    values = (1.5 * xx + 0.3 * yy + 4 * np.sin(xx / 7)).astype(np.float32)
+    values[:, 30:] += 50.0  # a second surface
+    values[15:, :] -= 40.0  # and a third
+    values += rng.normal(0, 0.05, values.shape).astype(np.float32)
+    values[rng.random(values.shape) < 0.04] = np.nan
+    values[5:9, 10:14] = np.nan
+    jump = 5.0
+    got = smooth_runs(values, sigma, jump)
+    radius = max(1, math.ceil(3 * sigma))
+    weights = np.exp(-0.5 * (np.arange(radius + 1) / sigma) ** 2)
+    rows = np.full(values.shape, np.nan)
+    for y in range(h):
+        for x in range(w):
+            if np.isfinite(values[y, x]):
+                rows[y, x] = _line_through(values[y], x, radius, weights, jump)
+    rows = rows.astype(np.float32)
+    want = np.full(values.shape, np.nan)
+    for x in range(w):
+        for y in range(h):
+            if np.isfinite(rows[y, x]):
+                want[y, x] = _line_through(rows[:, x], y, radius, weights, jump)
+    np.testing.assert_array_equal(np.isnan(got), np.isnan(values))
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-4)

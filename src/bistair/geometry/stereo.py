@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -53,6 +54,7 @@ import cv2
 import numpy as np
 
 from ..codecs import decode, get_codec
+from ..core.jit import side_by_side
 from ..core.result import AxesResult, DecodeResult, make_result
 from ..errors import BistairError
 from ..spec import BaseSpec
@@ -284,7 +286,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     smooth : float, optional
         Gaussian sigma (px) of a smoothing of both cameras' projector coordinates on the
         rectified grids before matching (:func:`~.stereo_jit.smooth_runs`: never across
-        two surfaces); 0 (the default) matches the decoded values as they are. Smoothing
+        two surfaces; the default, 1 px); 0 matches the decoded values as they are. Smoothing
         trades lateral resolution for depth noise (sigma 1 px: about a third of it).
     offset : float, optional
         The patterns' mean (the spec's ``offset``): scales the fringes' average to grey
@@ -559,15 +561,21 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
     if not isinstance(calibration, StereoCalibration):
         calibration = load_stereo_calibration(calibration)
     opts = decode_options(spec.method, force, options)
-    results = []
-    for side, images in (("left", left_images), ("right", right_images)):
-        try:
-            res = decode(images, spec, **opts)
-        except BistairError as exc:
-            raise BistairError(f"{side}: {exc}") from None
-        if not res.mask.any():
-            raise BistairError(f"{side}: no pixel decoded: does the spec fit the captures?")
-        results.append(res)
+
+    def decoded(side: str, images: np.ndarray) -> Callable[[], DecodeResult | AxesResult]:
+        def run() -> DecodeResult | AxesResult:
+            try:
+                res = decode(images, spec, **opts)
+            except BistairError as exc:
+                raise BistairError(f"{side}: {exc}") from None
+            if not res.mask.any():
+                raise BistairError(f"{side}: no pixel decoded: does the spec fit the "
+                                   "captures?")
+            return res
+        return run
+
+    # both cameras at once, the cores shared (the same results as one after the other)
+    results = side_by_side(decoded("left", left_images), decoded("right", right_images))
     return reconstruct_stereo(*results, calibration, spec.orientation, rectification,
                               min_depth, max_depth, tolerance, other_tolerance,
                               smooth=smooth, offset=spec.offset, force=force)

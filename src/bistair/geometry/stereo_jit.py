@@ -280,34 +280,83 @@ def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray
 
 
 @_numba_inline
+def _value_alone(vs: np.ndarray, begins: np.ndarray, ends: np.ndarray, runs: int,
+                 alone: np.ndarray) -> None:
+    """Mark the runs whose value range (first to last value, rising) meets no other run's:
+    a value such a run holds is held by no other run of the row."""
+    first = np.empty(runs, np.float64)
+    for r in range(runs):
+        alone[r] = 0
+        lo, hi = vs[begins[r]], vs[ends[r] - 1]
+        first[r] = lo if lo <= hi else math.inf  # a falling run holds no value: last
+    order = np.argsort(first)
+    reach = -math.inf  # the largest last value of the runs before, in that order
+    for i in range(runs):
+        r = order[i]
+        lo, hi = vs[begins[r]], vs[ends[r] - 1]
+        if not lo <= hi:
+            break
+        meets = reach >= lo or (i + 1 < runs and first[order[i + 1]] <= hi)
+        alone[r] = 0 if meets else 1
+        reach = max(reach, hi)
+
+
+@_numba_inline
+def _crossing(r: int, q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
+              begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
+              hints: np.ndarray, reach: int) -> tuple[bool, float, float]:
+    """Whether run ``r`` holds ``q`` within ``[xlo, xhi]``: ``(hit, first, last)``, the
+    first and last crossings of ``q`` (the same where it rises through it once)."""
+    a, b = begins[r], ends[r]
+    if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] <= q <= vs[b - 1]):
+        return False, 0.0, 0.0
+    i = _first_at_least(pmax, a, b, q, hints[r, 0])  # first crossing in (i-1, i]
+    j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
+    hints[r, 0] = i
+    hints[r, 1] = j + 1
+    if i == j + 1 and reach > 1 and i - reach >= a and j + reach < b:  # one crossing
+        x1 = x2 = mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, math.nan)
+        if mid != mid:  # no line (never for a rising run): between the neighbours
+            x1 = x2 = mid = xs[j] + (q - vs[j]) / (vs[i] - vs[j]) * (xs[i] - xs[j])
+    else:
+        x1, x2 = float(xs[a]), float(xs[a])  # q is the run's first value
+        if i > a:
+            x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
+        if j >= a:
+            x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
+        mid = 0.5 * (x1 + x2)
+    if mid < xlo or mid > xhi:
+        return False, 0.0, 0.0
+    return True, x1, x2
+
+
+@_numba_inline
 def _find(q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
           begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
-          hints: np.ndarray, runs: int, wiggle: float, reach: int) -> tuple[int, float]:
-    """``(status, position)`` of the value ``q`` on a row's runs within ``[xlo, xhi]``."""
+          hints: np.ndarray, runs: int, wiggle: float, reach: int, alone: np.ndarray,
+          last: np.ndarray) -> tuple[int, float]:
+    """``(status, position)`` of the value ``q`` on a row's runs within ``[xlo, xhi]``.
+
+    The run that held the last value searched (``last[0]``) is tried first: where it holds
+    ``q`` and no other run shares its values (``alone``), no other run can hold it."""
+    c = last[0]
+    if c < runs and alone[c] == 1 and vs[begins[c]] <= q <= vs[ends[c] - 1]:
+        hit, x1, x2 = _crossing(c, q, xlo, xhi, xs, vs, begins, ends, pmax, smin, hints,
+                                reach)
+        if not hit:
+            return UNMATCHED, math.nan
+        if x2 - x1 > wiggle:
+            return NOT_MONOTONIC, math.nan
+        return MATCHED, 0.5 * (x1 + x2)
     found, bad, best = 0, False, math.nan
     for r in range(runs):
-        a, b = begins[r], ends[r]
-        if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] <= q <= vs[b - 1]):
-            continue
-        i = _first_at_least(pmax, a, b, q, hints[r, 0])  # first crossing in (i-1, i]
-        j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
-        hints[r, 0] = i
-        hints[r, 1] = j + 1
-        if i == j + 1 and reach > 1 and i - reach >= a and j + reach < b:  # one crossing
-            x1 = x2 = mid = _fit_crossing(xs, vs, i - reach, j + reach + 1, q, math.nan)
-            if mid != mid:  # no line (never for a rising run): between the neighbours
-                x1 = x2 = mid = xs[j] + (q - vs[j]) / (vs[i] - vs[j]) * (xs[i] - xs[j])
-        else:
-            x1, x2 = float(xs[a]), float(xs[a])  # q is the run's first value
-            if i > a:
-                x1 = xs[i - 1] + (q - vs[i - 1]) / (vs[i] - vs[i - 1]) * (xs[i] - xs[i - 1])
-            if j >= a:
-                x2 = xs[j] + (q - vs[j]) / (vs[j + 1] - vs[j]) * (xs[j + 1] - xs[j])
-            mid = 0.5 * (x1 + x2)
-        if mid < xlo or mid > xhi:
+        hit, x1, x2 = _crossing(r, q, xlo, xhi, xs, vs, begins, ends, pmax, smin, hints,
+                                reach)
+        if not hit:
             continue
         found += 1
-        best = mid
+        best = 0.5 * (x1 + x2)
+        last[0] = r
         if x2 - x1 > wiggle:
             bad = True
     if found == 0:
@@ -338,23 +387,28 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
         lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
         lhint = np.empty((w // 2 + 1, 2), np.int64)
         alone = np.empty(w, np.uint8)  # not bool: numba reads bool arrays slowly
+        ralone, lalone = np.empty(wr // 2 + 1, np.uint8), np.empty(w // 2 + 1, np.uint8)
+        rlast, llast = np.zeros(1, np.int64), np.zeros(1, np.int64)
         for y in range(c * h // chunks, (c + 1) * h // chunks):
             nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
             nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
             _alone(lxs, lvs, lb, le, nl, alone)
+            _value_alone(rvs, rb, re, nr, ralone)
+            _value_alone(lvs, lb, le, nl, lalone)
+            rlast[0] = llast[0] = 0
             for x in range(w):
                 q = left[y, x]
                 if q != q:
                     continue
                 found, xm = _find(q, x + lo, x + hi, rxs, rvs, rb, re, rmax, rmin, rhint,
-                                  nr, wiggle, reach)
+                                  nr, wiggle, reach, ralone, rlast)
                 if found != MATCHED:
                     status[y, x] = found
                     continue
                 back, xb = MATCHED, float(x)
                 if alone[x] == 0:
                     back, xb = _find(q, xm - hi, xm - lo, lxs, lvs, lb, le, lmax, lmin,
-                                     lhint, nl, wiggle, 1)
+                                     lhint, nl, wiggle, 1, lalone, llast)
                 if back != MATCHED or not abs(xb - x) <= tolerance:
                     status[y, x] = INCONSISTENT
                     continue
@@ -521,50 +575,141 @@ def drop_kinks(values: np.ndarray, limit: float, reach: int = 2) -> np.ndarray:
 
 
 @_numba_inline
-def _local_line(line: np.ndarray, x: int, radius: int, weights: np.ndarray,
-                jump: float) -> float:
-    """The weighted least-squares line through ``line`` around ``x`` (within ``radius``,
-    up to the first invalid sample or step over ``jump`` on each side), at ``x``."""
-    n = line.shape[0]
-    sw, swk, swkk, swv, swkv = 0.0, 0.0, 0.0, 0.0, 0.0
-    for direction in (-1, 1):
-        prev = float(line[x])
-        for k in range(0 if direction < 0 else 1, radius + 1):
-            j = x + direction * k
-            if j < 0 or j >= n:
-                break
-            v = float(line[j])
-            if v != v or abs(v - prev) > jump:
-                break
-            prev = v
-            w = weights[k]
-            off = direction * k
-            sw += w
-            swk += w * off
-            swkk += w * off * off
-            swv += w * v
-            swkv += w * off * v
-    det = sw * swkk - swk * swk
-    if not det > 1e-12:
-        return float(line[x])
-    return (swkk * swv - swk * swkv) / det
+def _joined(a: float, b: float, jump: float) -> bool:
+    """Two neighbouring samples of one surface: both valid, at most ``jump`` apart."""
+    return abs(float(a) - float(b)) <= jump  # False where either is NaN
+
+
+@_numba_inline
+def _fit_at(line: np.ndarray, x: int, a: int, b: int, radius: int,
+            coefficients: np.ndarray) -> float:
+    """The least-squares line through ``line[x-a .. x+b]`` at ``x``: a weighted sum."""
+    total = 0.0
+    for k in range(-a, b + 1):
+        total += coefficients[a, b, k + radius] * float(line[x + k])
+    return total
 
 
 @kernel(parallel=True)
-def _smooth(values: np.ndarray, radius: int, weights: np.ndarray, jump: float) -> np.ndarray:
+def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray,
+            jump: float) -> np.ndarray:
+    """:func:`smooth_runs`: each pass filters every sample with the whole window's weights
+    (a fixed filter, in vector loops; NaN wherever the window holds one), then fits again
+    the samples whose window is cut short (``left``/``right``, ``up``/``down``: how far
+    each sample's run reaches, up to ``radius``)."""
     h, w = values.shape
-    rows = values.copy()
-    for y in prange(h):
-        for x in range(w):
-            if values[y, x] == values[y, x]:
-                rows[y, x] = _local_line(values[y], x, radius, weights, jump)
-    columns = np.ascontiguousarray(rows.T)
-    out = columns.copy()
-    for x in prange(w):
-        for y in range(h):
-            if columns[x, y] == columns[x, y]:
-                out[x, y] = _local_line(columns[x], y, radius, weights, jump)
-    return np.ascontiguousarray(out.T)
+    r = radius
+    full = coefficients[r, r].copy()
+    rows = np.empty_like(values)
+    for y in prange(h):  # along the rows
+        line = values[y]
+        left = np.zeros(w, np.int8)
+        run = 0
+        for x in range(1, w):
+            run = min(run + 1, r) if _joined(line[x], line[x - 1], jump) else 0
+            left[x] = run
+        acc = np.zeros(w, np.float64)
+        if r == 3:  # the default sigma (1 px): a loop of fixed length, in vector registers
+            for x in range(r, w - r):
+                total = 0.0
+                for k in range(7):
+                    total += full[k] * float(line[x + k - 3])
+                acc[x] = total
+        else:
+            for x in range(r, w - r):
+                total = 0.0
+                for k in range(2 * r + 1):
+                    total += full[k] * float(line[x + k - r])
+                acc[x] = total
+        run = 0
+        for x in range(w - 1, -1, -1):
+            if x < w - 1:
+                run = min(run + 1, r) if _joined(line[x], line[x + 1], jump) else 0
+            a = int(left[x])
+            if a < r or run < r:
+                acc[x] = (_fit_at(line, x, a, run, r, coefficients)
+                          if line[x] == line[x] else line[x])
+            rows[y, x] = acc[x]
+    out = np.empty_like(values)
+    strip = 64  # down the columns, in strips of columns
+    for s in prange((w + strip - 1) // strip):
+        x0, x1 = s * strip, min(s * strip + strip, w)
+        n = x1 - x0
+        up = np.zeros((h, n), np.int8)
+        for y in range(1, h):
+            for i in range(n):
+                up[y, i] = (min(up[y - 1, i] + 1, r)
+                            if _joined(rows[y, x0 + i], rows[y - 1, x0 + i], jump) else 0)
+        down = np.zeros(n, np.int64)
+        acc = np.zeros(n, np.float64)
+        for y in range(h - 1, -1, -1):
+            if r == 3 and 3 <= y < h - 3:
+                for i in range(n):
+                    total = 0.0
+                    for k in range(7):
+                        total += full[k] * float(rows[y + k - 3, x0 + i])
+                    acc[i] = total
+            elif r <= y < h - r:
+                for i in range(n):
+                    total = 0.0
+                    for k in range(2 * r + 1):
+                        total += full[k] * float(rows[y + k - r, x0 + i])
+                    acc[i] = total
+            if y < h - 1:
+                for i in range(n):
+                    down[i] = (min(down[i] + 1, r)
+                               if _joined(rows[y, x0 + i], rows[y + 1, x0 + i], jump) else 0)
+            for i in range(n):  # the windows cut short
+                a, b = int(up[y, i]), down[i]
+                if a < r or b < r:
+                    v = rows[y, x0 + i]
+                    if v == v:
+                        total = 0.0
+                        for k in range(-a, b + 1):
+                            total += coefficients[a, b, k + r] * float(rows[y + k, x0 + i])
+                        acc[i] = total
+                    else:
+                        acc[i] = v
+            for i in range(n):
+                out[y, x0 + i] = acc[i]
+    return out
+
+
+def line_coefficients(weights: np.ndarray) -> np.ndarray:
+    """The weights of the least-squares line at a sample through its neighbours ``-a .. b``
+    (``weights[k]`` the weight of a neighbour ``k`` away): ``(r+1, r+1, 2r+1)`` for
+    ``a, b`` in ``0 .. r`` and the offsets ``-r .. r`` (a lone sample keeps its value).
+
+    Parameters
+    ----------
+    weights : numpy.ndarray
+        ``(r+1,)`` weights of the neighbours 0 to ``r`` samples away.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(r+1, r+1, 2r+1)`` float64: the value of the line at the sample is the sum of
+        ``[a, b, k + r]`` times the neighbour ``k`` away, ``k`` in ``-a .. b``.
+
+    Examples
+    --------
+    >>> c = line_coefficients(np.array([1.0, 0.5]))
+    >>> c[1, 1].round(3).tolist(), c[0, 1].round(3).tolist()  # a mean; the sample itself
+    ([0.25, 0.5, 0.25], [0.0, 1.0, 0.0])
+    """
+    r = len(weights) - 1
+    out = np.zeros((r + 1, r + 1, 2 * r + 1))
+    for a in range(r + 1):
+        for b in range(r + 1):
+            k = np.arange(-a, b + 1, dtype=float)
+            wk = np.asarray(weights, float)[np.abs(k).astype(int)]
+            sw, swk, swkk = wk.sum(), (wk * k).sum(), (wk * k * k).sum()
+            det = sw * swkk - swk * swk
+            if det > 1e-12:
+                out[a, b, k.astype(int) + r] = wk * (swkk - swk * k) / det
+            else:
+                out[a, b, r] = 1.0
+    return out
 
 
 def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
@@ -602,7 +747,7 @@ def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
         return values.copy()
     radius = max(1, int(math.ceil(3 * sigma)))
     weights = np.exp(-0.5 * (np.arange(radius + 1) / sigma) ** 2)
-    return _smooth(values, radius, weights, float(jump))
+    return _smooth(values, radius, line_coefficients(weights), float(jump))
 
 
 @kernel(parallel=True)
