@@ -182,6 +182,14 @@ def _first_at_least(arr: np.ndarray, a: int, b: int, q: float, hint: int) -> int
     """The first index in ``[a, b)`` of the non-decreasing ``arr`` with ``arr >= q`` (``b``
     if none), searched from ``hint`` outward in doubling steps (the answer is usually a
     step or two from the last one), then by halving."""
+    # the answer is mostly the hint or the one after it (the value searched for moves on
+    # by about a sample from pixel to pixel): two looks before any search
+    if a <= hint < b:
+        if arr[hint] >= q:
+            if hint == a or arr[hint - 1] < q:
+                return hint
+        elif hint + 1 == b or arr[hint + 1] >= q:
+            return hint + 1
     lo, hi = a, b  # arr[lo - 1] < q (or lo == a), arr[hi] >= q (or hi == b)
     step = 1
     if hint < b and arr[hint] >= q:
@@ -248,33 +256,40 @@ def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray
           hints: np.ndarray) -> int:
     """The runs of a row (valid samples at most ``gap`` columns and ``jump`` per column
     apart, two samples at least): their samples ``xs, vs``, bounds, prefix maxima and
-    suffix minima; returns how many."""
+    suffix minima, and in ``hints`` (runs, 3) the search hints and whether each rises
+    strictly; returns how many."""
     n = 0
-    for x in range(row.shape[0]):
+    for x in range(row.shape[0]):  # a select, not a branch
         value = row[x]
-        if value == value:
-            xs[n] = x
-            vs[n] = value
-            n += 1
+        xs[n] = x
+        vs[n] = value
+        n += 1 if value == value else 0
     runs = 0
     k = 0
     while k < n:
         e = k + 1
+        rising = 1
         while e < n and xs[e] - xs[e - 1] <= gap and (
                 abs(vs[e] - vs[e - 1]) <= jump * (xs[e] - xs[e - 1])):
+            rising = rising if vs[e] > vs[e - 1] else 0
             e += 1
         if e - k >= 2:
             begins[runs] = k
             ends[runs] = e
             hints[runs, 0] = k
             hints[runs, 1] = k
+            hints[runs, 2] = rising
             runs += 1
-            pmax[k] = vs[k]
+            top = vs[k]  # (kept in a register, not read back)
+            pmax[k] = top
             for i in range(k + 1, e):
-                pmax[i] = max(pmax[i - 1], vs[i])
-            smin[e - 1] = vs[e - 1]
+                top = max(top, vs[i])
+                pmax[i] = top
+            low = vs[e - 1]
+            smin[e - 1] = low
             for i in range(e - 2, k - 1, -1):
-                smin[i] = min(smin[i + 1], vs[i])
+                low = min(low, vs[i])
+                smin[i] = low
         k = e
     return runs
 
@@ -311,7 +326,10 @@ def _crossing(r: int, q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.n
     if xs[b - 1] < xlo or xs[a] > xhi or not (vs[a] <= q <= vs[b - 1]):
         return False, 0.0, 0.0
     i = _first_at_least(pmax, a, b, q, hints[r, 0])  # first crossing in (i-1, i]
-    j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
+    if hints[r, 2] == 1:  # rising strictly: the first crossing is the last
+        j = i - 1
+    else:
+        j = _first_at_least(smin, a, b, q, hints[r, 1]) - 1  # last one in (j, j+1]
     hints[r, 0] = i
     hints[r, 1] = j + 1
     if i == j + 1 and reach > 1 and i - reach >= a and j + reach < b:  # one crossing
@@ -381,11 +399,11 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
         rxs, rvs = np.empty(wr, np.int64), np.empty(wr, np.float64)
         rb, re = np.empty(wr // 2 + 1, np.int64), np.empty(wr // 2 + 1, np.int64)
         rmax, rmin = np.empty(wr, np.float64), np.empty(wr, np.float64)
-        rhint = np.empty((wr // 2 + 1, 2), np.int64)
+        rhint = np.empty((wr // 2 + 1, 3), np.int64)
         lxs, lvs = np.empty(w, np.int64), np.empty(w, np.float64)
         lb, le = np.empty(w // 2 + 1, np.int64), np.empty(w // 2 + 1, np.int64)
         lmax, lmin = np.empty(w, np.float64), np.empty(w, np.float64)
-        lhint = np.empty((w // 2 + 1, 2), np.int64)
+        lhint = np.empty((w // 2 + 1, 3), np.int64)
         alone = np.empty(w, np.uint8)  # not bool: numba reads bool arrays slowly
         ralone, lalone = np.empty(wr // 2 + 1, np.uint8), np.empty(w // 2 + 1, np.uint8)
         rlast, llast = np.zeros(1, np.int64), np.zeros(1, np.int64)
