@@ -283,10 +283,14 @@ def scheduler(tmp_path_factory):
         start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
               "--scheduler-file", info, "--idle-timeout", "600")
         deadline = time.monotonic() + 60
-        while not info.exists() and time.monotonic() < deadline:
+        address = None
+        while address is None and time.monotonic() < deadline:
             assert procs[0].poll() is None, (folder / "scheduler.log").read_text()
-            time.sleep(0.05)
-        address = json.loads(info.read_text())["address"]
+            try:  # the file appears before the scheduler has written it
+                address = json.loads(info.read_text())["address"]
+            except (OSError, ValueError, KeyError):
+                time.sleep(0.05)
+        assert address is not None, (folder / "scheduler.log").read_text()
         start("worker", address, "--nthreads", 1, "--nworkers", 1, "--no-dashboard",
               "--host", "127.0.0.1", "--death-timeout", 60, "--local-directory", folder)
         yield address
