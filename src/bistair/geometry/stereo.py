@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -562,20 +561,18 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         calibration = load_stereo_calibration(calibration)
     opts = decode_options(spec.method, force, options)
 
-    def decoded(side: str, images: np.ndarray) -> Callable[[], DecodeResult | AxesResult]:
-        def run() -> DecodeResult | AxesResult:
-            try:
-                res = decode(images, spec, **opts)
-            except BistairError as exc:
-                raise BistairError(f"{side}: {exc}") from None
-            if not res.mask.any():
-                raise BistairError(f"{side}: no pixel decoded: does the spec fit the "
-                                   "captures?")
-            return res
-        return run
+    def decoded(side: str, images: np.ndarray) -> DecodeResult | AxesResult:
+        try:
+            res = decode(images, spec, **opts)
+        except BistairError as exc:
+            raise BistairError(f"{side}: {exc}") from None
+        if not res.mask.any():
+            raise BistairError(f"{side}: no pixel decoded: does the spec fit the captures?")
+        return res
 
     # both cameras at once, the cores shared (the same results as one after the other)
-    results = side_by_side(decoded("left", left_images), decoded("right", right_images))
+    results = side_by_side(lambda: decoded("left", left_images),
+                           lambda: decoded("right", right_images))
     return reconstruct_stereo(*results, calibration, spec.orientation, rectification,
                               min_depth, max_depth, tolerance, other_tolerance,
                               smooth=smooth, offset=spec.offset, force=force)

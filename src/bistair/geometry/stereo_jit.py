@@ -410,9 +410,9 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
         for y in range(c * h // chunks, (c + 1) * h // chunks):
             nr = _runs(right[y], gap, jump, rxs, rvs, rb, re, rmax, rmin, rhint)
             nl = _runs(left[y], gap, jump, lxs, lvs, lb, le, lmax, lmin, lhint)
-            _alone(lxs, lvs, lb, le, nl, alone)
             _value_alone(rvs, rb, re, nr, ralone)
             _value_alone(lvs, lb, le, nl, lalone)
+            _alone(lxs, lb, le, lhint, nl, lalone, alone)
             rlast[0] = llast[0] = 0
             for x in range(w):
                 q = left[y, x]
@@ -441,24 +441,15 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
 
 
 @_numba_inline
-def _alone(xs: np.ndarray, vs: np.ndarray, begins: np.ndarray, ends: np.ndarray, runs: int,
-           alone: np.ndarray) -> None:
-    """Mark the columns of the runs that rise strictly and share no value with another
-    run: each of their pixels comes back to itself, no search back is needed there."""
+def _alone(xs: np.ndarray, begins: np.ndarray, ends: np.ndarray, hints: np.ndarray,
+           runs: int, value_alone: np.ndarray, alone: np.ndarray) -> None:
+    """Mark the columns of the runs that rise strictly (``hints[r, 2]``) and share no value
+    with another run (:func:`_value_alone`): each of their pixels comes back to itself, no
+    search back is needed there."""
     alone[:] = 0
     for r in range(runs):
-        a, b = begins[r], ends[r]
-        rising = True
-        for k in range(a + 1, b):
-            if not vs[k] > vs[k - 1]:
-                rising = False
-                break
-        for r2 in range(runs):
-            if r2 != r and rising and vs[begins[r2]] <= vs[b - 1] and (
-                    vs[a] <= vs[ends[r2] - 1]):
-                rising = False
-        if rising:
-            for k in range(a, b):
+        if hints[r, 2] == 1 and value_alone[r] == 1:
+            for k in range(begins[r], ends[r]):
                 alone[xs[k]] = 1
 
 
@@ -681,13 +672,7 @@ def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray,
                 a, b = int(up[y, i]), down[i]
                 if a < r or b < r:
                     v = rows[y, x0 + i]
-                    if v == v:
-                        total = 0.0
-                        for k in range(-a, b + 1):
-                            total += coefficients[a, b, k + r] * float(rows[y + k, x0 + i])
-                        acc[i] = total
-                    else:
-                        acc[i] = v
+                    acc[i] = _fit_at(rows[:, x0 + i], y, a, b, r, coefficients) if v == v else v
             for i in range(n):
                 out[y, x0 + i] = acc[i]
     return out
