@@ -18,6 +18,7 @@ from __future__ import annotations
 import glob
 import re
 from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -28,6 +29,8 @@ from ..codecs import spec_from_dict
 from ..errors import BistairError
 from ..spec import BaseSpec
 from .jsonfile import read_json
+
+READ_THREADS = 3  # frames read at once (1.3 MP PNGs: 3 threads 35 ms, 1 thread 59 ms, 6 38)
 
 IMAGE_SUFFIXES = (".png", ".tif", ".tiff", ".bmp")
 
@@ -280,7 +283,9 @@ def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
         keep = [i for i in range(stack.shape[0]) if i not in skip]
         return np.ascontiguousarray(stack[keep] if skip else stack)
     files = [f for i, f in enumerate(files) if i not in skip]
-    frames = [read_image(f) for f in files]
+    # the image libraries free the GIL while they decode: about 0.6 of the time on two cores
+    with ThreadPoolExecutor(max_workers=min(len(files), READ_THREADS)) as pool:
+        frames = list(pool.map(read_image, files))  # the first bad file's error, as in a loop
     first = frames[0]
     for f, img in zip(files, frames, strict=True):
         if img.shape != first.shape:
