@@ -75,6 +75,12 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
     (4, W+1) is scratch for the running sums."""
     h, w = phi.shape
     one = np.float32(1.0)
+    # the running sums in registers, stored as they grow (adding to the sum just stored
+    # waited on the store: about 1.5 ms of 14 at 1.3 MP on one thread)
+    s0 = np.float32(0.0)
+    s1 = np.float32(0.0)
+    s2 = np.float32(0.0)
+    s3 = np.float32(0.0)
     for x in range(w):
         gx = np.float32(0.0)
         nx = np.float32(0.0)
@@ -86,10 +92,14 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
         if y < h - 1 and valid[y, x] and valid[y + 1, x]:
             gy = _wrapped(phi[y + 1, x] - phi[y, x])
             ny = one
-        sums[0, x + 1] = sums[0, x] + gx
-        sums[1, x + 1] = sums[1, x] + nx
-        sums[2, x + 1] = sums[2, x] + gy
-        sums[3, x + 1] = sums[3, x] + ny
+        s0 += gx
+        s1 += nx
+        s2 += gy
+        s3 += ny
+        sums[0, x + 1] = s0
+        sums[1, x + 1] = s1
+        sums[2, x + 1] = s2
+        sums[3, x + 1] = s3
     few = np.float32(half)
     for x in range(w):  # a window of under ``half`` samples never cuts: no means needed
         hi = min(x + half, w)
