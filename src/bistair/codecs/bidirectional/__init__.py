@@ -55,7 +55,7 @@ from ...core.stair_jit import pair_phase, quantize32
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
-from .bands import row_runs, union_levels
+from .bands import nearest_level, row_runs, union_levels
 from .evidence import (
     BandLayout,
     band_splits,
@@ -462,10 +462,12 @@ def level_offset(prof: RowProfiles, levels: np.ndarray) -> float:
     weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
     if theta.size == 0 or not weight.sum() > 0:
         return 0.0
-    dist = np.abs(wrap(theta[:, None] - levels[None, :]))
-    nearest = dist.argmin(axis=1)
+    # the nearest level's index as argmin gives it, compiled: NumPy's argmin and min over
+    # a (rows, levels) array take milliseconds along so short an axis
+    nearest = nearest_level(theta, levels)
+    near = np.abs(wrap(theta - levels[nearest]))
     gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
-    share = dist.min(axis=1) / (0.5 * gaps.min(axis=1)[nearest])
+    share = near / (0.5 * gaps.min(axis=1)[nearest])
     order = np.argsort(share)
     cum = np.cumsum(weight[order])
     return float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])

@@ -83,7 +83,7 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
         return 0.0
     levels = union_levels(spec.partitions, spec.stairs)
     seen = observed_levels(th, np.ones(th.size), levels)
-    near = np.abs(wrap(th[:, None] - seen[None, :])).min(axis=1)
+    near = np.abs(wrap(th - seen[nearest_level(th, seen)]))  # the least distance to a level
     local = nearest_level(stair_level_phase(np.arange(spec.stairs), spec.stairs), levels)
     part = nearest_level(stair_level_phase(np.arange(spec.partitions), spec.partitions), levels)
     inside = k // spec.stairs < spec.partitions
