@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from .phase import TWO_PI, order_from_reference
+from .phase import TWO_PI, order_from_reference, wrap
 from .regions_jit import drop_small, fringe_links, period_jump_links, reattach, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
@@ -190,8 +190,7 @@ def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
     """
     a, b = phi[::8, :-1], phi[::8, 1:]
     ok = valid[::8, :-1] & valid[::8, 1:]
-    diff = (b - a)[ok]
-    diff = (diff + np.pi) % TWO_PI - np.pi
+    diff = wrap((b - a)[ok])  # (diff + pi) % 2pi - pi, compiled
     return 1 if diff.size == 0 or _median_sign(diff) >= 0 else -1
 
 
