@@ -352,7 +352,8 @@ def write_previews(result: DecodeResult, folder: str | Path, suffix: str = "") -
 def _write_png(path: Path, rgb: np.ndarray) -> bool:
     # fast deflate (level 1) after the 'up' row filter alone: previews are views, and must
     # not take longer than a decode. At 1.3 MP the five previews encode in about half the
-    # time that OpenCV's default filter choice takes, into files no larger (the same pixels)
+    # time that OpenCV's default filter choice takes, into files of about the same size
+    # (2.21 against 2.20 MB for the five; the same pixels)
     return bool(cv2.imwrite(str(path), np.ascontiguousarray(rgb[..., ::-1]),
                             [cv2.IMWRITE_PNG_COMPRESSION, 1,
                              cv2.IMWRITE_PNG_FILTER, cv2.IMWRITE_PNG_FILTER_UP]))
