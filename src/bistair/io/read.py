@@ -284,7 +284,7 @@ def read_captures(captures: Captures, skip: Sequence[int] = ()) -> np.ndarray:
         return np.ascontiguousarray(stack[keep] if skip else stack)
     files = [f for i, f in enumerate(files) if i not in skip]
     # the image libraries free the GIL while they decode: about 0.6 of the time on two cores
-    with ThreadPoolExecutor(max_workers=min(len(files), READ_THREADS)) as pool:
+    with ThreadPoolExecutor(max_workers=max(1, min(len(files), READ_THREADS))) as pool:
         frames = list(pool.map(read_image, files))  # the first bad file's error, as in a loop
     first = frames[0]
     for f, img in zip(files, frames, strict=True):
