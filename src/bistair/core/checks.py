@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import BistairError
 from .checks_jit import code_steps, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
+from .stair import half_gaps
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 _FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
@@ -524,10 +525,9 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     t = theta[::4, ::4][valid[::4, ::4]][:20000].astype(np.float64)  # plenty for a median
     if t.size == 0:
         return 0.0
-    gap = (np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * 9).min(axis=1)
     d = np.abs(wrap(t[:, None] - levels[None, :]))
     nearest = d.argmin(axis=1)
-    return float(np.median(d[np.arange(t.size), nearest] / (0.5 * gap[nearest])))
+    return float(np.median(d[np.arange(t.size), nearest] / half_gaps(levels)[nearest]))
 
 
 def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from .phase import TWO_PI
+from .phase import TWO_PI, wrap
 from .phase_jit import arctan2_32
 
 
@@ -177,3 +177,34 @@ def level_misfit(theta: float, level: int, levels: int) -> float:
     """
     d = (theta - stair_level_phase(level, levels) + math.pi) % TWO_PI
     return ((d - math.pi) / (math.pi / levels)) ** 2
+
+
+def half_gaps(levels: np.ndarray) -> np.ndarray:
+    """Half the wrapped distance from each stair level to its nearest other level: how far
+    a reading may stray from its level before it is nearer another (the unit of the band
+    evidence's and the checks' misfits).
+
+    Parameters
+    ----------
+    levels : (L,) float array
+        The levels' phases in radians, any order (L >= 1; a lone level's nearest other is
+        itself a full turn away).
+
+    Returns
+    -------
+    (L,) float64 array
+        ``0.5 * min over j != i of |wrap(levels[i] - levels[j])|``, the differences taken
+        in the levels' own float type.
+
+    Examples
+    --------
+    >>> half_gaps(np.array([-2.0, 0.0, 2.0])).round(3).tolist()
+    [1.0, 1.0, 1.0]
+    >>> half_gaps(np.array([0.0, 0.5, np.pi])).round(3).tolist()
+    [0.25, 0.25, 1.321]
+    """
+    levels = np.asarray(levels)
+    if not np.issubdtype(levels.dtype, np.floating):
+        levels = levels.astype(np.float64)
+    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
+    return 0.5 * gaps.min(axis=1)

@@ -47,10 +47,10 @@ import numpy as np
 from ...core.captures import Prepared
 from ...core.checks import refuse, stair_misfit, wrap_steps
 from ...core.measure import FringeSet
-from ...core.phase import TWO_PI, wrap
+from ...core.phase import wrap
 from ...core.regions import core_weight, fringe_direction, fringe_regions
 from ...core.resolve import orders_from_regions
-from ...core.stair import stair_level_phase, stair_pair
+from ...core.stair import half_gaps, stair_level_phase, stair_pair
 from ...core.stair_jit import pair_phase, quantize32
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
@@ -466,8 +466,7 @@ def level_offset(prof: RowProfiles, levels: np.ndarray) -> float:
     # a (rows, levels) array take milliseconds along so short an axis
     nearest = nearest_level(theta, levels)
     near = np.abs(wrap(theta - levels[nearest]))
-    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
-    share = near / (0.5 * gaps.min(axis=1)[nearest])
+    share = near / half_gaps(levels)[nearest]
     order = np.argsort(share)
     cum = np.cumsum(weight[order])
     return float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])

@@ -18,7 +18,7 @@ from functools import lru_cache
 import numpy as np
 
 from ...core.phase import TWO_PI, wrap
-from ...core.stair import stair_level_phase
+from ...core.stair import half_gaps, stair_level_phase
 from .bands_jit import band_reads, band_runs, band_sums, nearest_levels
 from .profiles import RowProfiles
 
@@ -206,10 +206,9 @@ def row_runs(prof: RowProfiles, levels: np.ndarray) -> Runs:
                     empty.astype(np.int64), empty.astype(bool), empty.astype(bool), empty)
     # distance of the rows from their level, in half the distance to the nearest other level
     # (where a reading would change level): blur mixing two bands puts rows in between
-    gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
     reg, y0, y1, length, cw, sw, weight, misfit, uid, top_ok, bottom_ok = band_runs(
         region, row, read, kept, prof.cos, prof.sin, prof.weight, row_theta, levels,
-        0.5 * gaps.min(axis=1))
+        half_gaps(levels))
     runs = Runs(region=reg, y0=y0, y1=y1, length=length, theta=np.arctan2(sw, cw),
                 weight=weight, uid=uid, top_ok=top_ok,
                 bottom_ok=bottom_ok, misfit=misfit)
