@@ -1,6 +1,7 @@
 """The measure stage's compiled passes (bistair.core.measure_jit: validity, phase noise, the
-noise sample) give, bit for bit, what the NumPy expressions they replaced gave (written out
-here), on random data and on the values where roundings and thresholds bite."""
+noise sample, the coherent dim pixels) give, bit for bit, what the NumPy expressions they
+replaced gave (written out here), on random data and on the values where roundings and
+thresholds bite."""
 
 from __future__ import annotations
 
@@ -10,7 +11,12 @@ from support.arrays import floats, same
 
 from bistair.core.captures import ScaledStack
 from bistair.core.measure import _chi2_median, noise_level
-from bistair.core.measure_jit import fit_residual_energy, phase_noise, pixel_validity
+from bistair.core.measure_jit import (
+    fit_residual_energy,
+    keep_coherent,
+    phase_noise,
+    pixel_validity,
+)
 from bistair.core.phase import (
     phase_shift_patterns,
     residuals,
@@ -91,3 +97,38 @@ def test_fit_residual_energy_is_numpys(steps, convention, shape):
         want = float(np.sqrt(np.median(expected[expected_ok] if expected_ok.sum() >= 100
                                        else expected.ravel()) / (2.0 * _chi2_median(steps - 3))))
         assert got == pytest.approx(want, rel=1e-5)
+
+
+def _keep_coherent_numpy(labels, weak, strong, n, min_strong, min_size, min_region):
+    size = np.bincount(labels.ravel(), minlength=n + 1)
+    bright = np.bincount(labels.ravel(), weights=strong.ravel(), minlength=n + 1)
+    keep = ((bright >= min_strong) | (size >= min_size)) & (size >= min_region)
+    keep[0] = False
+    return strong | (weak & keep[labels])
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (7, 33), (300, 41), (1100, 90)])
+def test_keep_coherent_is_numpys(shape):
+    """Counted in blocks of rows and runs along them: the same pixels as counting each."""
+    weak = RNG.random(shape) < 0.7
+    strong = weak & (RNG.random(shape) < 0.3)
+    n = 40
+    # runs of one label along the rows, as fringe regions have, and single pixels
+    labels = np.repeat(RNG.integers(1, n + 1, (shape[0], shape[1] // 5 + 1)), 5, axis=1)
+    labels = labels[:, :shape[1]].astype(np.int32)
+    labels[RNG.random(shape) < 0.1] = RNG.integers(1, n + 1)
+    labels[~weak] = 0  # regions of the weak mask
+    for thresholds in [(10, 100, 20), (1, 10**9, 1), (3, 20, 2), (10**9, 10**9, 0)]:
+        got = keep_coherent(labels, weak, strong, n, *thresholds)
+        assert np.array_equal(got, _keep_coherent_numpy(labels, weak, strong, n, *thresholds))
+
+
+def test_keep_coherent_with_many_regions():
+    """More regions than the row blocks' counts have room for: one block."""
+    shape = (600, 3000)
+    labels = np.arange(shape[0] * shape[1], dtype=np.int32).reshape(shape) // 2 + 1
+    n = int(labels.max())
+    weak = np.ones(shape, bool)
+    strong = RNG.random(shape) < 0.5
+    got = keep_coherent(labels, weak, strong, n, 2, 100, 1)
+    assert np.array_equal(got, _keep_coherent_numpy(labels, weak, strong, n, 2, 100, 1))

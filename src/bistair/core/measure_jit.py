@@ -62,16 +62,38 @@ def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: i
     [[True, False, False, False, False, False]]
     """
     h, w = labels.shape
-    size = np.zeros(n + 1, np.int64)
-    bright = np.zeros(n + 1, np.int64)
-    for y in range(h):
-        for x in range(w):
-            lab = labels[y, x]
-            size[lab] += 1
-            if strong[y, x]:
-                bright[lab] += 1
-    keep = ((bright >= min_strong) | (size >= min_size)) & (size >= min_region)
-    keep[0] = False
+    # counted in blocks of rows (each its own counts: as many as leave them under 8 MB),
+    # a run of one label along a row at a time; pixels outside the weak mask are label 0
+    blocks = min(16, max(1, h // 256), max(1, (1 << 20) // (n + 1)))
+    size = np.zeros((blocks, n + 1), np.int32)
+    bright = np.zeros((blocks, n + 1), np.int32)
+    for b in prange(blocks):
+        sizes = size[b]
+        brights = bright[b]
+        for y in range(b * h // blocks, (b + 1) * h // blocks):
+            run = 0
+            run_size = 0
+            run_bright = 0
+            for x in range(w):
+                lab = labels[y, x] if weak[y, x] else 0
+                if lab != run:
+                    sizes[run] += run_size
+                    brights[run] += run_bright
+                    run = lab
+                    run_size = 0
+                    run_bright = 0
+                run_size += 1
+                run_bright += strong[y, x]
+            sizes[run] += run_size
+            brights[run] += run_bright
+    keep = np.zeros(n + 1, np.bool_)
+    for i in range(1, n + 1):
+        total = 0
+        lit = 0
+        for b in range(blocks):
+            total += size[b, i]
+            lit += bright[b, i]
+        keep[i] = (lit >= min_strong or total >= min_size) and total >= min_region
     out = np.empty((h, w), np.bool_)
     for y in prange(h):
         for x in range(w):
