@@ -58,6 +58,9 @@ ROWS = [
     (["demo", "--seed", "-1", "--out", "{out}"], "seed must be a whole number of at least 0"),
     # decode: output paths that would break the next run, unreadable frames named
     (["decode", "{pats}", "--out", "{pats}"], "is the captures' own folder: choose another"),
+    (["decode", "{pats}", "--out", "{pats}/00.png/result"], "00.png is a file, not a folder"),
+    (["patterns", "graycode", "--out", "{pats}/spec.json/new"],
+     "spec.json is a file, not a folder"),
     (["decode", "{pats}", "--out", ""], "the output path is empty"),
     (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
     (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "

@@ -33,6 +33,24 @@ from ..errors import BistairError
 from .read import Captures
 
 
+def _reason(path: Path, exc: OSError) -> str:
+    """Why ``path`` cannot be written: the file standing where one of its folders should
+    be, else the system's reason.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     _ = (Path(tmp) / "a").write_text("a file")
+    ...     _reason(Path(tmp) / "a" / "b" / "c.json", FileExistsError(17, "File exists"))
+    'a is a file, not a folder'
+    """
+    for folder in path.parents:
+        if folder.exists():
+            if not folder.is_dir():
+                return f"{folder.name or folder} is a file, not a folder"
+            break
+    return str(exc.strerror or exc)
+
+
 def write_image(path: str | Path, image: np.ndarray) -> None:
     """Write an 8- or 16-bit image (PNG, TIFF or BMP by suffix).
 
@@ -203,7 +221,7 @@ def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
         tmp = Path(tempfile.mkdtemp(prefix=prefix or _prefix(), dir=parent))
         tmp.chmod(0o777 & ~_umask())  # mkdtemp makes it private; outputs are not
     except OSError as exc:
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
+        raise BistairError(f"cannot write output folder {out}: {_reason(out, exc)}") from None
     try:
         yield tmp
         if not out.exists():
@@ -267,7 +285,7 @@ def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]
         tmp = Path(tempfile.mkdtemp(prefix=prefix, dir=out.parent))
         tmp.chmod(0o777 & ~_umask())
     except OSError as exc:
-        raise BistairError(f"cannot write output folder {out}: {exc.strerror}") from None
+        raise BistairError(f"cannot write output folder {out}: {_reason(out, exc)}") from None
     old = None
     try:
         yield tmp
@@ -382,7 +400,7 @@ def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
                                     dir=path.parent)
         os.close(fd)
     except OSError as exc:
-        raise BistairError(f"cannot write {path}: {exc.strerror}") from None
+        raise BistairError(f"cannot write {path}: {_reason(path, exc)}") from None
     tmp = Path(name)
     try:
         yield tmp
