@@ -137,6 +137,7 @@ def test_gray_and_lv_helpers():
     ("multifreq", dict(periods=(180, 30), unwrap="hierarchical"), "needs a period covering"),
     ("multifreq", dict(periods=(100, 90)), "narrower than the 1080-px coded axis"),
     ("multifreq", dict(periods=(30, 30)), "periods must differ"),
+    ("multifreq", dict(periods=(40, 60, 120)), "give two equal beats or a beat equal to a"),
     ("lv", dict(period=10, levels=3), "need more than 3 levels"),
     ("phase-coding", dict(period=2), "at least 4"),
     ("graycode", dict(period=30, complementary=2), "complementary must be 0 or 1, got 2"),
@@ -144,6 +145,16 @@ def test_gray_and_lv_helpers():
 def test_parameters_that_cannot_work(method, params, reason):
     with pytest.raises(BistairError, match=reason):
         bistair.make_spec(method, width=1080, height=1080, **params)
+
+
+def test_heterodyne_beats_that_do_not_grow_with_the_periods():
+    """42, 45 and 50 px beat at 630 and 450 px (the second pair beats faster), and those at
+    1575 px: the beats are taken in ascending order, so the widest is positive and the
+    decode exact."""
+    spec = bistair.make_spec("multifreq", width=1500, height=24, periods=(42, 45, 50))
+    assert beat_tree(spec.periods) == [[42.0, 45.0, 50.0], [450.0, 630.0], [1575.0]]
+    result = bistair.decode(np.round(bistair.encode(spec) * 200 + 20).astype(np.uint8), spec)
+    assert result.mask.all() and np.abs(result.coord - np.arange(1500)).max() < 0.1
 
 
 def test_every_codec_decodes_through_the_cli(tmp_path, monkeypatch):

@@ -49,7 +49,7 @@ from .multifreq_jit import agreed_orders, unwrap_chain
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     """Levels of beat periods: level 0 the periods ascending, each next the beats of
-    neighbours of the one below, up to a single period.
+    neighbours of the one below (:func:`beat`), ascending, up to a single period.
 
     Parameters
     ----------
@@ -61,16 +61,46 @@ def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     list of list of float
         The levels, each ascending; the last holds one period (the widest beat).
 
+    Raises
+    ------
+    BistairError
+        Two beats come out equal, or a beat equals a period: their phases cannot be told
+        apart.
+
     Examples
     --------
     >>> beat_tree((48, 42, 45))
     [[42.0, 45.0, 48.0], [630.0, 720.0], [5040.0]]
+    >>> beat_tree((42, 45, 50))  # the beats of 42 & 45 and 45 & 50 are 630 and 450
+    [[42.0, 45.0, 50.0], [450.0, 630.0], [1575.0]]
+    >>> beat_tree((40, 60, 120))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the periods (40, 60, 120) give two equal beats or a beat ...
     """
     levels = [sorted(float(p) for p in periods)]
+    seen = set(levels[0])
     while len(levels[-1]) > 1:
         low = levels[-1]
-        levels.append([a * b / (b - a) for a, b in zip(low[:-1], low[1:], strict=True)])
+        beats = sorted(beat(a, b) for a, b in zip(low[:-1], low[1:], strict=True))
+        same = [t for i, t in enumerate(beats) if t in seen or t in beats[:i]]
+        if same:
+            shown = ", ".join(format_period(p) for p in periods)
+            raise BistairError(f"the periods ({shown}) give two equal beats or a beat equal to "
+                               f"a period ({same[0]:.0f} px): their phases cannot be told apart")
+        seen.update(beats)
+        levels.append(beats)
     return levels
+
+
+def beat(shorter: float, longer: float) -> float:
+    """The beat period of two fringe periods, ``shorter < longer``: the period of the
+    difference of their phases, ``shorter * longer / (longer - shorter)``.
+
+    >>> beat(42.0, 45.0)
+    630.0
+    """
+    return shorter * longer / (longer - shorter)
 
 
 def miss_peak(worst: np.ndarray, valid: np.ndarray) -> float:
@@ -358,16 +388,15 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
             absolute[fine] = unwrap(phase_of[fine], absolute[coarse], coarse / fine)
     else:
         levels = beat_tree(tuple(phase_of))
-        for lvl in range(1, len(levels)):
-            for i, t in enumerate(levels[lvl]):
-                a, b = levels[lvl - 1][i], levels[lvl - 1][i + 1]
-                phase_of[t] = (phase_of[a] - phase_of[b]) % TWO_PI
+        for low in levels[:-1]:  # the beats' phases, level by level up
+            for a, b in zip(low[:-1], low[1:], strict=True):
+                phase_of[beat(a, b)] = (phase_of[a] - phase_of[b]) % TWO_PI
         top = levels[-1][0]
         absolute = {top: top_phase(phase_of[top], top, spec.coded_length)}
-        for lvl in range(len(levels) - 2, -1, -1):
-            above = levels[lvl + 1]
-            for i, t in enumerate(levels[lvl]):
-                parent = above[min(i, len(above) - 1)]
+        for low in levels[-2::-1]:  # each period from a beat it makes with a neighbour
+            for i, t in enumerate(low):
+                j = min(i, len(low) - 2)
+                parent = beat(low[j], low[j + 1])
                 absolute[t] = unwrap(phase_of[t], absolute[parent], parent / t)
     order = order_from_reference(fs.phi, absolute[shortest])
     code = np.where(valid & np.isfinite(order), order, -1).astype(np.int32)
