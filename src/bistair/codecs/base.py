@@ -284,6 +284,11 @@ class Codec:
         turned = axis_problem(fs.phi, fs.valid, spec.orientation)
         if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
             refuse(turned)
+
+        def judge(problem: str | None) -> None:
+            """Refuse for ``problem``, naming a turned axis too (the likelier cause)."""
+            refuse(problem if problem is None or turned is None else f"{problem}; {turned}")
+
         code = self.code_columns(cols, spec, fs, min_modulation)
         # every set is measured: saturation is in the validity, the clipped masks (one byte
         # a pixel, twice for the rows orientation) need not stay in memory
@@ -296,15 +301,15 @@ class Codec:
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
             bad, big, links = wrap_steps(fs.phi, orders.order, fs.valid)
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
-            refuse(jump_problem(bad, links, big=big, big_limit=0.02))
+            judge(jump_problem(bad, links, big=big, big_limit=0.02))
             if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
                 orders.info["warnings"] = [*orders.info.get("warnings", []), (
                     f"the orders do not step by one across {100 * bad / links:.1f}% of the "
                     "phase jumps: pixels beside the code's edges read one order off (a code "
                     "whose edges sit on the phase jumps; a complementary or shifted code, a "
                     "second period or --strategy region avoid it)")]
-        refuse(jump_problem(orders.info.get("jump_violations", 0),
-                             orders.info.get("jump_links", 0)))
+        judge(jump_problem(orders.info.get("jump_violations", 0),
+                           orders.info.get("jump_links", 0)))
         words, beyond = code.code, code.beyond
         del code  # its maps are done with: the result is made without them in memory
         result = result_from_orders(self.name, fs, orders.order, spec.period,
@@ -312,8 +317,8 @@ class Codec:
         if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
-        refuse(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
-                                spec.coded_length))
+        judge(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
+                              spec.coded_length))
         result.info["valid_pixels"] = int(result.mask.sum())
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":

@@ -242,8 +242,12 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     guess = (phase_offset + check.crossing + np.pi) % TWO_PI - np.pi
     named = {0.0: "0", np.pi: "pi", -np.pi: "-pi", np.pi / 2: "pi/2", -np.pi / 2: "-pi/2",
              2 * np.pi / 3: "2*pi/3", -2 * np.pi / 3: "-2*pi/3"}
-    near = [(value, name) for value, name in named.items() if abs(guess - value) < 0.2]
-    suggestion = near[0][1] if near else f"{guess:.3f}"
+    # the steps' crossing reads short of a large offset (kamino's -2*pi/3 read as -1.851
+    # from 0): a named offset within half the gap between two of them is suggested, with
+    # the measured one beside it when they differ
+    near = [(value, name) for value, name in named.items() if abs(guess - value) < 0.25]
+    suggestion = f"{guess:.3f}" if not near else (
+        near[0][1] if abs(guess - near[0][0]) < 0.05 else f"{near[0][1]} (measured {guess:.3f})")
     message = (f"the code steps where the wrapped phase is "
                f"{wrap(check.crossing + edge_phase) % TWO_PI:.2f} rad, not at "
                f"{edge_phase:.2f} rad: is phase_offset {suggestion}?")
@@ -329,7 +333,8 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
     if outside < 100 or outside <= 0.1 * total:
         return None
     return (f"the coordinates of {100 * outside / total:.0f}% of the decoded pixels fall "
-            f"outside the {length}-px projector: is the period (or the projector size) right?")
+            f"outside the {length}-px projector: is the period (or the projector size) right? "
+            "(or shift_sign: shifts that run the other way mirror the coordinates)")
 
 
 def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
