@@ -41,7 +41,9 @@ def main() -> None:
             forced = info.get("forced", [])
             refused += bool(forced)
             label = name if axis is None else f"{name} {axis}"
+            modulated = info.get("valid_modulation")
             rows.append((label, f"{100 * part.mask.mean():.1f}%",
+                         f"{100 * part.mask.sum() / modulated:.1f}%" if modulated else "-",
                          f"{100 * share:.2f}% of {links}",
                          f"{100 * info.get('block_jumps', 0) / max(links, 1):.2f}%",
                          _fmt(info.get("stair_misfit")), _fmt(info.get("period_agreement")),
@@ -49,8 +51,8 @@ def main() -> None:
                               if info.get("cell_steps") else None),
                          "; ".join(f[:60] for f in forced) or "-",
                          f"{time.perf_counter() - start:.1f}s"))
-    head = ("part", "valid", "wrong steps", "block jumps", "stair misfit", "periods agree",
-            "cells backwards", "would refuse", "time")
+    head = ("part", "valid", "of modulated", "wrong steps", "block jumps", "stair misfit",
+            "periods agree", "cells backwards", "would refuse", "time")
     widths = [max(len(str(r[i])) for r in [head, *rows]) for i in range(len(head))]
     for row in [head, *rows]:
         print("  ".join(str(v).ljust(w) for v, w in zip(row, widths, strict=True)))

@@ -59,6 +59,8 @@ ROWS = [
     # decode: output paths that would break the next run, unreadable frames named
     (["decode", "{pats}", "--out", "{pats}"], "is the captures' own folder: choose another"),
     (["decode", "{pats}", "--out", "{pats}/00.png/result"], "00.png is a file, not a folder"),
+    (["reconstruct", "{pats}", "--calibration", "{pats}/spec.json", "--out", "{out}.xyz"],
+     "must name a .ply file: the point cloud is written as PLY"),
     (["patterns", "graycode", "--out", "{pats}/spec.json/new"],
      "spec.json is a file, not a folder"),
     (["decode", "{pats}", "--out", ""], "the output path is empty"),

@@ -323,6 +323,8 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
     from .jobs import parse_depth_range, reconstruct_folder
     from .progress import Progress
 
+    if out.suffix.lower() != ".ply":
+        raise CliError(f"--out {out} must name a .ply file: the point cloud is written as PLY")
     depth = depth or out.with_name(out.stem + "-depth")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {k: v for k, v in (("strategy", strategy), ("force", force or None))

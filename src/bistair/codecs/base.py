@@ -48,6 +48,7 @@ from ..core.checks import (
     jump_problem,
     outside_problem,
     refuse,
+    sparse_problem,
     swapped_frames,
     wrap_steps,
 )
@@ -310,6 +311,9 @@ class Codec:
                     "second period or --strategy region avoid it)")]
         judge(jump_problem(orders.info.get("jump_violations", 0),
                            orders.info.get("jump_links", 0)))
+        modulated = int(np.count_nonzero(fs.valid))
+        orders.info.setdefault("valid_modulation", modulated)
+        judge(sparse_problem(int(np.count_nonzero(orders.order >= 0)), modulated))
         words, beyond = code.code, code.beyond
         del code  # its maps are done with: the result is made without them in memory
         result = result_from_orders(self.name, fs, orders.order, spec.period,

@@ -94,9 +94,21 @@ def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
 
 
 def beat(shorter: float, longer: float) -> float:
-    """The beat period of two fringe periods, ``shorter < longer``: the period of the
-    difference of their phases, ``shorter * longer / (longer - shorter)``.
+    """The beat period of two fringe periods: the period of the difference of their
+    phases.
 
+    Parameters
+    ----------
+    shorter, longer : float
+        The two periods in projector pixels, ``shorter < longer``.
+
+    Returns
+    -------
+    float
+        ``shorter * longer / (longer - shorter)``.
+
+    Examples
+    --------
     >>> beat(42.0, 45.0)
     630.0
     """
