@@ -3,7 +3,8 @@
 
 Each codec's captures of one scene are decoded with specs that differ from the one that
 made them: the other orientation, a wider projector, another period, other levels, another
-method's spec with the same frame count, code frames or shift frames swapped. Each decode
+method's spec with the same frame count, code frames or shift frames swapped, a shift frame
+exchanged with a code frame. Each decode
 must either be refused with a one-line :class:`BistairError` or be right (at most 1% of the
 valid pixels more than 5 projector pixels off the truth of the spec's coded axis).
 
@@ -26,7 +27,7 @@ from bistair.errors import BistairError
 from bistair.sim import Imaging, expose, preset, trace
 
 COMMON = ["rows", "wider projector", "another method", "swapped code frames",
-          "swapped shift frames"]
+          "swapped shift frames", "shift and code frames swapped"]
 OWN = {
     "bidirectional": ["period x1.5", "period 2000", "stairs - 1", "partitions + 1"],
     "graycode": ["period x1.5", "not complementary"],
@@ -97,6 +98,15 @@ def _same_frames(method: str, spec: Any) -> Any:
     return made if made.frame_count == frames else None
 
 
+# Mismatches no check catches yet, measured on this scene
+KNOWN_GAPS = {
+    "phase-coding": "shift-0 exchanged with code-cos or code-sin: 15% and 10% of the "
+                    "modulated pixels decoded, 88% and 92% of them wrong; the orders step by "
+                    "one at every phase jump and the four-step residual (0.38 of the "
+                    "modulation) is no larger than a right decode's under an uncompensated "
+                    "gamma of 2.8 (0.39)",
+}
+
 # What a refusal of a spec that does not fit must name: one of the fit checks (the message
 # of every thresholded check starts so), or the frame count; never e.g. "captures are dark"
 FIT = ("the captures do not fit the spec", "frames, the captures have")
@@ -145,6 +155,20 @@ def test_a_spec_that_does_not_fit_is_refused(scene: Any, method: str, case: str)
         for i in range(0, len(frames) - 1, 2):
             swapped = images.copy()
             swapped[[frames[i], frames[i + 1]]] = swapped[[frames[i + 1], frames[i]]]
+            _refused_or_right(swapped, spec, traced.truth)
+        return
+    if case == "shift and code frames swapped":  # shift-0 with the first and the last
+        if method == "phase-coding":  # see KNOWN_GAPS
+            pytest.xfail(KNOWN_GAPS[method])
+        frames = code or list(range(spec.steps, spec.frame_count))
+        for other in sorted({frames[0], frames[-1]}):
+            swapped = images.copy()
+            swapped[[0, other]] = swapped[[other, 0]]
+            try:
+                if not bistair.decode(swapped, spec).mask.any():
+                    continue  # nothing answered (the command line refuses: no pixel decoded)
+            except BistairError:
+                pass  # judged below
             _refused_or_right(swapped, spec, traced.truth)
         return
     if case == "swapped shift frames":
