@@ -473,7 +473,7 @@ def sparse_problem(decoded: int, modulated: int, coverage: float = 0.01,
     [True, True, True]
     """
     if modulated < least or decoded >= coverage * modulated or decoded == 0:
-        return None  # (none decoded: the hard error that no pixel is valid follows)
+        return None  # (none decoded: an empty answer, which the command line refuses)
     return (f"the code was read on only {100 * decoded / modulated:.2f}% of the "
             "well-modulated pixels, as few as pass by chance: does the spec fit the captures "
             "(method, frame order, levels, period), or is there too much noise or blur for "
