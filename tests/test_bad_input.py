@@ -4,8 +4,10 @@ Each row runs ``bistair`` in-process and must exit with code 2, print exactly on
 line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
 uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
 patterns with their spec (they decode), ``{zero}`` and ``{corrupt}`` for copies whose frame
-03.png is empty or not an image, and ``{poses}`` for calibration captures of two poses that
-show no board.
+03.png is empty or not an image, ``{blank}`` for Gray code captures alone whose finest
+column bit shows no contrast (every pixel modulated, none decoded: the library answers
+nothing, the command line refuses), and ``{poses}`` for calibration captures of two poses
+that show no board.
 """
 
 from __future__ import annotations
@@ -80,6 +82,12 @@ ROWS = [
                                            "(a fraction of full scale), got nan"),
     (DECODE + ["--min-modulation", "0.9"], "no pixel has the minimum modulation 0.9 asked for "
                                            "(the most is 0.5"),
+    # decode: an answer of nothing is refused (bistair.decode returns it, every pixel -1)
+    (["decode", "{blank}/columns", "--out", "{out}"],
+     "Error: no pixel decoded (3072 pixels have fringes): does the spec fit the captures "
+     "(method, periods, frame order, phase_offset, shift_sign)?"),
+    (["decode", "{blank}/both", "--out", "{out}"], "Error: x: no pixel decoded (3072 pixels "
+                                                   "have fringes): does the spec fit"),
     # calibrate: at least 3 poses, asked for and usable
     (CALIBRATE + ["--min-poses", "1"], "--min-poses 1 is too few: a camera-projector "
                                        "calibration needs at least 3 board poses"),
@@ -150,6 +158,14 @@ def inputs(tmp_path_factory):
     for name, content in (("zero", b""), ("corrupt", b"not a png at all")):
         shutil.copytree(root / "pats", root / name)
         (root / name / "03.png").write_bytes(content)
+    for orientation in ("columns", "both"):  # the finest column bit and its inverse grey
+        spec = bistair.make_spec("graycode", width=64, height=48, steps=0, inverse=1,
+                                 orientation=orientation)
+        images = np.round(bistair.encode(spec) * 200 + 20).astype(np.uint8)
+        finest = [i for i, name in enumerate(spec.frames)
+                  if name.removeprefix("x/") in ("gray-5", "gray-5-inv")]
+        images[finest] = 120
+        save_captures(images, spec, root / "blank" / orientation)
     (root / "poses").mkdir()
     (root / "poses" / "board.json").write_text(json.dumps(
         {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20.0}))
@@ -166,6 +182,14 @@ def inputs(tmp_path_factory):
     return root
 
 
+def save_captures(images: np.ndarray, spec: bistair.spec.BaseSpec, folder: Path) -> None:
+    """``images`` as ``NN.png`` and ``spec.json`` in ``folder``."""
+    folder.mkdir(parents=True)
+    for i, image in enumerate(images):
+        write_image(folder / f"{i:02d}.png", image)
+    (folder / "spec.json").write_text(spec.to_json())
+
+
 def row_id(args: list[str]) -> str:
     """The command and the options that make the row (not the common ones)."""
     for common in (SIM, BIDI, DECODE, CALIBRATE):
@@ -178,7 +202,8 @@ def row_id(args: list[str]) -> str:
 @pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
 def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
-    paths = {"out": out, **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt")}}
+    paths = {"out": out, **{name: inputs / name
+                            for name in ("pats", "poses", "zero", "corrupt", "blank")}}
     # a run slower than the progress delay (a cold numba cache compiles for seconds) prints
     # progress lines before the refusal: they are not what this test is about
     monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")

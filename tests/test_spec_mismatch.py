@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 import bistair
+from bistair.app.jobs import require_valid
 from bistair.codecs import REGISTRY, lv
 from bistair.errors import BistairError
 from bistair.sim import Imaging, expose, preset, trace
@@ -165,10 +166,15 @@ def test_a_spec_that_does_not_fit_is_refused(scene: Any, method: str, case: str)
             swapped = images.copy()
             swapped[[0, other]] = swapped[[other, 0]]
             try:
-                if not bistair.decode(swapped, spec).mask.any():
-                    continue  # nothing answered (the command line refuses: no pixel decoded)
+                answer = bistair.decode(swapped, spec)
             except BistairError:
-                pass  # judged below
+                answer = None  # judged below
+            if answer is not None and not answer.mask.any():
+                # nothing answered (lv, shift-0 with its last code frame): an answer the
+                # command line refuses, exit code 2 (tests/test_bad_input.py)
+                with pytest.raises(BistairError, match="^no pixel decoded"):
+                    require_valid(answer)
+                continue
             _refused_or_right(swapped, spec, traced.truth)
         return
     if case == "swapped shift frames":
