@@ -1,18 +1,18 @@
-"""A Gray code alone (steps 0): OpenCV's GrayCodePattern bit for bit, decodes against ground
-truth on rendered scenes, and agrees with the real rigs' own decoders."""
+"""A Gray code alone (steps 0): OpenCV's GrayCodePattern bit for bit (its own images, kept in
+tests/data), decodes them and rendered scenes against ground truth, and agrees with the real
+rigs' own decoders."""
 
 from __future__ import annotations
 
 import json
-import math
 from pathlib import Path
 
-import cv2
 import imageio.v3 as iio
 import numpy as np
 import pytest
 from click.testing import CliRunner
 from conftest import SHARED, warped_scene
+from support import opencv_graycode
 
 import bistair
 from bistair.app.cli import cli
@@ -25,53 +25,46 @@ PROCAM = SHARED / "data" / "procam-calibration"
 KAMINO = SHARED / "data" / "kamino-object1"
 
 
-def opencv_graycode(width: int, height: int) -> list[np.ndarray]:
-    """OpenCV's ``GrayCodePattern::generate`` (structured_light module, graycodepattern.cpp)
-    written out, then its shadow-mask images white and black: for column j and bit image k
-    (k = 0 the least significant), the pixel is lit where bit k of j's Gray code
-    (``(j >> k) ^ (j >> (k + 1))``, low bit) is 1; image ``2*(n - k - 1)`` holds it and the
-    next its inverse; columns first, then rows the same way."""
-    out = []
-    for length, other, axis in ((width, height, 1), (height, width, 0)):
-        n = math.ceil(math.log(length) / math.log(2))
-        imgs = [None] * (2 * n)
-        for k in range(n):
-            flag = np.zeros(length, np.uint8)
-            for j in range(length):
-                num, prev = j, j % 2
-                for _ in range(k + 1):
-                    num //= 2
-                    rem = num % 2
-                    f = 1 if rem != prev else 0
-                    prev = rem
-                flag[j] = f
-            line = flag * 255
-            img = np.tile(line, (other, 1)) if axis == 1 else np.tile(line[:, None], (1, other))
-            imgs[2 * n - 2 * k - 2] = img.astype(np.uint8)
-            imgs[2 * n - 2 * k - 1] = (255 - img).astype(np.uint8)
-        out += imgs
-    return out + [np.full((height, width), 255, np.uint8), np.zeros((height, width), np.uint8)]
-
-
-@pytest.mark.parametrize("size", [(1024, 768), (37, 19), (320, 200)])
-def test_patterns_are_opencvs_graycodepattern(tmp_path, size):
-    width, height = size
+def patterns_of(tmp_path: Path, width: int, height: int) -> np.ndarray:
+    """``bistair patterns graycode --steps 0 --inverse 1 --white 1 --orientation both``."""
     result = CliRunner().invoke(cli, ["patterns", "graycode", "--steps", "0", "--inverse", "1",
                                       "--white", "1", "--orientation", "both", "--width",
                                       str(width), "--height", str(height), "--out",
                                       str(tmp_path)])
     assert result.exit_code == 0, result.output
-    ours = [iio.imread(p) for p in sorted(tmp_path.glob("*.png"))]
-    if hasattr(cv2, "structured_light"):  # opencv-contrib installed: OpenCV itself
-        ok, pats = cv2.structured_light.GrayCodePattern.create(width, height).generate()
-        want = [*pats, np.full((height, width), 255, np.uint8), np.zeros((height, width),
-                                                                         np.uint8)]
-    else:  # the same loops, from OpenCV's source
-        want = opencv_graycode(width, height)
-    assert len(ours) == len(want)
-    assert all(np.array_equal(a, b) for a, b in zip(ours, want, strict=True))
     spec = json.loads((tmp_path / "spec.json").read_text())
     assert spec["period"] == 1 and spec["frames"][-2:] == ["white", "black"]
+    return np.stack([iio.imread(p) for p in sorted(tmp_path.glob("*.png"))])
+
+
+@pytest.mark.parametrize("size", opencv_graycode.SIZES)
+def test_patterns_and_decode_are_opencvs_graycodepattern(tmp_path, size):
+    """OpenCV's own GrayCodePattern images (tests/data/opencv_graycode.npz, made by
+    OpenCV 5.0 with tests/support/opencv_graycode.py): the patterns bit for bit, and decoded
+    (OpenCV's images as captures, one camera pixel a projector pixel) to each pixel's own
+    column and row, with and without the white and black frames."""
+    width, height = size
+    theirs = opencv_graycode.load(width, height)
+    assert np.array_equal(patterns_of(tmp_path, width, height), theirs)
+    for white in (1, 0):
+        spec = bistair.make_spec("graycode", steps=0, inverse=1, white=white,
+                                 orientation="both", width=width, height=height)
+        res = bistair.decode(theirs if white else theirs[:-2], spec)
+        rows, columns = np.indices((height, width))
+        assert res.x.mask.all() and res.y.mask.all()
+        assert np.array_equal(res.x.order, columns) and np.array_equal(res.y.order, rows)
+        # the coordinate goes through the float32 phase: 28.999998 for 29
+        assert np.abs(res.x.coord - columns).max() < 1e-4
+        assert np.abs(res.y.coord - rows).max() < 1e-4
+
+
+@pytest.mark.skipif(not PROCAM.is_dir(), reason="../shared/data/procam-calibration not present")
+def test_patterns_are_procams_own_1024x768(tmp_path):
+    """procam-calibration's graycode_pattern/ (made by its gen_graycode_imgs.py with
+    OpenCV's GrayCodePattern for its 1024 x 768 projector): the same 42 images."""
+    theirs = np.stack([iio.imread(p) for p in sorted((PROCAM / "graycode_pattern")
+                                                      .glob("pattern_*.png"))])
+    assert np.array_equal(patterns_of(tmp_path, 1024, 768), theirs)
 
 
 @pytest.mark.parametrize(("inverse", "period", "orientation"),

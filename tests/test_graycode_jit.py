@@ -1,6 +1,7 @@
-"""The Gray code's compiled passes (bistair.codecs.graycode_jit: code bits, orders) give, bit
-for bit, what the NumPy expressions they replaced gave (written out here), on random data
-and on the values where roundings and thresholds bite."""
+"""The Gray code's compiled passes (bistair.codecs.graycode_jit: code bits, orders, and the
+Gray code alone's levels and cells) give, bit for bit, what NumPy gives (written out here:
+the first bit the most significant, as OpenCV's GrayCodePattern), on random data and on the
+values where roundings and thresholds bite."""
 
 from __future__ import annotations
 
@@ -8,11 +9,9 @@ import numpy as np
 from support.arrays import same
 
 from bistair.codecs.graycode import gray_to_binary
-from bistair.codecs.graycode_jit import code_bits, gray_orders
+from bistair.codecs.graycode_jit import alone_cells, alone_levels, code_bits, gray_orders
 from bistair.core.captures import ScaledStack
-from bistair.core.phase import (
-    TWO_PI,
-)
+from bistair.core.phase import TWO_PI
 
 RNG = np.random.default_rng(7)
 
@@ -29,7 +28,6 @@ def test_code_bits_are_numpys():
             gray <<= 1
             gray |= frame > against
         assert same(code_bits(raw, 2, 3, np.float32(1 / 255), avg, inverse), gray)
-
 
 
 def test_gray_orders_are_numpys():
@@ -53,3 +51,79 @@ def test_gray_orders_are_numpys():
         assert same(code, np.where(ok, k, -1).astype(np.int32))
         assert same(got_edges, np.where(valid, edges, -1).astype(np.int32))
         assert beyond == int(np.count_nonzero(valid & (k >= fringes)))
+
+
+def alone_levels_numpy(raw: np.ndarray, bits: int, inverse: bool, scale: float,
+                       white: np.ndarray, black: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The twin of ``alone_levels``: with inverses (frames ``2i``, ``2i + 1``) the mid-level
+    is the float32 sum over the bits, in bit order, of ``pattern + inverse`` times 0.5 over
+    the bits, the contrast the median of ``|pattern - inverse| * 0.5``; without, half the
+    sum and half the difference of white and black."""
+    half = np.float32(0.5)
+    if not inverse:
+        return (white + black) * half, (white - black) * half
+    frames = raw[:2 * bits].astype(np.float32) * np.float32(scale)
+    total = np.zeros(raw.shape[1:], np.float32)
+    for i in range(bits):
+        total += frames[2 * i] + frames[2 * i + 1]
+    diff = np.abs(frames[0::2] - frames[1::2]) * half
+    return total * half / np.float32(bits), np.median(diff, axis=0).astype(np.float32)
+
+
+def alone_cells_numpy(raw: np.ndarray, bits: int, inverse: bool, scale: float,
+                      mid: np.ndarray, valid: np.ndarray, clear: float) -> np.ndarray:
+    """The twin of ``alone_cells``: bit ``i`` (frame ``2i`` against ``2i + 1``, or frame
+    ``i`` against ``mid``) is 1 where the difference is positive and clear where it is at
+    least ``clear``; the first bit is the most significant of the Gray code word; -1 where
+    not ``valid`` or a bit is not clear."""
+    frames = raw.astype(np.float32) * np.float32(scale)
+    word = np.zeros(raw.shape[1:], np.int32)
+    ok = valid.copy()
+    for i in range(bits):
+        diff = frames[2 * i] - frames[2 * i + 1] if inverse else frames[i] - mid
+        ok &= np.abs(diff) >= np.float32(clear)
+        word = (word << 1) | (diff > 0)
+    return np.where(ok, gray_to_binary(word), -1).astype(np.int32)
+
+
+def gray_frames(bits: int, inverse: bool, shape: tuple[int, int]) -> np.ndarray:
+    """uint8 captures of random cells (each bit and, with ``inverse``, its inverse; contrast
+    and noise random), a few differences exactly zero and exactly at the clear limit."""
+    cells = RNG.integers(0, 2**bits, shape)
+    gray = cells ^ (cells >> 1)
+    lit = [(gray >> (bits - 1 - i)) & 1 for i in range(bits)]
+    low = RNG.integers(0, 80, shape)
+    high = low + RNG.integers(0, 170, shape)
+    frames = []
+    for bit in lit:
+        pattern = np.where(bit, high, low) + RNG.integers(-6, 7, shape)
+        frames += [pattern, np.where(bit, low, high) + RNG.integers(-6, 7, shape)] if inverse \
+            else [pattern]
+    raw = np.clip(frames, 0, 255).astype(np.uint8)
+    if inverse:
+        raw[1, 0, :5] = raw[0, 0, :5]  # no difference: not clear
+        raw[0, 1, :5], raw[1, 1, :5] = 100, 105  # exactly the limit (5 / 255)
+    return raw
+
+
+def test_alone_levels_are_numpys():
+    for inverse in (True, False):
+        raw = gray_frames(7, inverse, (30, 40))
+        white = RNG.uniform(0.3, 1, (30, 40)).astype(np.float32)
+        black = (white * RNG.uniform(-0.1, 0.6, (30, 40))).astype(np.float32)
+        args = (raw, 7, inverse, 1 / 255, white, black)
+        for got, want in zip(alone_levels(*args), alone_levels_numpy(*args), strict=True):
+            assert same(got, want)
+
+
+def test_alone_cells_are_numpys():
+    for bits, inverse in ((7, True), (6, False), (1, True)):
+        raw = gray_frames(bits, inverse, (30, 40))
+        mid = RNG.uniform(0.1, 0.6, (30, 40)).astype(np.float32)
+        mid.flat[:3] = raw[0].flat[:3] / np.float32(255)  # a bit equal to the mid-level
+        valid = RNG.random((30, 40)) < 0.9
+        for clear in (np.float32(5 / 255), 0.02, 0.0):
+            args = (raw, bits, inverse, 1 / 255, mid, valid, float(clear))
+            got, want = alone_cells(*args), alone_cells_numpy(*args)
+            assert same(got, want), (bits, inverse, clear)
+            assert (got >= 0).mean() > (0.2 if clear else 0.8)  # cells decoded, not all -1
