@@ -4,8 +4,10 @@
 camera blur 1.2 px, projector blur 1.0 px, 15% ambient, gamma 2.2) and low-resolution
 cameras (320 x 256: about 5 camera pixels per fringe, partition bands 3 px tall): every
 decode is right (at most 0.5% of its valid pixels more than half a period off the truth),
-refused, or says why it may not be (a warning in ``info``). With the projector's gamma
-compensated, the 121-codeword decodes are right.
+or says why it may not be (a warning in ``info``). With the projector's gamma compensated,
+the 121-codeword decodes are right. Each case must decode (a refusal of every decode would
+pass "right or refused" and is as bad as a wrong one): at least 60% of the truth's pixels
+(measured 68.9-99.7% at 320 x 256, 77.8% for the uncompensated gamma).
 """
 
 from __future__ import annotations
@@ -26,7 +28,8 @@ CODE_121 = dict(period=16, partitions=11, stairs=11)
 
 def _decode(scene: str, camera: tuple[int, int], seed: int, optics: dict, code: dict,
             compensated: bool) -> tuple[str, float, list[str]]:
-    """(outcome, wrong share, warnings) of one rendered decode."""
+    """(outcome, wrong share, warnings) of one rendered decode; a decode must answer for
+    at least 60% of the pixels the truth knows."""
     rig, geometry = preset(scene, camera_size=camera)
     imaging = Imaging(**optics, seed=seed)
     traced = trace(rig, geometry, imaging)
@@ -38,7 +41,7 @@ def _decode(scene: str, camera: tuple[int, int], seed: int, optics: dict, code: 
     except BistairError:
         return "refused", 0.0, []
     both = result.mask & traced.truth.mask
-    assert both.sum() > 1000
+    assert both.sum() >= 0.6 * traced.truth.mask.sum(), f"{both.sum()} pixels decoded"
     wrong = float(np.mean(np.abs(result.coord - traced.truth.coord_x)[both] > spec.period / 2))
     return "decoded", wrong, result.info.get("warnings", [])
 
@@ -52,12 +55,14 @@ def test_121_codewords_under_hard_optics_are_right(scene, seed):
 
 def test_121_codewords_misread_by_an_uncompensated_gamma_warn():
     """paper-sim: the uncompensated gamma moves a partition level nearer its neighbour, and
-    a whole partition of the bust reads one partition off (about 20% of the valid pixels,
-    each region's own code consistent with it): not refused, but the decode says why."""
+    a whole partition of the bust reads one partition off (measured 19.9% of the valid
+    pixels, each region's own code consistent with it): not refused, but the decode says
+    why."""
     outcome, wrong, warnings = _decode("paper-sim", (1280, 1024), 0, HARD, CODE_121,
                                        compensated=False)
-    assert outcome == "refused" or wrong <= 0.005 or any("gamma" in w for w in warnings), \
-        f"{100 * wrong:.2f}% wrong, no refusal, no warning"
+    assert outcome == "decoded"
+    assert wrong <= 0.005 or any("gamma" in w for w in warnings), \
+        f"{100 * wrong:.2f}% wrong, no warning"
 
 
 @pytest.mark.parametrize("scene", ["paper-sim"])
@@ -76,10 +81,11 @@ def test_low_resolution_decodes_are_never_silently_wrong(scene, seed):
     outcome, wrong, warnings = _decode(scene, (320, 256), seed, LOW,
                                        dict(period=30, partitions=8, stairs=8),
                                        compensated=True)
-    assert outcome == "refused" or wrong <= 0.005 or any("partition bands" in w
-                                                        for w in warnings), \
-        f"{100 * wrong:.2f}% wrong, no refusal, no warning"
-    assert outcome == "refused" or wrong <= 0.02  # and never a whole object off
+    # measured: all 12 decode, 68.9-99.7% of the truth's pixels, 0-1.3% wrong
+    assert outcome == "decoded"
+    assert wrong <= 0.005 or any("partition bands" in w for w in warnings), \
+        f"{100 * wrong:.2f}% wrong, no warning"
+    assert wrong <= 0.02  # and never a whole object off
 
 
 def test_the_stripe_above_the_sphere_is_not_given_the_spheres_orders(tmp_path):
