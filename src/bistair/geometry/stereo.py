@@ -59,6 +59,13 @@ from ..errors import BistairError
 from ..spec import BaseSpec
 from .calibration import Calibration, Device
 from .stereo_calibration import StereoCalibration, load_stereo_calibration
+from .stereo_checks import (
+    MISFIT_PX,
+    OTHER_AXIS_MAX,
+    other_axis_share,
+    projector_misfits,
+    same_captures,
+)
 from .stereo_jit import (
     ALONE,
     AMBIGUOUS,
@@ -80,6 +87,10 @@ from .triangulate import check_depth_range
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
 MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
 KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
+MISFIT_FLOOR = 0.002  # projector misfits over this share: other readings of the inputs tried
+MISFIT_RATIO = 5.0  # ... one of them refused when that reading has this many times fewer
+MISFIT_WARN = 0.01  # ... else a warning over this share
+WARN_BASELINE = 10.0  # mm: a shorter baseline is warned about (T in metres, in squares)
 
 
 @dataclass(frozen=True, eq=False)
@@ -329,6 +340,64 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
             raise BistairError(f"the {name} must be positive, got {value}")
     rect = rectification or rectify(calibration)
     coords = _coordinates(left, right, calibration, orientation)
+    settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
+    m = _match(coords, rect, *settings)
+    mask = np.isfinite(m.depth)
+    counts = np.bincount(m.status.ravel(), minlength=8)
+    info: dict[str, Any] = {
+        "left_decoded": int(m.decoded.sum()), "matched": int(mask.sum()),
+        "matched_fraction": round(float(mask.sum() / max(m.decoded.sum(), 1)), 6),
+        "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
+        "not_monotonic": int(counts[NOT_MONOTONIC]),
+        "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
+        "alone": int(counts[ALONE]),
+        "rectified_matches": int(counts[MATCHED]), "outside_range": int(m.outside),
+        "matched_axis": m.axis,
+        "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
+                      "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
+                      "cx_right": rect.cx_right, "tx": rect.tx,
+                      "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
+        "noise_px": round(m.noise, 4), "tolerance_px": round(m.tolerance, 4),
+        "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(m.wiggle, 4),
+        "support_px": round(m.support, 4), "smooth_px": smooth, "warnings": []}
+    problems = _check_matches(info, m, coords, rect, calibration, settings)
+    if problems and not force:
+        raise BistairError(problems[0])
+    info["warnings"] += problems
+    if calibration.baseline < WARN_BASELINE:
+        depths = m.depth[mask]
+        where = (f"; the points lie {np.min(depths):.3g}-{np.max(depths):.3g} mm away"
+                 if depths.size else "")
+        info["warnings"].append(f"a baseline of {calibration.baseline:.3g} mm: T must be in "
+                                f"millimetres, not metres or board squares{where}")
+    return StereoResult(m.disparity, m.depth, _grey(left, offset), mask, left, right, rect,
+                        info)
+
+
+@dataclass
+class _Matched:
+    """What :func:`_match` gives: the matched axis, the disparity and status on the
+    rectified left grid, the depth on the left camera's own grid (and how many points fell
+    outside the depth range), the left pixels decoded on that axis, and the thresholds
+    used (noise, tolerance, wiggle, support: rectified pixels)."""
+
+    axis: str
+    disparity: np.ndarray
+    status: np.ndarray
+    depth: np.ndarray
+    outside: int
+    decoded: np.ndarray
+    noise: float
+    tolerance: float
+    wiggle: float
+    support: float
+
+
+def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification,
+           min_depth: float, max_depth: float, tolerance: float, other_tolerance: float,
+           gap: int, wiggle: float, support: float, smooth: float) -> _Matched:
+    """Resample both cameras' projector coordinates onto the rectified grids, match them
+    along the rows and triangulate (steps 2-4 of the module docstring)."""
     spread = {name: _step(pair[0]) for name, pair in coords.items()}
     on_grid = {name: (remap_valid(lc, *rect.maps_left, spread[name]),
                       remap_valid(rc, *rect.maps_right, spread[name]))
@@ -358,33 +427,67 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     decoded = np.isfinite(coords[axis][0])
     depth, outside = grid_depth(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
                                 rect.cy, rect.tx, rect.R1, min_depth, max_depth)
-    mask = np.isfinite(depth)
-    counts = np.bincount(status.ravel(), minlength=8)
-    info: dict[str, Any] = {
-        "left_decoded": int(decoded.sum()), "matched": int(mask.sum()),
-        "matched_fraction": round(float(mask.sum() / max(decoded.sum(), 1)), 6),
-        "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
-        "not_monotonic": int(counts[NOT_MONOTONIC]),
-        "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
-        "alone": int(counts[ALONE]),
-        "rectified_matches": int(counts[MATCHED]), "outside_range": int(outside),
-        "matched_axis": axis,
-        "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
-                      "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
-                      "cx_right": rect.cx_right, "tx": rect.tx,
-                      "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
-        "noise_px": round(noise, 4), "tolerance_px": round(tolerance, 4),
-        "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(wiggle, 4),
-        "support_px": round(support, 4), "smooth_px": smooth, "warnings": []}
+    return _Matched(axis, disparity, status, depth, int(outside), decoded, noise, tolerance,
+                    wiggle, support)
+
+
+def _misfits(m: _Matched, coords: dict[str, tuple[np.ndarray, np.ndarray]],
+             rect: Rectification) -> tuple[float, float]:
+    """The projector misfits of a match (:func:`~.stereo_checks.projector_misfits`) and
+    its share of the decoded left pixels with a point."""
+    mask = np.isfinite(m.depth)
+    rows, cols = np.nonzero(mask)
+    z = m.depth[rows, cols]
+    points = np.column_stack([z * rect.rays[0][rows, cols], z * rect.rays[1][rows, cols], z])
+    share = float(mask.sum() / max(m.decoded.sum(), 1))
+    return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share
+
+
+def _check_matches(info: dict[str, Any], m: _Matched,
+                   coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification,
+                   calibration: StereoCalibration,
+                   settings: tuple) -> list[str]:
+    """What the matches say against the inputs (refused without ``force``): too few
+    matches, projector rows that disagree (both axes), points no projector lit; ``info``
+    gets ``other_axis_share`` and ``projector_misfits``."""
     share = info["matched_fraction"]
     if share < MIN_MATCHED:
-        message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
-                   "pixels found their match in the right camera: is the calibration for these "
-                   "cameras, and are LEFT and RIGHT the right way round?")
-        if not force:
-            raise BistairError(message)
-        info["warnings"].append(message)
-    return StereoResult(disparity, depth, _grey(left, offset), mask, left, right, rect, info)
+        return [f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left pixels "
+                "found their match in the right camera: is the calibration for these "
+                "cameras, and are LEFT and RIGHT the right way round?"]
+    if len(coords) == 2:
+        rows = info["other_axis_share"] = round(
+            other_axis_share(info["other_axis"], info["left_decoded"]), 6)
+        if rows > OTHER_AXIS_MAX:
+            return [f"the projector rows disagree between the two cameras at {100 * rows:.0f}% "
+                    f"of the decoded left pixels (over {100 * OTHER_AXIS_MAX:.0f}%): the "
+                    "rectified rows are not the same in both; are LEFT and RIGHT the right way "
+                    "round, is the calibration for these cameras, is one image upside down?"]
+    misfits = info["projector_misfits"] = round(_misfits(m, coords, rect)[0], 6)
+    if misfits <= MISFIT_FLOOR:
+        return []
+    # which other reading of the inputs fits one projector: the cameras exchanged, the right
+    # images upside down
+    others = {"with the right images turned upside down": {
+        k: (a, b[::-1]) for k, (a, b) in coords.items()}}
+    if calibration.left.size == calibration.right.size:
+        others["with LEFT and RIGHT exchanged"] = {k: (b, a) for k, (a, b) in coords.items()}
+    for reading, alt in others.items():
+        try:
+            other_misfits, other_share = _misfits(_match(alt, rect, *settings), alt, rect)
+        except BistairError:
+            continue
+        if other_share >= MIN_MATCHED and other_misfits * MISFIT_RATIO <= misfits:
+            return [f"{100 * misfits:.1f}% of the points lie off the projector that lit the "
+                    f"others (over {MISFIT_PX:g} projector pixels), {100 * other_misfits:.2f}% "
+                    f"{reading}: " + ("are LEFT and RIGHT the right way round?"
+                                      if "exchanged" in reading
+                                      else "is the right camera upside down?")]
+    if misfits > MISFIT_WARN:
+        info["warnings"].append(
+            f"{100 * misfits:.1f}% of the points lie off the projector that lit the others "
+            f"(over {MISFIT_PX:g} projector pixels): is the calibration for these cameras?")
+    return []
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
@@ -554,6 +657,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         raise BistairError("left and right captures differ: " + " and ".join(
             f"{s[0]} frames of {s[2]}x{s[1]}" if len(s) == 3 else f"shape {s}"
             for s in (left_images.shape, right_images.shape)))
+    same_captures(left_images, right_images)
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")

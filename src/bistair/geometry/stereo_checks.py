@@ -1,0 +1,141 @@
+"""Checks that a binocular reconstruction's inputs fit each other, beyond what the matching
+itself refuses (:mod:`bistair.geometry.stereo`): the same captures given for both cameras,
+two cameras whose projector rows disagree (both axes decoded), and points that no single
+projector could have lit (:func:`projector_misfits`).
+
+The projector is the third view of every scene point: the coordinate each point was lit
+with is, for a pinhole projector, a ratio of two affine functions of the point,
+``x_p = (a . P + a0) / (c . P + c0)``, the same seven numbers for every point. A right
+reconstruction fits it to the decode's noise (plus the projector's smooth lens distortion,
+fitted as a cubic of ``x_p`` and the image row); a pair whose rows do not correspond
+(cameras exchanged, R, T of another pair, an image upside down) puts points where no
+projector ray meets them, tens of projector pixels off. What it cannot see: a
+reconstruction that is a projective distortion of the truth fits as well (a baseline or
+focal length scaled, and, with one coded axis, cameras exchanged on a scene without detail
+down the image: a plane, upright cylinders), so these checks judge only what a scene shows.
+
+Examples
+--------
+Points lit by a pinhole projector fit it; moving a few of them along the ray makes them
+misfits:
+
+>>> rng = np.random.default_rng(0)
+>>> pts = rng.uniform([-100, -80, 500], [100, 80, 700], (4000, 3))
+>>> coord = 960 + 2000 * (pts[:, 0] - 100) / pts[:, 2]
+>>> rows = 240 + 600 * pts[:, 1] / pts[:, 2]
+>>> projector_misfits(pts, coord, rows)
+0.0
+>>> pts[:200, 2] *= 1.2
+>>> round(projector_misfits(pts, coord, rows), 3)
+0.05
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import BistairError
+
+MISFIT_PX = 5.0  # a point off the projector's fit by more than this (projector px) misfits
+MISFIT_SAMPLE = 30000  # points fitted (evenly spaced through the matched ones)
+MISFIT_MIN_POINTS = 1000  # fewer points: nothing judged
+OTHER_AXIS_MAX = 0.20  # share of the decoded left pixels whose projector rows disagree
+
+
+def same_captures(left: np.ndarray, right: np.ndarray) -> None:
+    """Refuse one camera's captures given for both (two cameras never give equal images:
+    their noise alone differs).
+
+    Raises
+    ------
+    BistairError
+        ``left`` and ``right`` hold the same values.
+
+    Examples
+    --------
+    >>> same_captures(np.zeros((3, 4, 4)), np.ones((3, 4, 4)))
+    >>> same_captures(np.zeros((3, 4, 4)), np.zeros((3, 4, 4)))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the left and right captures are the same images: ...
+    """
+    if left.shape == right.shape and np.array_equal(left[0], right[0]) and \
+            np.array_equal(left, right):
+        raise BistairError("the left and right captures are the same images: give each "
+                           "camera's own captures")
+
+
+def other_axis_share(rejected: int, decoded: int) -> float:
+    """The share of the decoded left pixels whose match the other projector axis refused.
+
+    Examples
+    --------
+    >>> other_axis_share(50, 1000)
+    0.05
+    """
+    return rejected / max(decoded, 1)
+
+
+def projector_misfits(points: np.ndarray, coord: np.ndarray, rows: np.ndarray) -> float:
+    """The share of points farther than :data:`MISFIT_PX` (projector pixels) from the
+    projector that best explains the rest.
+
+    Fitted on up to :data:`MISFIT_SAMPLE` points evenly spaced through the list: the
+    pinhole projector's coordinate ``(a . P + a0) / (c . P + c0)`` (direct linear
+    transform, weighted toward the geometric error), plus a cubic in the coordinate and
+    the image row for its lens distortion, refitted four times without the tenth of the
+    points that fit worst.
+
+    Parameters
+    ----------
+    points : numpy.ndarray
+        ``(N, 3)`` points (any frame, mm).
+    coord : numpy.ndarray
+        ``(N,)`` the projector coordinate each point was decoded with (the matched axis).
+    rows : numpy.ndarray
+        ``(N,)`` each point's image row (a stand-in for the projector's other coordinate
+        in the distortion).
+
+    Returns
+    -------
+    float
+        The share of misfits among the points fitted; 0 for fewer than
+        :data:`MISFIT_MIN_POINTS` points.
+    """
+    n = len(coord)
+    if n < MISFIT_MIN_POINTS:
+        return 0.0
+    pick = np.linspace(0, n - 1, min(n, MISFIT_SAMPLE)).astype(np.int64)
+    pts, x, v = (np.asarray(a, float)[pick] for a in (points, coord, rows))
+    centre = pts.mean(axis=0)
+    scale = np.sqrt(((pts - centre) ** 2).sum(axis=1).mean() / 3) or 1.0
+    pts = (pts - centre) / scale
+    x_mean, x_scale = x.mean(), x.std() or 1.0
+    xn = (x - x_mean) / x_scale
+    vn = (v - v.mean()) / (v.std() or 1.0)
+    cubic = np.column_stack([xn**i * vn**j for i in range(4) for j in range(4 - i)])
+    bent = np.zeros_like(xn)  # the distortion's share of each coordinate
+    keep = np.arange(len(xn))
+    for _ in range(4):
+        p = _dlt(pts[keep], (xn - bent)[keep])
+        residual = xn - (pts @ p[:3] + p[3]) / (pts @ p[4:7] + p[7])
+        sub = cubic[keep]
+        bent = cubic @ np.linalg.solve(sub.T @ sub, sub.T @ residual[keep])
+        off = np.abs(residual - bent)
+        keep = np.flatnonzero(off <= np.quantile(off, 0.9))
+    return float(np.mean(off * x_scale > MISFIT_PX))
+
+
+def _dlt(pts: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``(a, a0, c, c0)`` of ``x = (a . P + a0) / (c . P + c0)`` by least squares on
+    ``a . P + a0 - x (c . P + c0) = 0`` (the eigenvector of the normal matrix with the
+    least eigenvalue), reweighted three times by ``1 / |c . P + c0|`` (toward the
+    geometric error)."""
+    system = np.column_stack([pts, np.ones(len(x)), -x[:, None] * pts, -x])
+    weight = np.ones(len(x))
+    for _ in range(3):
+        rows = system * weight[:, None]
+        p = np.linalg.eigh(rows.T @ rows)[1][:, 0]
+        weight = 1.0 / np.maximum(np.abs(pts @ p[4:7] + p[7]), 1e-12)
+        weight /= np.median(weight)
+    return p
