@@ -60,9 +60,9 @@ from ..spec import BaseSpec
 from .calibration import Calibration, Device
 from .stereo_calibration import StereoCalibration, load_stereo_calibration
 from .stereo_checks import (
-    MISFIT_PX,
-    OTHER_AXIS_MAX,
-    other_axis_share,
+    Coords,
+    check_matches,
+    other_readings,
     projector_misfits,
     same_captures,
 )
@@ -85,11 +85,7 @@ from .stereo_jit import (
 from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
-MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
 KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
-MISFIT_FLOOR = 0.002  # projector misfits over this share: other readings of the inputs tried
-MISFIT_RATIO = 5.0  # ... one of them refused when that reading has this many times fewer
-MISFIT_WARN = 0.01  # ... else a warning over this share
 WARN_BASELINE = 10.0  # mm: a shorter baseline is warned about (T in metres, in squares)
 
 
@@ -302,8 +298,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         The patterns' mean (the spec's ``offset``): scales the fringes' average to grey
         when there is no white frame.
     force : bool, optional
-        Keep a reconstruction that matches fewer than :data:`MIN_MATCHED` of the left
-        pixels (with a warning in ``info``) instead of refusing it.
+        Keep a reconstruction that the checks of the matches
+        (:func:`~.stereo_checks.check_matches`) would refuse, with the reason as a warning in
+        ``info``.
 
     Returns
     -------
@@ -311,15 +308,20 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         ``info`` counts ``left_decoded`` (valid left pixels on the matched axis),
         ``matched`` (their points), ``unmatched``, ``ambiguous``, ``not_monotonic``,
         ``inconsistent`` and ``other_axis`` (on the rectified grid), ``outside_range``,
-        and gives ``matched_axis``, ``rectified`` (grids, ``f``, ``tx``) and the tolerances.
+        and gives ``matched_axis``, ``rectified`` (grids, ``f``, ``tx``), the tolerances,
+        ``other_axis_share`` (both axes), ``projector_misfits`` (the share of points off
+        the projector that lit the others), ``other_readings`` (when tried) and
+        ``warnings`` (a baseline under 10 mm, misfits over 1%).
 
     Raises
     ------
     BistairError
         A bad depth range, tolerance or smoothing, decodes of different kinds or sizes,
         sizes other than the calibration's, a coded axis that does not change along the
-        baseline, phases that run opposite ways in the
-        two cameras, or (without ``force``) too few matches.
+        baseline, phases that run opposite ways in the two cameras, or (without ``force``)
+        what :func:`~.stereo_checks.check_matches` refuses: too few matches, projector rows
+        that disagree, points that fit one projector only with the cameras exchanged or the
+        right images upside down.
 
     Examples
     --------
@@ -360,7 +362,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         "noise_px": round(m.noise, 4), "tolerance_px": round(m.tolerance, 4),
         "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(m.wiggle, 4),
         "support_px": round(m.support, 4), "smooth_px": smooth, "warnings": []}
-    problems = _check_matches(info, m, coords, rect, calibration, settings)
+    problems = check_matches(info, coords, lambda alt: _misfits(alt, rect, settings),
+                             calibration.left.size == calibration.right.size,
+                             _misfits(coords, rect, settings, m)[0])
     if problems and not force:
         raise BistairError(problems[0])
     info["warnings"] += problems
@@ -431,10 +435,12 @@ def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification
                     wiggle, support)
 
 
-def _misfits(m: _Matched, coords: dict[str, tuple[np.ndarray, np.ndarray]],
-             rect: Rectification) -> tuple[float, float]:
-    """The projector misfits of a match (:func:`~.stereo_checks.projector_misfits`) and
-    its share of the decoded left pixels with a point."""
+def _misfits(coords: Coords, rect: Rectification, settings: tuple,
+             m: _Matched | None = None) -> tuple[float, float]:
+    """The projector misfits (:func:`~.stereo_checks.projector_misfits`) of the match of
+    ``coords`` (``m`` if already made) and its share of the decoded left pixels with a
+    point."""
+    m = m or _match(coords, rect, *settings)
     mask = np.isfinite(m.depth)
     rows, cols = np.nonzero(mask)
     z = m.depth[rows, cols]
@@ -443,51 +449,51 @@ def _misfits(m: _Matched, coords: dict[str, tuple[np.ndarray, np.ndarray]],
     return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share
 
 
-def _check_matches(info: dict[str, Any], m: _Matched,
-                   coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification,
-                   calibration: StereoCalibration,
-                   settings: tuple) -> list[str]:
-    """What the matches say against the inputs (refused without ``force``): too few
-    matches, projector rows that disagree (both axes), points no projector lit; ``info``
-    gets ``other_axis_share`` and ``projector_misfits``."""
-    share = info["matched_fraction"]
-    if share < MIN_MATCHED:
-        return [f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left pixels "
-                "found their match in the right camera: is the calibration for these "
-                "cameras, and are LEFT and RIGHT the right way round?"]
-    if len(coords) == 2:
-        rows = info["other_axis_share"] = round(
-            other_axis_share(info["other_axis"], info["left_decoded"]), 6)
-        if rows > OTHER_AXIS_MAX:
-            return [f"the projector rows disagree between the two cameras at {100 * rows:.0f}% "
-                    f"of the decoded left pixels (over {100 * OTHER_AXIS_MAX:.0f}%): the "
-                    "rectified rows are not the same in both; are LEFT and RIGHT the right way "
-                    "round, is the calibration for these cameras, is one image upside down?"]
-    misfits = info["projector_misfits"] = round(_misfits(m, coords, rect)[0], 6)
-    if misfits <= MISFIT_FLOOR:
-        return []
-    # which other reading of the inputs fits one projector: the cameras exchanged, the right
-    # images upside down
-    others = {"with the right images turned upside down": {
-        k: (a, b[::-1]) for k, (a, b) in coords.items()}}
-    if calibration.left.size == calibration.right.size:
-        others["with LEFT and RIGHT exchanged"] = {k: (b, a) for k, (a, b) in coords.items()}
-    for reading, alt in others.items():
+def readings(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
+             calibration: StereoCalibration, orientation: str,
+             rectification: Rectification | None = None, min_depth: float = 0.0,
+             max_depth: float = math.inf, tolerance: float = 1.0,
+             other_tolerance: float = 2.0, gap: int = 3, wiggle: float = 1.0,
+             support: float = 2.0, smooth: float = 1.0) -> dict[str, tuple[float, float]]:
+    """How well each reading of two decodes fits one projector: as given, with the cameras
+    exchanged and with the right images upside down (:func:`~.stereo_checks.other_readings`),
+    each ``(misfits, matched share)``: what :func:`reconstruct_stereo` weighs when the
+    reading as given has misfits over :data:`~.stereo_checks.MISFIT_FLOOR`
+    (``benchmarks/stereo_margins.py`` prints them for every case).
+
+    Parameters
+    ----------
+    left, right, calibration, orientation, rectification
+        As for :func:`reconstruct_stereo`.
+    min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth
+        The matching's settings, as for :func:`reconstruct_stereo`.
+
+    Returns
+    -------
+    dict
+        ``{"as given": (misfits, share), reading: (misfits, share), ...}``; a reading
+        whose matching refuses the inputs is left out.
+
+    Examples
+    --------
+    >>> cal = _toy_stereo()
+    >>> left, right = (_plane_decode(cal, side, 500.0) for side in ("left", "right"))
+    >>> readings(left, right, cal, "columns")["as given"]
+    (0.0, 0.990872)
+    """
+    rect = rectification or rectify(calibration)
+    coords = _coordinates(left, right, calibration, orientation)
+    settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
+    out = {}
+    for name, alt in {"as given": coords,
+                      **other_readings(coords, calibration.left.size ==
+                                       calibration.right.size)}.items():
         try:
-            other_misfits, other_share = _misfits(_match(alt, rect, *settings), alt, rect)
+            misfits, share = _misfits(alt, rect, settings)
         except BistairError:
             continue
-        if other_share >= MIN_MATCHED and other_misfits * MISFIT_RATIO <= misfits:
-            return [f"{100 * misfits:.1f}% of the points lie off the projector that lit the "
-                    f"others (over {MISFIT_PX:g} projector pixels), {100 * other_misfits:.2f}% "
-                    f"{reading}: " + ("are LEFT and RIGHT the right way round?"
-                                      if "exchanged" in reading
-                                      else "is the right camera upside down?")]
-    if misfits > MISFIT_WARN:
-        info["warnings"].append(
-            f"{100 * misfits:.1f}% of the points lie off the projector that lit the others "
-            f"(over {MISFIT_PX:g} projector pixels): is the calibration for these cameras?")
-    return []
+        out[name] = (round(misfits, 6), round(share, 6))
+    return out
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,

@@ -201,7 +201,7 @@ def check_pair(R: np.ndarray, T: np.ndarray) -> None:
     """
     T = np.asarray(T, float).reshape(3)
     baseline = float(np.linalg.norm(T))
-    shown = "[" + ", ".join(f"{t:.4g}" for t in T) + "]"
+    shown = "[" + ", ".join(f"{t + 0.0:g}" for t in np.round(T, 3)) + "]"
     if baseline == 0:
         raise BistairError("T = [0, 0, 0]: the two cameras would be at one place (a stereo "
                            "pair needs a baseline, T in mm)")

@@ -27,19 +27,28 @@ misfits:
 0.0
 >>> pts[:200, 2] *= 1.2
 >>> round(projector_misfits(pts, coord, rows), 3)
-0.05
+0.048
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
 from ..errors import BistairError
 
+Coords = dict[str, tuple[np.ndarray, np.ndarray]]  # per coded axis: left and right coordinates
+
+MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
+MISFIT_FLOOR = 0.002  # projector misfits over this share: other readings of the inputs tried
+MISFIT_RATIO = 5.0  # ... one refused when that reading has this many times fewer misfits
+MISFIT_WARN = 0.01  # ... else a warning over this share
 MISFIT_PX = 5.0  # a point off the projector's fit by more than this (projector px) misfits
 MISFIT_SAMPLE = 30000  # points fitted (evenly spaced through the matched ones)
 MISFIT_MIN_POINTS = 1000  # fewer points: nothing judged
-OTHER_AXIS_MAX = 0.20  # share of the decoded left pixels whose projector rows disagree
+OTHER_AXIS_MAX = 0.10  # share of the decoded left pixels whose projector rows disagree
 
 
 def same_captures(left: np.ndarray, right: np.ndarray) -> None:
@@ -74,6 +83,97 @@ def other_axis_share(rejected: int, decoded: int) -> float:
     0.05
     """
     return rejected / max(decoded, 1)
+
+
+def other_readings(coords: Coords, same_size: bool) -> dict[str, Coords]:
+    """The other readings of two cameras' coordinates that a mistake would call for: the
+    right images upside down (flipped top to bottom) and, for cameras of one size, the two
+    cameras exchanged.
+
+    Examples
+    --------
+    >>> a, b = np.zeros((2, 3)), np.ones((2, 3))
+    >>> sorted(other_readings({"columns": (a, b)}, True))
+    ['exchanged', 'upside down']
+    """
+    out = {"upside down": {k: (a, b[::-1]) for k, (a, b) in coords.items()}}
+    if same_size:
+        out["exchanged"] = {k: (b, a) for k, (a, b) in coords.items()}
+    return out
+
+
+def check_matches(info: dict[str, Any], coords: Coords,
+                  misfits_of: Callable[[Coords], tuple[float, float]], same_size: bool,
+                  misfits: float) -> list[str]:
+    """What a binocular match says against its inputs: too few matches, projector rows that
+    disagree (both axes decoded, over :data:`OTHER_AXIS_MAX`), points that no projector lit
+    (over :data:`MISFIT_FLOOR`, when another reading of the inputs fits
+    :data:`MISFIT_RATIO` times better; else a warning over :data:`MISFIT_WARN`).
+
+    Parameters
+    ----------
+    info : dict
+        The reconstruction's ``info`` (``matched_fraction``, ``left_decoded``,
+        ``other_axis``); gets ``other_axis_share`` (both axes), ``projector_misfits``,
+        ``other_readings`` (the misfits of each reading tried) and warnings.
+    coords : dict
+        Both cameras' coordinates per coded axis.
+    misfits_of : callable
+        ``(misfits, matched share)`` of a match of other coordinates.
+    same_size : bool
+        Whether the two cameras' images have one size (so that they can be exchanged).
+    misfits : float
+        The projector misfits of the inputs as given.
+
+    Returns
+    -------
+    list of str
+        The refusals (empty when the inputs fit); the first is the one to raise.
+
+    Examples
+    --------
+    >>> info = {"matched_fraction": 0.05, "left_decoded": 1000, "other_axis": 0}
+    >>> check_matches(info, {}, None, True, 0.0)[0]  # doctest: +ELLIPSIS
+    'only 5.0% of the 1000 decoded left pixels found their match in the right camera: ...'
+    """
+    share = info["matched_fraction"]
+    if share < MIN_MATCHED:
+        return [f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left pixels "
+                "found their match in the right camera: is the calibration for these "
+                "cameras, and are LEFT and RIGHT the right way round?"]
+    if len(coords) == 2:
+        rows = info["other_axis_share"] = round(
+            other_axis_share(info["other_axis"], info["left_decoded"]), 6)
+        if rows > OTHER_AXIS_MAX:
+            return [f"the projector rows disagree between the two cameras at {100 * rows:.0f}% "
+                    f"of the decoded left pixels (over {100 * OTHER_AXIS_MAX:.0f}%): their "
+                    "rectified rows are not the same; are LEFT and RIGHT the right way round, "
+                    "is the calibration for these cameras, is one image upside down?"]
+    info["projector_misfits"] = round(misfits, 6)
+    if misfits <= MISFIT_FLOOR:
+        return []
+    tried = info["other_readings"] = {}
+    for reading, alt in other_readings(coords, same_size).items():
+        try:
+            other, matched = misfits_of(alt)
+        except BistairError:  # the matching refuses this reading outright
+            continue
+        tried[reading] = round(other, 6)
+        if matched >= MIN_MATCHED and other * MISFIT_RATIO <= misfits:
+            ask = ("are LEFT and RIGHT the right way round?" if reading == "exchanged"
+                   else "is the right camera upside down (its images flipped top to bottom)?")
+            return [f"{100 * misfits:.1f}% of the points lie off the projector that lit the "
+                    f"others (over {MISFIT_PX:g} projector pixels), {100 * other:.2f}% with "
+                    f"the {_READING[reading]}: {ask}"]
+    if misfits > MISFIT_WARN:
+        info["warnings"].append(
+            f"{100 * misfits:.1f}% of the points lie off the projector that lit the others "
+            f"(over {MISFIT_PX:g} projector pixels): wrong matches or decodes, or a "
+            "calibration for other cameras")
+    return []
+
+
+_READING = {"exchanged": "cameras exchanged", "upside down": "right images upside down"}
 
 
 def projector_misfits(points: np.ndarray, coord: np.ndarray, rows: np.ndarray) -> float:
