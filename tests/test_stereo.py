@@ -13,7 +13,9 @@ resampled onto the rectified grid average some noise away).
 
 from __future__ import annotations
 
+import csv
 import json
+import shutil
 
 import cv2
 import numpy as np
@@ -428,3 +430,71 @@ def test_projector_rows_that_disagree_are_refused(scenes):
     assert forced.info["matched_fraction"] > 0.1 and forced.info["other_axis_share"] > 0.3
     right_way = stereo(left, right, spec, StereoCalibration.from_rig(rig))
     assert right_way.info["other_axis_share"] < 0.01
+
+
+@pytest.fixture(scope="module")
+def mugs_folder(tmp_path_factory):
+    """``bistair simulate --scene mugs-on-wall --method graycode --cameras 2`` at 320 x 256."""
+    out = tmp_path_factory.mktemp("mugs") / "pair"
+    return simulate_stereo("mugs-on-wall", ["graycode"], out, camera_size=SIZE)
+
+
+def test_the_command_refuses_inputs_that_do_not_fit(mugs_folder, tmp_path, monkeypatch,
+                                                     capfd):
+    """QA S01 (LEFT and RIGHT exchanged), S48 (one folder as both), S74/S37 (the right
+    camera's spec.json of another pattern set, ignored): one line, exit code 2, nothing
+    written."""
+    gray = mugs_folder / "graycode"
+    cal = mugs_folder / "stereo.json"
+    other = tmp_path / "R36"  # the right captures with a spec.json of period 36
+    shutil.copytree(gray / "R", other)
+    spec = json.loads((other / "spec.json").read_text())
+    (other / "spec.json").write_text(json.dumps({**spec, "period": 36}))
+    cases = [
+        ([gray / "R", gray / "L"], "are LEFT and RIGHT the right way round?"),
+        ([gray / "L", gray / "L"], f"LEFT and RIGHT are the same captures ({gray / 'L'}): "
+                                   "give each camera's own"),
+        ([gray / "L", tmp_path / ".." / tmp_path.name / "R36" / ".." / "R36"],
+         "the spec.json beside RIGHT differs from the one beside LEFT in period (30 and 36): "
+         "both cameras see one pattern set (give it with --spec, or correct the wrong file)"),
+    ]
+    for pair, message in cases:
+        out = tmp_path / "out"
+        code, stdout, err = cli_run(monkeypatch, capfd, "stereo", *pair, "--calibration", cal,
+                                    "--out", out)
+        lines = err.strip().splitlines()
+        assert code == 2 and len(lines) == 1 and lines[0].startswith("Error:"), (pair, err)
+        assert message in lines[0], (message, lines[0])
+        assert stdout == "" and not out.exists()
+    # --spec names the pattern set of both: the spec.json files beside are not read
+    code, _, err = cli_run(monkeypatch, capfd, "stereo", gray / "L", other, "--calibration",
+                           cal, "--spec", gray / "L" / "spec.json", "--out", tmp_path / "ok",
+                           "-q")
+    assert code == 0 and err == ""
+
+
+def test_batch_reports_refused_stereo_sets_as_failed(mugs_folder, tmp_path, monkeypatch,
+                                                     capfd):
+    """QA B03, B04: exchanged and same-folder sets were rows "ok"; now "error" with the
+    reason, exit code 3 (some sets failed), the good set still ok."""
+    gray = mugs_folder / "graycode"
+    root = tmp_path / "sets"
+    for name, (left, right) in {"good": ("L", "R"), "swapped": ("R", "L")}.items():
+        (root / name).mkdir(parents=True)
+        (root / name / "L").symlink_to(gray / left)
+        (root / name / "R").symlink_to(gray / right)
+    for side in ("L", "R"):  # the left camera's images copied as both
+        shutil.copytree(gray / "L", root / "same" / side)
+    out = tmp_path / "res"
+    code, _, err = cli_run(monkeypatch, capfd, "batch", root, "--calibration",
+                           mugs_folder / "stereo.json", "--out", out, "--workers", "1", "-q")
+    assert code == 3, err
+    with (out / "batch.csv").open(newline="") as fh:
+        rows = {row["name"]: row for row in csv.DictReader(fh)}
+    assert rows["good"]["status"] == "ok" and rows["good"]["error"] == ""
+    assert rows["swapped"]["status"] == "error"
+    assert "are LEFT and RIGHT the right way round?" in rows["swapped"]["error"]
+    assert rows["same"]["status"] == "error"
+    assert rows["same"]["error"] == ("the left and right captures are the same images: give "
+                                     "each camera's own captures")
+    assert not (out / "swapped").exists() and not (out / "same").exists()
