@@ -32,6 +32,9 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
    on the left camera's own (distorted) image grid.
+5. Checks of the inputs against each other (:mod:`.stereo_checks`): too few matches,
+   projector rows that disagree (both axes), points that one projector explains only with
+   the cameras exchanged or the right images upside down.
 
 Examples
 --------
@@ -646,8 +649,9 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
     Raises
     ------
     BistairError
-        Captures of different shapes, a camera-projector calibration, a decode that refuses
-        its captures or finds no valid pixel, or what :func:`reconstruct_stereo` refuses.
+        Captures of different shapes, the same captures for both cameras, a
+        camera-projector calibration, a decode that refuses its captures or finds no valid
+        pixel, or what :func:`reconstruct_stereo` refuses.
 
     Examples
     --------

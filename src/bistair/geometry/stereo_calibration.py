@@ -159,6 +159,16 @@ class StereoCalibration:
 def right_centre(R: np.ndarray, T: np.ndarray) -> np.ndarray:
     """The right camera's centre in the left camera's frame, ``-R.T @ T`` (mm).
 
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(3,)`` the centre (mm).
+
     Examples
     --------
     >>> right_centre(np.eye(3), np.array([-120.0, 0.0, 0.0])).tolist()
@@ -168,9 +178,19 @@ def right_centre(R: np.ndarray, T: np.ndarray) -> np.ndarray:
 
 
 def on_the_left(R: np.ndarray, T: np.ndarray) -> float:
-    """How far (mm) the right camera sits to the left of the left one (``-x`` of its frame,
-    the axis of the baseline rather than its y), or 0 for a pair in bistair's convention
-    (and for cameras stacked vertically, which rectification refuses).
+    """How far the right camera sits to the left of the left one.
+
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``).
+
+    Returns
+    -------
+    float
+        The distance (mm) of the right camera's centre at ``-x`` of the left camera's frame
+        when that is the axis of the baseline rather than its y; 0 for a pair in bistair's
+        convention (and for cameras stacked vertically, which rectification refuses).
 
     Examples
     --------
@@ -182,9 +202,16 @@ def on_the_left(R: np.ndarray, T: np.ndarray) -> float:
 
 
 def check_pair(R: np.ndarray, T: np.ndarray) -> None:
-    """Refuse a pair that no stereo reconstruction should use: a baseline under
-    :data:`MIN_BASELINE` (zero: ``cv2.stereoRectify`` would fail; ``T`` in metres: every
-    depth 1000 times too small) or a right camera on the left (:func:`on_the_left`).
+    """Refuse a pair that no stereo reconstruction should use.
+
+    A baseline under :data:`MIN_BASELINE` (zero: ``cv2.stereoRectify`` would fail; ``T``
+    in metres: every depth 1000 times too small) or a right camera on the left
+    (:func:`on_the_left`: ``R, T`` inverted, or the cameras named the other way round).
+
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``, mm).
 
     Raises
     ------

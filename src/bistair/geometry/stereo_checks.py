@@ -55,6 +55,11 @@ def same_captures(left: np.ndarray, right: np.ndarray) -> None:
     """Refuse one camera's captures given for both (two cameras never give equal images:
     their noise alone differs).
 
+    Parameters
+    ----------
+    left, right : numpy.ndarray
+        The two cameras' capture stacks.
+
     Raises
     ------
     BistairError
@@ -77,6 +82,17 @@ def same_captures(left: np.ndarray, right: np.ndarray) -> None:
 def other_axis_share(rejected: int, decoded: int) -> float:
     """The share of the decoded left pixels whose match the other projector axis refused.
 
+    Parameters
+    ----------
+    rejected : int
+        Left pixels whose projector rows disagree with their match's (``other_axis``).
+    decoded : int
+        Left pixels decoded on the matched axis.
+
+    Returns
+    -------
+    float
+
     Examples
     --------
     >>> other_axis_share(50, 1000)
@@ -89,6 +105,18 @@ def other_readings(coords: Coords, same_size: bool) -> dict[str, Coords]:
     """The other readings of two cameras' coordinates that a mistake would call for: the
     right images upside down (flipped top to bottom) and, for cameras of one size, the two
     cameras exchanged.
+
+    Parameters
+    ----------
+    coords : dict
+        Both cameras' coordinates per coded axis, as given.
+    same_size : bool
+        Whether the two cameras' images have one size.
+
+    Returns
+    -------
+    dict
+        ``{"upside down": coords, "exchanged": coords}`` (the latter for one size).
 
     Examples
     --------
@@ -201,6 +229,13 @@ def projector_misfits(points: np.ndarray, coord: np.ndarray, rows: np.ndarray) -
     float
         The share of misfits among the points fitted; 0 for fewer than
         :data:`MISFIT_MIN_POINTS` points.
+
+    Examples
+    --------
+    See the module's (a pinhole projector's points, and 5% of them moved).
+
+    >>> projector_misfits(np.zeros((10, 3)), np.zeros(10), np.zeros(10))
+    0.0
     """
     n = len(coord)
     if n < MISFIT_MIN_POINTS:
