@@ -63,6 +63,7 @@ from ..spec import BaseSpec
 from .calibration import Calibration, Device
 from .stereo_calibration import StereoCalibration, load_stereo_calibration
 from .stereo_checks import (
+    MISFIT_SAMPLE,
     Coords,
     check_matches,
     other_readings,
@@ -446,9 +447,11 @@ def _misfits(coords: Coords, rect: Rectification, settings: tuple,
     m = m or _match(coords, rect, *settings)
     mask = np.isfinite(m.depth)
     rows, cols = np.nonzero(mask)
+    share = float(len(rows) / max(m.decoded.sum(), 1))
+    pick = np.linspace(0, len(rows) - 1, min(len(rows), MISFIT_SAMPLE)).astype(np.int64)
+    rows, cols = rows[pick], cols[pick]
     z = m.depth[rows, cols]
     points = np.column_stack([z * rect.rays[0][rows, cols], z * rect.rays[1][rows, cols], z])
-    share = float(mask.sum() / max(m.decoded.sum(), 1))
     return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share
 
 

@@ -249,25 +249,29 @@ def projector_misfits(points: np.ndarray, coord: np.ndarray, rows: np.ndarray) -
     xn = (x - x_mean) / x_scale
     vn = (v - v.mean()) / (v.std() or 1.0)
     cubic = np.column_stack([xn**i * vn**j for i in range(4) for j in range(4 - i)])
+    system = np.empty((len(xn), 8))  # a . P + a0 - x (c . P + c0), x the corrected coordinate
+    system[:, :3], system[:, 3] = pts, 1.0
     bent = np.zeros_like(xn)  # the distortion's share of each coordinate
     keep = np.arange(len(xn))
     for _ in range(4):
-        p = _dlt(pts[keep], (xn - bent)[keep])
+        corrected = xn - bent
+        system[:, 4:7], system[:, 7] = -corrected[:, None] * pts, -corrected
+        p = _dlt(system[keep], pts[keep])
         residual = xn - (pts @ p[:3] + p[3]) / (pts @ p[4:7] + p[7])
         sub = cubic[keep]
         bent = cubic @ np.linalg.solve(sub.T @ sub, sub.T @ residual[keep])
         off = np.abs(residual - bent)
-        keep = np.flatnonzero(off <= np.quantile(off, 0.9))
+        keep = np.flatnonzero(off <= np.partition(off, int(0.9 * (len(off) - 1)))[
+            int(0.9 * (len(off) - 1))])
     return float(np.mean(off * x_scale > MISFIT_PX))
 
 
-def _dlt(pts: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``(a, a0, c, c0)`` of ``x = (a . P + a0) / (c . P + c0)`` by least squares on
-    ``a . P + a0 - x (c . P + c0) = 0`` (the eigenvector of the normal matrix with the
-    least eigenvalue), reweighted three times by ``1 / |c . P + c0|`` (toward the
-    geometric error)."""
-    system = np.column_stack([pts, np.ones(len(x)), -x[:, None] * pts, -x])
-    weight = np.ones(len(x))
+def _dlt(system: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """``(a, a0, c, c0)`` of ``x = (a . P + a0) / (c . P + c0)`` by least squares on the rows
+    ``a . P + a0 - x (c . P + c0) = 0`` of ``system`` (the eigenvector of the normal
+    matrix with the least eigenvalue), reweighted twice by ``1 / |c . P + c0|`` (toward
+    the geometric error)."""
+    weight = np.ones(len(system))
     for _ in range(3):
         rows = system * weight[:, None]
         p = np.linalg.eigh(rows.T @ rows)[1][:, 0]
