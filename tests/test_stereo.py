@@ -498,3 +498,15 @@ def test_batch_reports_refused_stereo_sets_as_failed(mugs_folder, tmp_path, monk
     assert rows["same"]["error"] == ("the left and right captures are the same images: give "
                                      "each camera's own captures")
     assert not (out / "swapped").exists() and not (out / "same").exists()
+    # QA S16 in a batch: T in metres refused for the whole batch; 5 mm: said once, sets ok
+    data = json.loads((mugs_folder / "stereo.json").read_text())
+    for name, scale in (("metres.json", 1e-3), ("short.json", 1 / 40)):
+        (tmp_path / name).write_text(json.dumps({**data, "T": [t * scale for t in data["T"]]}))
+    args = ("batch", root, "--out", tmp_path / "res2", "--workers", "1", "-q")
+    code, _, err = cli_run(monkeypatch, capfd, *args, "--calibration", tmp_path / "metres.json")
+    assert code == 2 and "T must be in millimetres (in metres, this is a 200 mm baseline)" in err
+    shutil.rmtree(root / "swapped")
+    shutil.rmtree(root / "same")
+    code, _, err = cli_run(monkeypatch, capfd, *args, "--calibration", tmp_path / "short.json")
+    assert code == 0 and err == (f"Warning: {tmp_path / 'short.json'}: a baseline of 5 mm: T "
+                                 "must be in millimetres, not metres or board squares\n")

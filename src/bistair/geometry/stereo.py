@@ -61,7 +61,7 @@ from ..core.result import AxesResult, DecodeResult, make_result
 from ..errors import BistairError
 from ..spec import BaseSpec
 from .calibration import Calibration, Device
-from .stereo_calibration import StereoCalibration, load_stereo_calibration
+from .stereo_calibration import StereoCalibration, load_stereo_calibration, short_baseline
 from .stereo_checks import (
     MISFIT_SAMPLE,
     Coords,
@@ -90,7 +90,6 @@ from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
 KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
-WARN_BASELINE = 10.0  # mm: a shorter baseline is warned about (T in metres, in squares)
 
 
 @dataclass(frozen=True, eq=False)
@@ -372,12 +371,11 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     if problems and not force:
         raise BistairError(problems[0])
     info["warnings"] += problems
-    if calibration.baseline < WARN_BASELINE:
+    short = short_baseline(calibration)
+    if short:
         depths = m.depth[mask]
-        where = (f"; the points lie {np.min(depths):.3g}-{np.max(depths):.3g} mm away"
-                 if depths.size else "")
-        info["warnings"].append(f"a baseline of {calibration.baseline:.3g} mm: T must be in "
-                                f"millimetres, not metres or board squares{where}")
+        info["warnings"].append(short + (f"; the points lie {np.min(depths):.3g}-"
+                                         f"{np.max(depths):.3g} mm away" if depths.size else ""))
     return StereoResult(m.disparity, m.depth, _grey(left, offset), mask, left, right, rect,
                         info)
 

@@ -56,6 +56,9 @@ KIND = "stereo"
 #: No two cameras sit closer than this (mm): their lenses are wider. ``T`` in metres reads
 #: 1000 times too short (a 200 mm baseline as 0.2).
 MIN_BASELINE = 1.0
+#: A shorter baseline is warned about: ``T`` in metres of a rig 1-10 m wide, or in board
+#: squares, reads so (cameras this close exist: a stereo endoscope's are 4-6 mm apart).
+WARN_BASELINE = 10.0
 _SIDES = (("left", "camera"), ("right", "projector"))  # our names, Uncertainty's
 
 
@@ -242,6 +245,30 @@ def check_pair(R: np.ndarray, T: np.ndarray) -> None:
                            f"(T = {shown}; the right camera is the one at +x of the left, "
                            "T's x negative): are R, T inverted (right to left), or the "
                            "cameras named the other way round?")
+
+
+def short_baseline(calibration: StereoCalibration) -> str | None:
+    """The warning for a baseline under :data:`WARN_BASELINE`, else ``None``.
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The pair.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> short_baseline(StereoCalibration(cam, cam, np.eye(3), [-5.0, 0.0, 0.0]))
+    'a baseline of 5 mm: T must be in millimetres, not metres or board squares'
+    """
+    if calibration.baseline >= WARN_BASELINE:
+        return None
+    return (f"a baseline of {calibration.baseline:.3g} mm: T must be in millimetres, not "
+            "metres or board squares")
 
 
 def save_stereo_calibration(calibration: StereoCalibration, path: str | Path) -> Path:
