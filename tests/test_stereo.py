@@ -13,7 +13,9 @@ resampled onto the rectified grid average some noise away).
 
 from __future__ import annotations
 
+import csv
 import json
+import shutil
 
 import cv2
 import numpy as np
@@ -28,7 +30,11 @@ from bistair.errors import BistairError
 from bistair.evaluation.stereo import score_stereo
 from bistair.geometry.calibration import Calibration
 from bistair.geometry.stereo import rectify, stereo
-from bistair.geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
+from bistair.geometry.stereo_calibration import (
+    StereoCalibration,
+    load_stereo_calibration,
+    save_stereo_calibration,
+)
 from bistair.io.atomic import write_image
 from bistair.sim import Imaging, preset
 from bistair.sim.stereo import StereoRig, render_stereo
@@ -306,3 +312,201 @@ def test_simulate_writes_the_rigs_exact_calibration(simulated, tmp_path):
     rig = StereoRig.default(camera_size=SIZE)
     path = save_stereo_calibration(StereoCalibration.from_rig(rig), tmp_path / "s.json")
     assert json.loads(path.read_text()) == json.loads((simulated / "stereo.json").read_text())
+
+
+# -- inputs that do not fit each other (issue 31: two-camera mistakes that pass silently) ----
+@pytest.fixture(scope="module")
+def mugs():
+    """(calibration, spec, left, right) of the README's scene, mugs-on-wall, at 320 x 256
+    (the QA's reproductions at 640 x 512: 0.58% of the points wrong... see the guide)."""
+    rig = StereoRig.default(camera_size=SIZE)
+    spec = graycode()
+    left, right, _, _ = render_stereo(bistair.encode(spec), rig, preset("mugs-on-wall")[1],
+                                      Imaging(seed=4))
+    return StereoCalibration.from_rig(rig), spec, left, right
+
+
+def test_the_right_order_fits_one_projector(mugs):
+    cal, spec, left, right = mugs
+    res = stereo(left, right, spec, cal)
+    assert res.info["projector_misfits"] == 0.0 and res.info["warnings"] == []
+
+
+def test_exchanged_cameras_are_refused(mugs):
+    """QA S01: LEFT and RIGHT exchanged (77.6% matched, 96% of the points off by more than
+    1%); 2.3% of the points lie over 5 projector pixels off the projector that lit the rest
+    (none the right way round)."""
+    cal, spec, left, right = mugs
+    with pytest.raises(BistairError) as exc:
+        stereo(right, left, spec, cal)
+    assert "of the points lie off the projector that lit the others" in one_line(exc)
+    assert "0.00% with the cameras exchanged: are LEFT and RIGHT the right way round?" in \
+        str(exc.value)
+    forced = stereo(right, left, spec, cal, force=True)
+    assert forced.info["projector_misfits"] > 0.01
+    assert any("the right way round" in w for w in forced.info["warnings"])
+
+
+def test_an_upside_down_right_camera_is_refused(mugs):
+    """QA S47: the right images flipped top to bottom (3.7% of the points wrong, the mugs;
+    the wall's are right as its projector columns do not change down the image)."""
+    cal, spec, left, right = mugs
+    with pytest.raises(BistairError) as exc:
+        stereo(left, right[:, ::-1], spec, cal)
+    assert ("0.00% with the right images upside down: is the right camera upside down (its "
+            "images flipped top to bottom)?") in one_line(exc)
+
+
+def test_the_same_captures_for_both_cameras_are_refused(mugs):
+    """QA S48: one camera's captures as both (94.6% "matched", 93% wrong)."""
+    cal, spec, left, _ = mugs
+    with pytest.raises(BistairError) as exc:
+        stereo(left, left.copy(), spec, cal)
+    assert one_line(exc) == ("the left and right captures are the same images: give each "
+                             "camera's own captures")
+
+
+def test_a_right_camera_on_the_left_is_refused(mugs, tmp_path):
+    """QA S28: R, T inverted (right to left) put the right camera 200 mm to the left: refused
+    where the calibration is made or read, not a wrong cloud."""
+    cal, spec, left, right = mugs
+    with pytest.raises(BistairError) as exc:
+        cal.replace(R=cal.R.T, T=-cal.R.T @ cal.T)
+    assert one_line(exc).startswith("the right camera sits 189.7 mm to the left of the left "
+                                    "one (T = [200, 0, 0]")  # the other camera's x is turned
+    assert "are R, T inverted (right to left), or the cameras named the other way round?" in \
+        str(exc.value)
+    data = json.loads(save_stereo_calibration(cal, tmp_path / "s.json").read_text())
+    data["R"], data["T"] = cal.R.tolist(), (-cal.R.T @ cal.T).tolist()  # T alone turned
+    (tmp_path / "inv.json").write_text(json.dumps(data))
+    with pytest.raises(BistairError) as exc:
+        stereo(left, right, spec, tmp_path / "inv.json")
+    assert one_line(exc).startswith(f"calibration file {tmp_path / 'inv.json'}: the right "
+                                    "camera sits")
+
+
+@pytest.mark.parametrize("scale, message", [
+    (0.0, "T = [0, 0, 0]: the two cameras would be at one place (a stereo pair needs a "
+          "baseline, T in mm)"),
+    (1e-3, "the cameras would be 0.2 mm apart (T = [-0.19, 0, 0.063]): T must be in millimetres "
+           "(in metres, this is a 200 mm baseline)")])
+def test_a_zero_baseline_and_T_in_metres_are_refused_by_the_loader(scale, message, tmp_path):
+    """QA S15 (T = 0: a cv2 traceback in rectification) and S16 (T in metres: depths of
+    0.6 mm, exit 0)."""
+    cal = StereoCalibration.from_rig(StereoRig.default(camera_size=SIZE))
+    data = json.loads(save_stereo_calibration(cal, tmp_path / "s.json").read_text())
+    data["T"] = (np.array(data["T"]) * scale).tolist()
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    with pytest.raises(BistairError) as exc:
+        load_stereo_calibration(tmp_path / "bad.json")
+    assert one_line(exc) == f"calibration file {tmp_path / 'bad.json'}: {message}"
+
+
+def test_a_baseline_under_10_mm_is_warned_about(mugs):
+    """A baseline of 1-10 mm (cameras this close exist; T in metres of a 1-10 m rig reads
+    so too): the points come, with a warning naming the unit and their depths."""
+    cal, spec, left, right = mugs
+    res = stereo(left, right, spec, cal.replace(T=cal.T / 40))
+    assert res.info["warnings"] == [
+        "a baseline of 5 mm: T must be in millimetres, not metres or board squares; the "
+        f"points lie {np.nanmin(res.depth):.3g}-{np.nanmax(res.depth):.3g} mm away"]
+    assert 10 < np.nanmin(res.depth) < np.nanmax(res.depth) < 20
+
+
+def test_projector_rows_that_disagree_are_refused(scenes):
+    """QA S87: both axes decoded, the calibration of a pair 120 mm apart on captures of a
+    pair 180 mm apart: 18% of the left pixels match (over the 10% floor), the projector rows
+    disagree at 64% of them (a right pair: 0.03%; under hard optics and lens distortion 2.6%)."""
+    rig, spec, left, right, *_ = scenes["tilted"]
+    other = StereoCalibration.from_rig(StereoRig.default(
+        camera_size=SIZE, baseline=120, camera_dist=DIST_L, right_dist=DIST_R,
+        right_height=6.0, right_roll_deg=1.5))
+    with pytest.raises(BistairError) as exc:
+        stereo(left, right, spec, other)
+    assert "the projector rows disagree between the two cameras at" in one_line(exc)
+    assert "of the decoded left pixels (over 10%): their rectified rows are not the same" in \
+        str(exc.value)
+    forced = stereo(left, right, spec, other, force=True)
+    assert forced.info["matched_fraction"] > 0.1 and forced.info["other_axis_share"] > 0.3
+    right_way = stereo(left, right, spec, StereoCalibration.from_rig(rig))
+    assert right_way.info["other_axis_share"] < 0.01
+
+
+@pytest.fixture(scope="module")
+def mugs_folder(tmp_path_factory):
+    """``bistair simulate --scene mugs-on-wall --method graycode --cameras 2`` at 320 x 256."""
+    out = tmp_path_factory.mktemp("mugs") / "pair"
+    return simulate_stereo("mugs-on-wall", ["graycode"], out, camera_size=SIZE)
+
+
+def test_the_command_refuses_inputs_that_do_not_fit(mugs_folder, tmp_path, monkeypatch,
+                                                     capfd):
+    """QA S01 (LEFT and RIGHT exchanged), S48 (one folder as both), S74/S37 (the right
+    camera's spec.json of another pattern set, ignored): one line, exit code 2, nothing
+    written."""
+    gray = mugs_folder / "graycode"
+    cal = mugs_folder / "stereo.json"
+    other = tmp_path / "R36"  # the right captures with a spec.json of period 36
+    shutil.copytree(gray / "R", other)
+    spec = json.loads((other / "spec.json").read_text())
+    (other / "spec.json").write_text(json.dumps({**spec, "period": 36}))
+    cases = [
+        ([gray / "R", gray / "L"], "are LEFT and RIGHT the right way round?"),
+        ([gray / "L", gray / "L"], f"LEFT and RIGHT are the same captures ({gray / 'L'}): "
+                                   "give each camera's own"),
+        ([gray / "L", tmp_path / ".." / tmp_path.name / "R36" / ".." / "R36"],
+         "the spec.json beside RIGHT differs from the one beside LEFT in period (30 and 36): "
+         "both cameras see one pattern set (give it with --spec, or correct the wrong file)"),
+    ]
+    for pair, message in cases:
+        out = tmp_path / "out"
+        code, stdout, err = cli_run(monkeypatch, capfd, "stereo", *pair, "--calibration", cal,
+                                    "--out", out)
+        lines = err.strip().splitlines()
+        assert code == 2 and len(lines) == 1 and lines[0].startswith("Error:"), (pair, err)
+        assert message in lines[0], (message, lines[0])
+        assert stdout == "" and not out.exists()
+    # --spec names the pattern set of both: the spec.json files beside are not read
+    code, _, err = cli_run(monkeypatch, capfd, "stereo", gray / "L", other, "--calibration",
+                           cal, "--spec", gray / "L" / "spec.json", "--out", tmp_path / "ok",
+                           "-q")
+    assert code == 0 and err == ""
+
+
+def test_batch_reports_refused_stereo_sets_as_failed(mugs_folder, tmp_path, monkeypatch,
+                                                     capfd):
+    """QA B03, B04: exchanged and same-folder sets were rows "ok"; now "error" with the
+    reason, exit code 3 (some sets failed), the good set still ok."""
+    gray = mugs_folder / "graycode"
+    root = tmp_path / "sets"
+    for name, (left, right) in {"good": ("L", "R"), "swapped": ("R", "L")}.items():
+        (root / name).mkdir(parents=True)
+        (root / name / "L").symlink_to(gray / left)
+        (root / name / "R").symlink_to(gray / right)
+    for side in ("L", "R"):  # the left camera's images copied as both
+        shutil.copytree(gray / "L", root / "same" / side)
+    out = tmp_path / "res"
+    code, _, err = cli_run(monkeypatch, capfd, "batch", root, "--calibration",
+                           mugs_folder / "stereo.json", "--out", out, "--workers", "1", "-q")
+    assert code == 3, err
+    with (out / "batch.csv").open(newline="") as fh:
+        rows = {row["name"]: row for row in csv.DictReader(fh)}
+    assert rows["good"]["status"] == "ok" and rows["good"]["error"] == ""
+    assert rows["swapped"]["status"] == "error"
+    assert "are LEFT and RIGHT the right way round?" in rows["swapped"]["error"]
+    assert rows["same"]["status"] == "error"
+    assert rows["same"]["error"] == ("the left and right captures are the same images: give "
+                                     "each camera's own captures")
+    assert not (out / "swapped").exists() and not (out / "same").exists()
+    # QA S16 in a batch: T in metres refused for the whole batch; 5 mm: said once, sets ok
+    data = json.loads((mugs_folder / "stereo.json").read_text())
+    for name, scale in (("metres.json", 1e-3), ("short.json", 1 / 40)):
+        (tmp_path / name).write_text(json.dumps({**data, "T": [t * scale for t in data["T"]]}))
+    args = ("batch", root, "--out", tmp_path / "res2", "--workers", "1", "-q")
+    code, _, err = cli_run(monkeypatch, capfd, *args, "--calibration", tmp_path / "metres.json")
+    assert code == 2 and "T must be in millimetres (in metres, this is a 200 mm baseline)" in err
+    shutil.rmtree(root / "swapped")
+    shutil.rmtree(root / "same")
+    code, _, err = cli_run(monkeypatch, capfd, *args, "--calibration", tmp_path / "short.json")
+    assert code == 0 and err == (f"Warning: {tmp_path / 'short.json'}: a baseline of 5 mm: T "
+                                 "must be in millimetres, not metres or board squares\n")

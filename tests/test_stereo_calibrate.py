@@ -134,11 +134,34 @@ def test_import_refusals(tmp_path, monkeypatch, capfd):
     code, _, err = cli_run(monkeypatch, capfd, "import-calibration", sized, "--out",
                            tmp_path / "m.json")
     assert code == 2 and "no projector size in" in err and not (tmp_path / "m.json").exists()
-    # T in metres: imported, with a warning naming the unit
-    small = cal.replace(T=cal.T / 1000)
-    write_fs(metres, {**items(small), "image_size": [1280, 1024]})
+    # a baseline of 5 mm (cameras can sit so close; or T in metres of a 5 m rig): imported,
+    # with a warning naming the unit
+    write_fs(metres, {**items(cal), "T": cal.T[:, None] / 30, "image_size": [1280, 1024]})
     code, stdout, err = run(monkeypatch, capfd, metres, "--out", tmp_path / "metres.json")
-    assert code == 0 and "baseline 0.15 mm" in stdout and "T must be in millimetres" in err
+    assert code == 0 and "baseline 5.00 mm" in stdout and "T must be in millimetres" in err
+
+
+@pytest.mark.parametrize("change, message", [
+    (lambda c: {"T": np.zeros((3, 1))}, "T = [0, 0, 0]: the two cameras would be at one place"),
+    (lambda c: {"T": c.T[:, None] / 1000}, "the cameras would be 0.15 mm apart (T = [-0.146, "
+                                           "0.001, 0.036]): T must be in millimetres (in "
+                                           "metres, this is a 150 mm baseline)"),
+    (lambda c: {"R": c.R.T, "T": (-c.R.T @ c.T)[:, None]},
+     "the right camera (M2) sits 145.7 mm to the left of the left one (M1; T's x is +150.0 mm, "
+     "negative for a left camera first): is M1 the right camera, or are R, T inverted (right "
+     "to left)?")])
+def test_import_refuses_a_pair_no_reconstruction_should_use(change, message, tmp_path,
+                                                            monkeypatch, capfd):
+    """QA I07 (T = 0: imported, then a cv2 traceback in stereo), T in metres (depths of
+    0.6 mm) and R, T of the right camera to the left one (a wrong cloud): refused at the
+    import, nothing written."""
+    cal = _example_stereo()
+    path = write_fs(tmp_path / "c.yml", {**items(cal), **change(cal),
+                                         "image_size": [1280, 1024]})
+    out = tmp_path / "c.json"
+    code, stdout, err = run(monkeypatch, capfd, path, "--out", out)
+    assert code == 2 and stdout == "" and not out.exists()
+    assert err.startswith(f"Error: {path}: {message}") and err.count("\n") == 1
 
 
 # -- calibrate-stereo on rendered board pairs -----------------------------------------------
@@ -227,6 +250,26 @@ def test_calibrate_stereo_refusals(boards, tmp_path, monkeypatch, capfd):
         assert code == 2 and len(lines) == 1 and lines[0].startswith("Error:"), (args, err)
         assert message in lines[0], (message, lines[0])
         assert not out.exists()
+
+
+def test_board_images_named_the_wrong_way_round_are_refused(boards, tmp_path, monkeypatch,
+                                                            capfd):
+    """QA C30: the board images named the wrong way round give R, T of the right camera to
+    the left one (T = (+199.9, 0.08, 0.03)), which put every point 98% wrong: refused with
+    the hint, nothing written."""
+    swapped = tmp_path / "swapped"
+    for pose in sorted(p for p in boards.iterdir() if p.is_dir()):
+        (swapped / pose.name).mkdir(parents=True)
+        shutil.copy(pose / "left.png", swapped / pose.name / "right.png")
+        shutil.copy(pose / "right.png", swapped / pose.name / "left.png")
+    out = tmp_path / "sw.json"
+    code, stdout, err = cli_run(monkeypatch, capfd, "calibrate-stereo", swapped, "--board",
+                                "chessboard:9x6:20", "--out", out)
+    assert code == 2 and stdout == "" and not out.exists()
+    assert err.startswith("Error: the camera of the right images sits 189.") and \
+        err.endswith(" mm to the left of the other (the right camera is the one at +x of the "
+                     "left, to the right in its image): are the board images named the wrong "
+                     "way round? Exchange left and right\n")
 
 
 def test_calibration_from_images_in_memory(boards):

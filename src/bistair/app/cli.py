@@ -270,6 +270,7 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
     R, T map the camera frame to the projector frame; T in millimetres. With --stereo, two
     cameras: R, T map the left camera's frame to the right one's."""
     if stereo:
+        from ..geometry.stereo_calibration import short_baseline
         from .stereo import import_stereo_calibration
 
         if projector_size is not None:
@@ -278,10 +279,8 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
         pair = import_stereo_calibration(files, out, camera_size, keys)
         click.echo(f"cameras {pair.left.width}x{pair.left.height}, baseline "
                    f"{pair.baseline:.2f} mm; wrote {out}")
-        if pair.baseline < 10:
-            click.echo(f"Warning: a baseline of {pair.baseline:.3g} mm: T must be in "
-                       "millimetres (was the board's square given in metres or squares?)",
-                       err=True)
+        if short_baseline(pair):
+            click.echo(f"Warning: {short_baseline(pair)}", err=True)
         return
     from .jobs import import_calibration as run
 

@@ -47,7 +47,14 @@ from ..geometry.stereo_calibration import (
 from ..geometry.stereo_opencv import read_opencv_stereo
 from ..io.atomic import check_output, output_folder, write_image
 from ..io.jsonfile import write_json
-from ..io.read import find_spec, list_images, natural_key, read_image, read_with_spec
+from ..io.read import (
+    default_spec_path,
+    find_spec,
+    list_images,
+    natural_key,
+    read_image,
+    read_with_spec,
+)
 from ..io.writers import write_depth, write_ply, write_result
 from ..sim import preset, scene_names, trace
 from ..sim.render import expose
@@ -75,8 +82,11 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     stack, as for ``bistair decode``) of one pattern set, match and triangulate, and write
     the files of the module docstring into ``out``.
 
-    ``spec`` defaults to ``spec.json`` beside the left captures and is used for both;
-    ``calibration`` must be a stereo calibration (``"kind": "stereo"``). ``force`` goes to
+    ``spec`` is used for both cameras; by default ``spec.json`` beside the left captures,
+    which must equal the one beside the right captures if they have one (both cameras see
+    one pattern set: two that differ are refused, naming the fields). LEFT and RIGHT must
+    not be the same path. ``calibration`` must be a stereo calibration (``"kind":
+    "stereo"``). ``force`` goes to
     the decoder when it takes it and keeps a reconstruction with few matches; ``smooth``:
     see :func:`~bistair.geometry.stereo.reconstruct_stereo`. ``options`` are decoder
     options. Nothing is written on error.
@@ -84,12 +94,15 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     say = progress or _silent
     for side in (left, right):
         check_output(out, side)
+    if _same_place(left, right):
+        raise BistairError(f"LEFT and RIGHT are the same captures ({left}): give each camera's "
+                           "own")
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
     if not isinstance(calibration, StereoCalibration):
         calibration = load_stereo_calibration(calibration)
-    spec = find_spec(left, spec)
+    spec = find_spec(left, spec) if spec is not None else _one_spec(left, right)
     stacks = []
     for name, captures in (("left", left), ("right", right)):
         say(f"reading the {name} captures")
@@ -106,6 +119,66 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     with output_folder(out) as tmp:
         write_stereo(result, tmp, previews)
     return result
+
+
+def _same_place(left: Any, right: Any) -> bool:
+    """Whether LEFT and RIGHT name the same folder, file or pattern."""
+    if not (isinstance(left, str | Path) and isinstance(right, str | Path)):
+        return False
+    return Path(left).expanduser().resolve() == Path(right).expanduser().resolve()
+
+
+def _one_spec(left: Any, right: Any) -> BaseSpec:
+    """The spec beside the left captures, refused if the right captures have their own and
+    it differs (:func:`spec_differences`)."""
+    spec = find_spec(left)
+    try:
+        other = default_spec_path(right)
+    except BistairError:
+        return spec  # unlistable right captures: their reading says why
+    if not other.is_file():
+        return spec
+    try:
+        differ = spec_differences(spec, find_spec(right))
+    except BistairError as exc:
+        raise BistairError(f"right: {exc}") from None
+    if differ:
+        raise BistairError(f"the spec.json beside RIGHT differs from the one beside LEFT in "
+                           f"{'; '.join(differ)}: both cameras see one pattern set (give it "
+                           "with --spec, or correct the wrong file)")
+    return spec
+
+
+def spec_differences(left: BaseSpec, right: BaseSpec) -> list[str]:
+    """The fields in which two specs differ, each ``"name (left value and right value)"``
+    (the method alone when the methods differ; a list by its first difference).
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> a = make_spec("graycode", width=1920, height=1080, period=30)
+    >>> spec_differences(a, a.replace(period=36.0))
+    ['period (30 and 36)']
+    >>> spec_differences(a, a.replace(frame_order=a.frames[::-1]))
+    ['frames (shift-0 and gray-5 at 0)']
+    >>> spec_differences(a, make_spec("bidirectional", width=1920, height=1080,
+    ...                               partitions=8, stairs=8))
+    ['method (graycode and bidirectional)']
+    """
+    a, b = left.to_dict(), right.to_dict()
+    if a["method"] != b["method"]:
+        return [f"method ({a['method']} and {b['method']})"]
+    return [f"{key} ({_shown(a.get(key), b.get(key))})" for key in dict.fromkeys([*a, *b])
+            if a.get(key) != b.get(key)]
+
+
+def _shown(a: Any, b: Any) -> str:
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return f"{len(a)} and {len(b)} items"
+        i = next(i for i, (x, y) in enumerate(zip(a, b, strict=True)) if x != y)
+        return f"{a[i]} and {b[i]} at {i}"
+    return f"{'none' if a is None else a} and {'none' if b is None else b}"
 
 
 def write_stereo(result: StereoResult, folder: Path, previews: bool = True) -> None:

@@ -32,6 +32,9 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
    on the left camera's own (distorted) image grid.
+5. Checks of the inputs against each other (:mod:`.stereo_checks`): too few matches,
+   projector rows that disagree (both axes), points that one projector explains only with
+   the cameras exchanged or the right images upside down.
 
 Examples
 --------
@@ -58,7 +61,15 @@ from ..core.result import AxesResult, DecodeResult, make_result
 from ..errors import BistairError
 from ..spec import BaseSpec
 from .calibration import Calibration, Device
-from .stereo_calibration import StereoCalibration, load_stereo_calibration
+from .stereo_calibration import StereoCalibration, load_stereo_calibration, short_baseline
+from .stereo_checks import (
+    MISFIT_SAMPLE,
+    Coords,
+    check_matches,
+    other_readings,
+    projector_misfits,
+    same_captures,
+)
 from .stereo_jit import (
     ALONE,
     AMBIGUOUS,
@@ -78,7 +89,6 @@ from .stereo_jit import (
 from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
-MIN_MATCHED = 0.10  # fewer matched left pixels than this share: the inputs do not fit
 KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
 
 
@@ -291,8 +301,9 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         The patterns' mean (the spec's ``offset``): scales the fringes' average to grey
         when there is no white frame.
     force : bool, optional
-        Keep a reconstruction that matches fewer than :data:`MIN_MATCHED` of the left
-        pixels (with a warning in ``info``) instead of refusing it.
+        Keep a reconstruction that the checks of the matches
+        (:func:`~.stereo_checks.check_matches`) would refuse, with the reason as a warning in
+        ``info``.
 
     Returns
     -------
@@ -300,15 +311,20 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         ``info`` counts ``left_decoded`` (valid left pixels on the matched axis),
         ``matched`` (their points), ``unmatched``, ``ambiguous``, ``not_monotonic``,
         ``inconsistent`` and ``other_axis`` (on the rectified grid), ``outside_range``,
-        and gives ``matched_axis``, ``rectified`` (grids, ``f``, ``tx``) and the tolerances.
+        and gives ``matched_axis``, ``rectified`` (grids, ``f``, ``tx``), the tolerances,
+        ``other_axis_share`` (both axes), ``projector_misfits`` (the share of points off
+        the projector that lit the others), ``other_readings`` (when tried) and
+        ``warnings`` (a baseline under 10 mm, misfits over 1%).
 
     Raises
     ------
     BistairError
         A bad depth range, tolerance or smoothing, decodes of different kinds or sizes,
         sizes other than the calibration's, a coded axis that does not change along the
-        baseline, phases that run opposite ways in the
-        two cameras, or (without ``force``) too few matches.
+        baseline, phases that run opposite ways in the two cameras, or (without ``force``)
+        what :func:`~.stereo_checks.check_matches` refuses: too few matches, projector rows
+        that disagree, points that fit one projector only with the cameras exchanged or the
+        right images upside down.
 
     Examples
     --------
@@ -329,6 +345,65 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
             raise BistairError(f"the {name} must be positive, got {value}")
     rect = rectification or rectify(calibration)
     coords = _coordinates(left, right, calibration, orientation)
+    settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
+    m = _match(coords, rect, *settings)
+    mask = np.isfinite(m.depth)
+    counts = np.bincount(m.status.ravel(), minlength=8)
+    info: dict[str, Any] = {
+        "left_decoded": int(m.decoded.sum()), "matched": int(mask.sum()),
+        "matched_fraction": round(float(mask.sum() / max(m.decoded.sum(), 1)), 6),
+        "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
+        "not_monotonic": int(counts[NOT_MONOTONIC]),
+        "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
+        "alone": int(counts[ALONE]),
+        "rectified_matches": int(counts[MATCHED]), "outside_range": int(m.outside),
+        "matched_axis": m.axis,
+        "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
+                      "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
+                      "cx_right": rect.cx_right, "tx": rect.tx,
+                      "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
+        "noise_px": round(m.noise, 4), "tolerance_px": round(m.tolerance, 4),
+        "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(m.wiggle, 4),
+        "support_px": round(m.support, 4), "smooth_px": smooth, "warnings": []}
+    problems = check_matches(info, coords, lambda alt: _misfits(alt, rect, settings),
+                             calibration.left.size == calibration.right.size,
+                             _misfits(coords, rect, settings, m)[0])
+    if problems and not force:
+        raise BistairError(problems[0])
+    info["warnings"] += problems
+    short = short_baseline(calibration)
+    if short:
+        depths = m.depth[mask]
+        info["warnings"].append(short + (f"; the points lie {np.min(depths):.3g}-"
+                                         f"{np.max(depths):.3g} mm away" if depths.size else ""))
+    return StereoResult(m.disparity, m.depth, _grey(left, offset), mask, left, right, rect,
+                        info)
+
+
+@dataclass
+class _Matched:
+    """What :func:`_match` gives: the matched axis, the disparity and status on the
+    rectified left grid, the depth on the left camera's own grid (and how many points fell
+    outside the depth range), the left pixels decoded on that axis, and the thresholds
+    used (noise, tolerance, wiggle, support: rectified pixels)."""
+
+    axis: str
+    disparity: np.ndarray
+    status: np.ndarray
+    depth: np.ndarray
+    outside: int
+    decoded: np.ndarray
+    noise: float
+    tolerance: float
+    wiggle: float
+    support: float
+
+
+def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification,
+           min_depth: float, max_depth: float, tolerance: float, other_tolerance: float,
+           gap: int, wiggle: float, support: float, smooth: float) -> _Matched:
+    """Resample both cameras' projector coordinates onto the rectified grids, match them
+    along the rows and triangulate (steps 2-4 of the module docstring)."""
     spread = {name: _step(pair[0]) for name, pair in coords.items()}
     on_grid = {name: (remap_valid(lc, *rect.maps_left, spread[name]),
                       remap_valid(rc, *rect.maps_right, spread[name]))
@@ -358,33 +433,71 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     decoded = np.isfinite(coords[axis][0])
     depth, outside = grid_depth(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
                                 rect.cy, rect.tx, rect.R1, min_depth, max_depth)
-    mask = np.isfinite(depth)
-    counts = np.bincount(status.ravel(), minlength=8)
-    info: dict[str, Any] = {
-        "left_decoded": int(decoded.sum()), "matched": int(mask.sum()),
-        "matched_fraction": round(float(mask.sum() / max(decoded.sum(), 1)), 6),
-        "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
-        "not_monotonic": int(counts[NOT_MONOTONIC]),
-        "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
-        "alone": int(counts[ALONE]),
-        "rectified_matches": int(counts[MATCHED]), "outside_range": int(outside),
-        "matched_axis": axis,
-        "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
-                      "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
-                      "cx_right": rect.cx_right, "tx": rect.tx,
-                      "R1": rect.R1.tolist(), "R2": rect.R2.tolist()},
-        "noise_px": round(noise, 4), "tolerance_px": round(tolerance, 4),
-        "other_tolerance": other_tolerance, "gap_px": gap, "wiggle_px": round(wiggle, 4),
-        "support_px": round(support, 4), "smooth_px": smooth, "warnings": []}
-    share = info["matched_fraction"]
-    if share < MIN_MATCHED:
-        message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
-                   "pixels found their match in the right camera: is the calibration for these "
-                   "cameras, and are LEFT and RIGHT the right way round?")
-        if not force:
-            raise BistairError(message)
-        info["warnings"].append(message)
-    return StereoResult(disparity, depth, _grey(left, offset), mask, left, right, rect, info)
+    return _Matched(axis, disparity, status, depth, int(outside), decoded, noise, tolerance,
+                    wiggle, support)
+
+
+def _misfits(coords: Coords, rect: Rectification, settings: tuple,
+             m: _Matched | None = None) -> tuple[float, float]:
+    """The projector misfits (:func:`~.stereo_checks.projector_misfits`) of the match of
+    ``coords`` (``m`` if already made) and its share of the decoded left pixels with a
+    point."""
+    m = m or _match(coords, rect, *settings)
+    mask = np.isfinite(m.depth)
+    rows, cols = np.nonzero(mask)
+    share = float(len(rows) / max(m.decoded.sum(), 1))
+    pick = np.linspace(0, len(rows) - 1, min(len(rows), MISFIT_SAMPLE)).astype(np.int64)
+    rows, cols = rows[pick], cols[pick]
+    z = m.depth[rows, cols]
+    points = np.column_stack([z * rect.rays[0][rows, cols], z * rect.rays[1][rows, cols], z])
+    return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share
+
+
+def readings(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
+             calibration: StereoCalibration, orientation: str,
+             rectification: Rectification | None = None, min_depth: float = 0.0,
+             max_depth: float = math.inf, tolerance: float = 1.0,
+             other_tolerance: float = 2.0, gap: int = 3, wiggle: float = 1.0,
+             support: float = 2.0, smooth: float = 1.0) -> dict[str, tuple[float, float]]:
+    """How well each reading of two decodes fits one projector: as given, with the cameras
+    exchanged and with the right images upside down (:func:`~.stereo_checks.other_readings`),
+    each ``(misfits, matched share)``: what :func:`reconstruct_stereo` weighs when the
+    reading as given has misfits over :data:`~.stereo_checks.MISFIT_FLOOR`
+    (``benchmarks/stereo_margins.py`` prints them for every case).
+
+    Parameters
+    ----------
+    left, right, calibration, orientation, rectification
+        As for :func:`reconstruct_stereo`.
+    min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth
+        The matching's settings, as for :func:`reconstruct_stereo`.
+
+    Returns
+    -------
+    dict
+        ``{"as given": (misfits, share), reading: (misfits, share), ...}``; a reading
+        whose matching refuses the inputs is left out.
+
+    Examples
+    --------
+    >>> cal = _toy_stereo()
+    >>> left, right = (_plane_decode(cal, side, 500.0) for side in ("left", "right"))
+    >>> readings(left, right, cal, "columns")["as given"]
+    (0.0, 0.990872)
+    """
+    rect = rectification or rectify(calibration)
+    coords = _coordinates(left, right, calibration, orientation)
+    settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
+    out = {}
+    for name, alt in {"as given": coords,
+                      **other_readings(coords, calibration.left.size ==
+                                       calibration.right.size)}.items():
+        try:
+            misfits, share = _misfits(alt, rect, settings)
+        except BistairError:
+            continue
+        out[name] = (round(misfits, 6), round(share, 6))
+    return out
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
@@ -537,8 +650,9 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
     Raises
     ------
     BistairError
-        Captures of different shapes, a camera-projector calibration, a decode that refuses
-        its captures or finds no valid pixel, or what :func:`reconstruct_stereo` refuses.
+        Captures of different shapes, the same captures for both cameras, a
+        camera-projector calibration, a decode that refuses its captures or finds no valid
+        pixel, or what :func:`reconstruct_stereo` refuses.
 
     Examples
     --------
@@ -554,6 +668,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         raise BistairError("left and right captures differ: " + " and ".join(
             f"{s[0]} frames of {s[2]}x{s[1]}" if len(s) == 3 else f"shape {s}"
             for s in (left_images.shape, right_images.shape)))
+    same_captures(left_images, right_images)
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")

@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import BistairError
 from .board import Board
 from .calibrate import MIN_POSES, calibrate_points
-from .stereo_calibration import StereoCalibration
+from .stereo_calibration import MIN_BASELINE, StereoCalibration, on_the_left
 
 
 def calibrate_stereo_images(left: Sequence[np.ndarray], right: Sequence[np.ndarray],
@@ -64,7 +64,9 @@ def calibrate_stereo_images(left: Sequence[np.ndarray], right: Sequence[np.ndarr
     ------
     BistairError
         Different numbers of left and right images, images of different sizes or not 2-D,
-        the board found in both images of fewer than ``min_poses`` poses, or OpenCV failing.
+        the board found in both images of fewer than ``min_poses`` poses, OpenCV failing, the
+        camera of the right images on the left of the other (images named the wrong way
+        round) or the cameras under 1 mm apart (a board's square not in millimetres).
 
     Examples
     --------
@@ -111,6 +113,15 @@ def calibrate_stereo_images(left: Sequence[np.ndarray], right: Sequence[np.ndarr
                            f"need at least {min_poses}")
     pair = calibrate_points(obj, lpts, rpts, sizes["left"][:2], sizes["right"][:2], used,
                             fix_k3=fix_k3)
+    left_of = on_the_left(pair.R, pair.T)
+    if left_of > 0:
+        raise BistairError(f"the camera of the right images sits {left_of:.1f} mm to the left "
+                           "of the other (the right camera is the one at +x of the left, to "
+                           "the right in its image): are the board images named the wrong way "
+                           "round? Exchange left and right")
+    if pair.baseline < MIN_BASELINE:
+        raise BistairError(f"the cameras come out {pair.baseline:.3g} mm apart: is the "
+                           f"board's square size ({board.spacing:g}) in millimetres?")
     cal = StereoCalibration.from_pair(pair)
     return cal.replace(board=board.to_dict(), poses_total=len(names)), skipped
 

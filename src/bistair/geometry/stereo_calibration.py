@@ -20,6 +20,12 @@ A camera-projector calibration (:mod:`bistair.geometry.calibration`, no ``kind``
 ``"kind": "camera-projector"``) keeps its own layout; each reader refuses the other kind with
 one line.
 
+The right camera is the one at ``+x`` of the left camera (to the right in its image): its
+centre ``-R.T @ T`` has a positive x in the left camera's frame. A pair that breaks this
+(``R, T`` inverted, right to left; two cameras named the other way round) and a baseline
+under :data:`MIN_BASELINE` (zero, or ``T`` in metres) are refused wherever a
+:class:`StereoCalibration` is made (:func:`check_pair`): a file, an import, a calibration.
+
 Examples
 --------
 >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
@@ -47,6 +53,12 @@ from ..io.jsonfile import read_json
 from .calibration import FORMAT, VERSION, Calibration, Device, Uncertainty, _array, _device
 
 KIND = "stereo"
+#: No two cameras sit closer than this (mm): their lenses are wider. ``T`` in metres reads
+#: 1000 times too short (a 200 mm baseline as 0.2).
+MIN_BASELINE = 1.0
+#: A shorter baseline is warned about: ``T`` in metres of a rig 1-10 m wide, or in board
+#: squares, reads so (cameras this close exist: a stereo endoscope's are 4-6 mm apart).
+WARN_BASELINE = 10.0
 _SIDES = (("left", "camera"), ("right", "projector"))  # our names, Uncertainty's
 
 
@@ -69,6 +81,7 @@ class StereoCalibration:
     def __post_init__(self) -> None:
         object.__setattr__(self, "R", np.asarray(self.R, float).reshape(3, 3))
         object.__setattr__(self, "T", np.asarray(self.T, float).reshape(3))
+        check_pair(self.R, self.T)
 
     @property
     def baseline(self) -> float:
@@ -144,6 +157,118 @@ class StereoCalibration:
                    float(rms) if isinstance(rms, int | float) and math.isfinite(rms) else None,
                    tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"),
                    sigma)
+
+
+def right_centre(R: np.ndarray, T: np.ndarray) -> np.ndarray:
+    """The right camera's centre in the left camera's frame, ``-R.T @ T`` (mm).
+
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(3,)`` the centre (mm).
+
+    Examples
+    --------
+    >>> right_centre(np.eye(3), np.array([-120.0, 0.0, 0.0])).tolist()
+    [120.0, 0.0, 0.0]
+    """
+    return -np.asarray(R, float).reshape(3, 3).T @ np.asarray(T, float).reshape(3)
+
+
+def on_the_left(R: np.ndarray, T: np.ndarray) -> float:
+    """How far the right camera sits to the left of the left one.
+
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``).
+
+    Returns
+    -------
+    float
+        The distance (mm) of the right camera's centre at ``-x`` of the left camera's frame
+        when that is the axis of the baseline rather than its y; 0 for a pair in bistair's
+        convention (and for cameras stacked vertically, which rectification refuses).
+
+    Examples
+    --------
+    >>> on_the_left(np.eye(3), [-120.0, 0.0, 0.0]), on_the_left(np.eye(3), [120.0, 0.0, 0.0])
+    (0.0, 120.0)
+    """
+    x, y, _ = right_centre(R, T)
+    return float(-x) if x < 0 and abs(x) >= abs(y) else 0.0
+
+
+def check_pair(R: np.ndarray, T: np.ndarray) -> None:
+    """Refuse a pair that no stereo reconstruction should use.
+
+    A baseline under :data:`MIN_BASELINE` (zero: ``cv2.stereoRectify`` would fail; ``T``
+    in metres: every depth 1000 times too small) or a right camera on the left
+    (:func:`on_the_left`: ``R, T`` inverted, or the cameras named the other way round).
+
+    Parameters
+    ----------
+    R, T : numpy.ndarray
+        The pair's rotation and translation (``X_right = R @ X_left + T``, mm).
+
+    Raises
+    ------
+    BistairError
+        One line naming the problem and the likely cause.
+
+    Examples
+    --------
+    >>> check_pair(np.eye(3), [-120.0, 0.0, 0.0])
+    >>> check_pair(np.eye(3), [-0.12, 0.0, 0.0])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the cameras would be 0.12 mm apart (T = [-0.12, 0, 0]): T must ...
+    """
+    T = np.asarray(T, float).reshape(3)
+    baseline = float(np.linalg.norm(T))
+    shown = "[" + ", ".join(f"{t + 0.0:g}" for t in np.round(T, 3)) + "]"
+    if baseline == 0:
+        raise BistairError("T = [0, 0, 0]: the two cameras would be at one place (a stereo "
+                           "pair needs a baseline, T in mm)")
+    if baseline < MIN_BASELINE:
+        raise BistairError(f"the cameras would be {baseline:.3g} mm apart (T = {shown}): T "
+                           f"must be in millimetres (in metres, this is a "
+                           f"{1000 * baseline:.4g} mm baseline)")
+    left = on_the_left(R, T)
+    if left > 0:
+        raise BistairError(f"the right camera sits {left:.1f} mm to the left of the left one "
+                           f"(T = {shown}; the right camera is the one at +x of the left, "
+                           "T's x negative): are R, T inverted (right to left), or the "
+                           "cameras named the other way round?")
+
+
+def short_baseline(calibration: StereoCalibration) -> str | None:
+    """The warning for a baseline under :data:`WARN_BASELINE`, else ``None``.
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The pair.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> cam = Device(640, 480, [[800.0, 0, 319.5], [0, 800, 239.5], [0, 0, 1]])
+    >>> short_baseline(StereoCalibration(cam, cam, np.eye(3), [-5.0, 0.0, 0.0]))
+    'a baseline of 5 mm: T must be in millimetres, not metres or board squares'
+    """
+    if calibration.baseline >= WARN_BASELINE:
+        return None
+    return (f"a baseline of {calibration.baseline:.3g} mm: T must be in millimetres, not "
+            "metres or board squares")
 
 
 def save_stereo_calibration(calibration: StereoCalibration, path: str | Path) -> Path:

@@ -45,7 +45,7 @@ from .opencv import (
     _translation,
     read_filestorage,
 )
-from .stereo_calibration import StereoCalibration
+from .stereo_calibration import StereoCalibration, on_the_left
 
 #: The key of each part of a stereo calibration (OpenCV ``stereo_calib``'s names).
 DEFAULT_STEREO_KEYS = {"left": "M1", "left_dist": "D1", "right": "M2", "right_dist": "D2",
@@ -83,7 +83,9 @@ def read_opencv_stereo(paths: Sequence[str | Path],
         One line naming the problem: a missing or unreadable file, an unknown part in
         ``keys``, a missing key (with the keys the files have), a key two files give
         differently, a matrix of the wrong shape, distortion terms bistair's model lacks,
-        ``R`` not a rotation, non-finite values, a bad or missing size.
+        ``R`` not a rotation, non-finite values, a bad or missing size, a right camera on the
+        left of the left one or a baseline under 1 mm
+        (:func:`~bistair.geometry.stereo_calibration.check_pair`).
 
     Examples
     --------
@@ -116,7 +118,20 @@ def read_opencv_stereo(paths: Sequence[str | Path],
     left = Device(width, height, _intrinsics(*parts["left"]), _distortion(*parts["left_dist"]))
     right = Device(width, height, _intrinsics(*parts["right"]),
                    _distortion(*parts["right_dist"]))
-    return StereoCalibration(left, right, _rotation(*parts["R"]), _translation(*parts["T"]))
+    rot, t = _rotation(*parts["R"]), _translation(*parts["T"])
+    where = ", ".join(str(path) for path, _ in files)
+    left_of = on_the_left(rot, t)
+    if left_of > 0:
+        raise BistairError(f"{where}: the right camera ({names['right']}) sits {left_of:.1f} mm "
+                           f"to the left of the left one ({names['left']}; T's x is "
+                           f"{t[0]:+.1f} mm, negative for a left camera first): is "
+                           f"{names['left']} the right camera, or are R, T inverted (right to "
+                           "left)? bistair needs the left camera first and R, T from its frame "
+                           "to the right one's")
+    try:
+        return StereoCalibration(left, right, rot, t)
+    except BistairError as exc:  # a baseline of zero, or T in metres
+        raise BistairError(f"{where}: {exc}") from None
 
 
 def _part(files: list[tuple[Path, Values]], key: str, role: str
