@@ -404,7 +404,7 @@ def complete_row(job: SetJob, options: Options, run: str | None = None
     them; ``None`` if they are not complete."""
     folder = Path(job.out)
     try:
-        data = read_json(folder / MARKER, "marker")
+        data = read_json(folder / MARKER, "marker", state=True)
     except BistairError:
         return None
     if not isinstance(data, dict) or data.get("format") != MARKER_FORMAT:

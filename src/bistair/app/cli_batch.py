@@ -11,6 +11,8 @@ import click
 import numpy as np
 
 from .cli_options import (
+    Input,
+    Output,
     _force,
     _quiet,
     _strategy,
@@ -21,12 +23,12 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
 
 
 @click.command()
-@click.argument("root", type=click.Path(path_type=Path))
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.argument("root", type=Input())
+@click.option("--out", "-o", required=True, type=Output(),
               help="output folder: OUT/<set name>/ per set and OUT/batch.csv")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of every set [default: spec.json in each set's folder]")
-@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+@click.option("--calibration", type=Input(), default=None,
               help="calibration file: also reconstruct every set (cloud.ply, depth.npy)")
 @click.option("--workers", type=int, default=None,
               help="processes of the local cluster [default: the cores]")
