@@ -168,9 +168,15 @@ def test_scan_needs_spec_and_out_and_a_folder_of_its_own(spec, tmp_path, monkeyp
     code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
                        "--camera", "sim")
     assert code == 2 and "Error: --out is needed for a scan" in err
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "a.txt").write_text("mine")
+    code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
+                       "--camera", "sim:plane:48x32", "--out", tmp_path / "notes")
+    assert code == 2 and "holds files and is not an earlier scan" in err
+    assert sorted(p.name for p in (tmp_path / "notes").iterdir()) == ["a.txt"]
     code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
                        "--camera", "sim:plane:48x32", "--out", tmp_path / "pats")
-    assert code == 2 and "holds files and is not an earlier scan" in err
+    assert code == 2 and "pats holds the input " in err  # its own spec (issue 31)
     assert sorted(p.name for p in (tmp_path / "pats").iterdir()) == ["spec.json"]
     code, _, err = run(monkeypatch, capsys, "scan", "--measure-latency", "--display", "none",
                        "--camera", "sim")

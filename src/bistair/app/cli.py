@@ -16,6 +16,7 @@ from typing import Any
 import click
 import numpy as np
 
+from ..core.jit import interrupt
 from ..core.memory import keep_freed_memory
 from ..spec import BaseSpec, coerce_field, field_kind
 from .cli_batch import batch
@@ -385,12 +386,21 @@ for _command in (simulate, batch, stereo, calibrate_stereo, scan):
 
 
 def _terminated(signum: int, frame: Any) -> None:
-    """SIGTERM ends the command like Ctrl-C: temporary outputs are removed on the way out."""
-    raise SystemExit(128 + signum)
+    """SIGTERM ends the command like Ctrl-C, with exit code 143: temporary outputs are
+    removed on the way out (raised when a running compiled kernel returns:
+    :func:`~bistair.core.jit.interrupt`)."""
+    interrupt(SystemExit(128 + signum))
+
+
+def _interrupted(signum: int, frame: Any) -> None:
+    """Ctrl-C: Python's KeyboardInterrupt, raised when a running compiled kernel returns."""
+    interrupt(KeyboardInterrupt())
 
 
 def main() -> None:
     signal.signal(signal.SIGTERM, _terminated)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # (not if ignored)
+        signal.signal(signal.SIGINT, _interrupted)
     keep_freed_memory()  # a short-lived process: freed arrays serve the next ones
     args = sys.argv[1:] or ["--help"]  # a bare `bistair` shows the help, as --help does
     try:
