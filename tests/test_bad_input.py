@@ -4,7 +4,8 @@ Each row runs ``bistair`` in-process and must exit with code 2, print exactly on
 line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
 uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
 patterns with their spec (they decode), ``{zero}`` and ``{corrupt}`` for copies whose frame
-03.png is empty or not an image, ``{poses}`` for calibration captures of two poses that
+03.png is empty or not an image, ``{nan}`` for an all-NaN ``.npy`` stack of as many
+frames, ``{poses}`` for calibration captures of two poses that
 show no board, ``{set}`` for a stereo set (``left/`` and ``right/``: copies of ``{pats}``,
 a spec and a calibration file), ``{link}`` for a symbolic link to ``{pats}`` and ``{ramp}``
 for captures of a gamma ramp (``ramp.json``, ``gamma.json``).
@@ -108,6 +109,8 @@ ROWS = [
      "the output path is empty"),
     (["demo", "--out", " "], "the output path is empty"),
     (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
+    (["decode", "{nan}", "--spec", "{pats}/spec.json", "--out", "{out}"],
+     "captures contain NaN or infinite values"),  # with no NumPy warning before it
     (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "
                                                  "another format)"),
     (DECODE + ["--threads", "0"], "Invalid value for '--threads': 0 is not in the range x>=1"),
@@ -129,6 +132,12 @@ ROWS = [
     (CALIBRATE + ["--min-poses", "2"], "--min-poses 2 is too few"),
     (CALIBRATE + ["--min-poses", "-3"], "--min-poses -3 is too few"),
     (CALIBRATE, "board found in 0 of 2 poses, need at least 3"),
+    # a board's square refused up front, not by OpenCV after decoding every pose (QA C08)
+    (CALIBRATE + ["--board", "chessboard:9x7:inf"], "board spacing must be a positive number "
+                                                    "of mm, got inf"),
+    (CALIBRATE + ["--board", "chessboard:9x7:nan"], "board spacing must be a positive number"),
+    (["batch", "{set}", "--out", "{out}", "--depth-range", "0:100"],
+     "--depth-range applies to the reconstruction: give --calibration too"),
     # patterns: each field's own range before it enters another field's message
     (BIDI + ["--group-rows", "0"], "group rows must lie in 3..1080 (the projector's height), "
                                    "got 0"),
@@ -190,7 +199,9 @@ def inputs(tmp_path_factory):
     """A decodable folder of graycode patterns, two calibration poses without a board, a
     stereo set (left/ and right/), a symbolic link to the patterns and a gamma ramp."""
     root = tmp_path_factory.mktemp("inputs")
-    save_patterns(bistair.make_spec("graycode", width=64, height=48, period=16), root / "pats")
+    spec = bistair.make_spec("graycode", width=64, height=48, period=16)
+    save_patterns(spec, root / "pats")
+    np.save(root / "nan.npy", np.full((spec.frame_count, 48, 64), np.nan, np.float32))
     for name, content in (("zero", b""), ("corrupt", b"not a png at all")):
         shutil.copytree(root / "pats", root / name)
         (root / name / "03.png").write_bytes(content)
@@ -228,11 +239,13 @@ def row_id(args: list[str]) -> str:
     return " ".join(a for a in args if "{" not in a and a != "--out")
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # printed before the error otherwise
 @pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
 def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
-    paths = {"out": out, **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt",
-                                                             "set", "link", "ramp")}}
+    paths = {"out": out, "nan": inputs / "nan.npy",
+             **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt", "set",
+                                                 "link", "ramp")}}
     # a run slower than the progress delay (a cold numba cache compiles for seconds) prints
     # progress lines before the refusal: they are not what this test is about
     monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")

@@ -180,7 +180,10 @@ def test_batch_refuses_bad_input_with_one_line(scans, tmp_path, monkeypatch, cap
 
     out = tmp_path / "out"
     assert "not found" in refused(tmp_path / "nothing", "--out", out)
-    assert "is the folder of the capture sets" in refused(scans, "--out", scans)
+    assert "is the input " in refused(scans, "--out", scans)
+    assert "holds the input " in refused(scans / "plane", "--out", scans)
+    assert "--depth-range applies to the reconstruction: give --calibration too" in \
+        refused(scans, "--out", out, "--depth-range", "0:100")
     assert "--workers must be 1 or more" in refused(scans, "--out", out, "--workers", 0)
     assert "with --scheduler" in refused(scans, "--out", out, "--workers", 2, "--scheduler",
                                          "tcp://127.0.0.1:1")

@@ -143,6 +143,12 @@ def test_opencv_camera_drops_the_buffered_frames(spec, tmp_path):
     ("sim:plane:64x48", ["--average", 0], "--average must be a whole number from 1"),
     ("sim:paper-sim:64x48", [], "the spec's 1920x1080 patterns do not fit the 1080x1080 "
                                 "projector of sim:paper-sim:64x48"),
+    # options accepted and ignored or out of range until issue 31 (QA N27, N28)
+    ("sim:plane:64x48", ["--exposure", 100], "the sim camera's exposure is its response to "
+                                             "white, above 0 and at most 1, got 100"),
+    ("sim:plane:64x48", ["--exposure", 0], "above 0 and at most 1, got 0"),
+    ("sim:plane:64x48", ["--depth-range", "0:100"], "--depth-range applies to the "
+                                                    "reconstruction: give --calibration too"),
 ])
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, monkeypatch, capsys, camera,
                                                    extra, message):

@@ -11,6 +11,7 @@ import click
 import numpy as np
 
 from .cli_options import (
+    CliError,
     Input,
     Output,
     _force,
@@ -59,11 +60,14 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     columns captures, spec, calibration, out (paths relative to the manifest; empty cells
     take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
     into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
-    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input.
+    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input; after Ctrl-C
+    1, after SIGTERM 143 (batch.csv lists the finished sets).
     """
     from .batch import run_batch
     from .jobs import parse_depth_range
 
+    if depth_range is not None and calibration is None:
+        raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
                                  ("force", force or None)) if v is not None}
@@ -73,9 +77,11 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
                            min_depth=low, max_depth=high,
                            epipolar_tolerance=epipolar_tolerance,
                            show_progress=sys.stderr.isatty() and not quiet, **options)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C: exit 1; SIGTERM: 143
         click.echo(f"Interrupted: the finished sets are in {out} (listed in batch.csv); "
                    "run again with --resume to go on", err=True)
+        if isinstance(exc, SystemExit):
+            raise
         raise click.exceptions.Abort() from None
     for row in report.failed:
         click.echo(f"failed {row['name']}: {row['error']}", err=quiet)

@@ -84,6 +84,8 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     for name, value in (("--spec", spec_path), ("--out", out)):
         if value is None:
             raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
+    if depth_range is not None and calibration is None:
+        raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     from .jobs import parse_depth_range
     from .scan import scan_folder
 

@@ -122,9 +122,11 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                                camera_size=camera, compensated=compensated, workers=workers,
                                scheduler=scheduler,
                                show_progress=sys.stderr.isatty() and not quiet, **imaging)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C: exit 1; SIGTERM: 143
         click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
                    "written", err=True)
+        if isinstance(exc, SystemExit):
+            raise
         raise click.exceptions.Abort() from None
     for name, error in report.failed:
         click.echo(f"failed {name}: {error}", err=quiet)

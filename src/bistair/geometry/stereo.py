@@ -378,13 +378,32 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         "support_px": round(support, 4), "smooth_px": smooth, "warnings": []}
     share = info["matched_fraction"]
     if share < MIN_MATCHED:
-        message = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left "
-                   "pixels found their match in the right camera: is the calibration for these "
-                   "cameras, and are LEFT and RIGHT the right way round?")
+        head = (f"only {100 * share:.1f}% of the {info['left_decoded']} decoded left pixels "
+                "found their match in the right camera")
+        ask = "is the calibration for these cameras, and are LEFT and RIGHT the right way round?"
+        message = f"{head}: {ask}"
+        if min_depth > 0 or max_depth < math.inf:  # the depth range may keep them out
+            whole = reconstruct_stereo(left, right, calibration, orientation, rect, 0.0,
+                                       math.inf, tolerance, other_tolerance, gap, wiggle,
+                                       support, smooth, offset, force=True)
+            message = _ranged(head, ask, whole, min_depth, max_depth)
         if not force:
             raise BistairError(message)
         info["warnings"].append(message)
     return StereoResult(disparity, depth, _grey(left, offset), mask, left, right, rect, info)
+
+
+def _ranged(head: str, ask: str, whole: StereoResult, low: float, high: float) -> str:
+    """The refusal of too few matches within a depth range, naming the range: the range is
+    to blame when the pair matches without it (``whole``), else the question ``ask``."""
+    within = f"{head} at depths {low:g} to {high:g} mm (--depth-range, left camera frame)"
+    found = whole.depth[whole.mask]
+    share = whole.info["matched_fraction"]
+    if share < MIN_MATCHED or not found.size:
+        return f"{within}, and {100 * share:.1f}% without it: {ask}"
+    lo, hi = np.percentile(found, [1, 99])
+    return (f"{within}; without it {100 * share:.1f}% match, at depths of {lo:.0f} to "
+            f"{hi:.0f} mm: widen or leave out --depth-range")
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
