@@ -220,6 +220,15 @@ def _bistair(*args, **kwargs) -> subprocess.Popen:
                             stderr=subprocess.PIPE, text=True, **kwargs)
 
 
+def _group_alive(pgid: int) -> bool:
+    """Whether a process of the group ``pgid`` still runs."""
+    try:
+        os.killpg(pgid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
 def _end(proc: subprocess.Popen) -> None:
     """End a process group this test started, if it still runs."""
     if proc.poll() is None:
@@ -227,7 +236,11 @@ def _end(proc: subprocess.Popen) -> None:
     proc.wait(timeout=30)
 
 
-def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGINT, 1), (signal.SIGTERM, 143)],
+                         ids=["ctrl-c", "sigterm"])
+def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path, sig, code):
+    """Ctrl-C (the terminal's whole process group) and SIGTERM (``kill``: this process
+    alone; until issue 31 it left no batch.csv) alike: batch.csv lists the finished sets."""
     root = tmp_path / "root"
     names = [f"s{i:02d}" for i in range(24)]
     for name in names:
@@ -243,14 +256,21 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
         # so an exit code of 0 can only mean a handler that swallowed it
         os.killpg(proc.pid, signal.SIGSTOP)
         unfinished = len(list(out.glob(f"*/{MARKER}"))) < len(names)
-        os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C on the terminal: the whole group
+        if sig == signal.SIGINT:
+            os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C on the terminal: the whole group
+        else:
+            proc.send_signal(signal.SIGTERM)
         os.killpg(proc.pid, signal.SIGCONT)
         _, err = proc.communicate(timeout=60)
     finally:
         _end(proc)
     if not unfinished:
         pytest.skip("the batch finished every set before it was stopped")
-    assert proc.returncode == 1 and "Interrupted" in err and "Traceback" not in err, err
+    assert proc.returncode == code and "Interrupted" in err and "Traceback" not in err, err
+    deadline = time.monotonic() + 30  # no worker outlives the batch (its process group)
+    while _group_alive(proc.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _group_alive(proc.pid), "a worker process outlived the batch"
     _no_temporaries(out)
     done = {p.parent.name for p in out.glob(f"*/{MARKER}")}
     assert {p.name for p in out.iterdir()} == done | {"batch.csv"}  # no half-written set

@@ -132,6 +132,21 @@ def test_a_signal_inside_a_kernel_stops_as_the_signal(tmp_path, sig, handler, wa
         assert got.value.code == 143
 
 
+def test_a_signal_while_a_kernel_compiles_is_not_held_back():
+    """Only a signal handled inside numba's call back from compiled code waits for the
+    kernel to return; one handled while numba compiles it (a minute or two, the first time)
+    stops the command at once."""
+    from bistair.core import jit
+
+    jit._SIGNALS["depth"] += 1  # as inside a kernel's call, in numba's compiler
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            jit.interrupt(KeyboardInterrupt(), sys._getframe())
+    finally:
+        jit._SIGNALS["depth"] -= 1
+    assert jit._SIGNALS["pending"] is None
+
+
 @pytest.mark.parametrize(("sig", "code", "last"), [(signal.SIGTERM, 143, None),
                                                    (signal.SIGINT, 1, "Aborted.")])
 def test_a_command_signalled_inside_a_kernel_stops_cleanly(tmp_path, sig, code, last):

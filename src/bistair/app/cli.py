@@ -389,12 +389,12 @@ def _terminated(signum: int, frame: Any) -> None:
     """SIGTERM ends the command like Ctrl-C, with exit code 143: temporary outputs are
     removed on the way out (raised when a running compiled kernel returns:
     :func:`~bistair.core.jit.interrupt`)."""
-    interrupt(SystemExit(128 + signum))
+    interrupt(SystemExit(128 + signum), frame)
 
 
 def _interrupted(signum: int, frame: Any) -> None:
     """Ctrl-C: Python's KeyboardInterrupt, raised when a running compiled kernel returns."""
-    interrupt(KeyboardInterrupt())
+    interrupt(KeyboardInterrupt(), frame)
 
 
 def main() -> None:

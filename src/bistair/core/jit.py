@@ -110,9 +110,9 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
     return wrap
 
 
-def interrupt(exc: BaseException) -> None:
-    """Raise a signal handler's exception now, or when the kernel running in the main
-    thread returns.
+def interrupt(exc: BaseException, frame: Any = None) -> None:
+    """Raise a signal handler's exception now, or, when the signal is handled inside
+    numba's call back into Python from a kernel, as the kernel returns.
 
     A signal that arrives while a kernel runs is handled at the next Python step, which can
     be inside numba's own call back into Python as the kernel hands its arrays over
@@ -121,23 +121,27 @@ def interrupt(exc: BaseException) -> None:
     exception set`` (:func:`signalled`), or, on a kernel's first call in a process, is lost
     and leaves a hole in the results. A handler that calls this instead of raising lets the
     kernel return whole, and the exception is raised as the call returns. The command line's
-    handlers of SIGINT (Ctrl-C) and SIGTERM do.
+    handlers of SIGINT (Ctrl-C) and SIGTERM do. Anywhere else, numba compiling a kernel
+    included, ``exc`` is raised at once.
 
     Parameters
     ----------
     exc : BaseException
         What the signal should raise (``KeyboardInterrupt()``, ``SystemExit(143)``); if
         several signals arrive during one kernel, the first one's.
+    frame : frame, optional
+        The frame the handler was given (where the signal is handled).
 
     Returns
     -------
     None
-        Only while a kernel runs in the main thread; else ``exc`` is raised.
+        Only inside numba's call back from a kernel in the main thread; else ``exc`` is
+        raised.
 
     Raises
     ------
     BaseException
-        ``exc``, when no kernel runs in the main thread.
+        ``exc``, outside numba's call back from a kernel.
 
     Examples
     --------
@@ -146,11 +150,22 @@ def interrupt(exc: BaseException) -> None:
     ...
     KeyboardInterrupt
     """
-    if _SIGNALS["depth"] > 0 and threading.get_ident() == _MAIN:
+    if _SIGNALS["depth"] > 0 and threading.get_ident() == _MAIN and _in_callback(frame):
         if _SIGNALS["pending"] is None:
             _SIGNALS["pending"] = exc
         return
     raise exc
+
+
+def _in_callback(frame: Any) -> bool:
+    """Whether ``frame`` runs inside numba's ``_numba_unpickle`` (what compiled code calls
+    back into Python for)."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "_numba_unpickle" and "numba" in code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
 
 
 def signalled(exc: SystemError) -> BaseException:
