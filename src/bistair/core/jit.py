@@ -145,10 +145,10 @@ def interrupt(exc: BaseException, frame: Any = None) -> None:
 
     Examples
     --------
-    >>> interrupt(KeyboardInterrupt())
+    >>> interrupt(SystemExit(143))  # no kernel runs: at once
     Traceback (most recent call last):
     ...
-    KeyboardInterrupt
+    SystemExit: 143
     """
     if _SIGNALS["depth"] > 0 and threading.get_ident() == _MAIN and _in_callback(frame):
         if _SIGNALS["pending"] is None:
