@@ -374,6 +374,17 @@ def test_a_set_that_breaks_the_decoder_is_an_error_row(scans, tmp_path, monkeypa
     assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
 
 
+def test_a_set_never_replaces_its_own_inputs(scans, tmp_path):
+    """A set's folder is replaced as a whole: one that holds the set's spec or calibration
+    (a manifest can say so) is an error row, and they stay (issue 31)."""
+    out = tmp_path / "out" / "plane"
+    out.mkdir(parents=True)
+    spec = shutil.copy(scans / "plane" / "spec.json", out / "spec.json")
+    row = run_set(SetJob("plane", str(scans / "plane"), str(spec), None, str(out)), Options())
+    assert row["status"] == "error" and "plane holds the input " in row["error"], row
+    assert [p.name for p in out.iterdir()] == ["spec.json"]
+
+
 @pytest.mark.parametrize("cell", ["../victim", "{abs}", ".", "a/../.."])
 def test_a_manifest_out_cell_must_stay_inside_out(cell, tmp_path):
     """An out cell that leaves OUT would replace (delete) a folder the batch does not own."""

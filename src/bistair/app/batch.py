@@ -289,7 +289,7 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
     message)."""
     start = time.perf_counter()
     try:
-        check_output(job.out, job.captures)
+        check_output(job.out, [job.captures, job.spec, job.calibration])  # (None: none)
         if is_stereo_calibration(job.calibration) or stereo_pair(job.captures):
             return _stereo_set(job, options, prefix, start)
         calibration = None if job.calibration is None else load_calibration(job.calibration)

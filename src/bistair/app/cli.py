@@ -154,7 +154,7 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
 @click.argument("captures", nargs=-1, required=True, type=Input(text=True))
 @click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set [default: spec.json in the captures' folder]")
-@click.option("--out", "-o", required=True, type=Output(),
+@click.option("--out", "-o", required=True, type=Output(text=True),
               help="output folder: phase.npy, coord.npy, order.npy, ..., the PNG previews "
               "and info.json")
 @_strategy
@@ -166,7 +166,7 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
 @_threads
 @_quiet
 @reports_errors
-def decode(captures: tuple[str, ...], spec_path: Path | None, out: Path, strategy: str | None,
+def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
            min_modulation: float | None, no_previews: bool, force: bool, quiet: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order.
 

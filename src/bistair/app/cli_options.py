@@ -91,12 +91,13 @@ def board_file(value: str) -> str | None:
 
 
 class Output(click.Path):
-    """A path the command writes, a folder or a ``file``: an empty one is refused here
-    (a path given as ``''`` would otherwise be the current folder), one that is, holds or
+    """A path the command writes, a folder or a ``file`` (kept as ``text`` as typed, e.g.
+    with its final ``/``, or as a :class:`~pathlib.Path`): an empty one is refused here (a
+    path given as ``''`` would otherwise be the current folder), one that is, holds or
     mixes with an :class:`Input` before the command runs (:func:`reports_errors`)."""
 
-    def __init__(self, file: bool = False) -> None:
-        super().__init__(path_type=Path)
+    def __init__(self, file: bool = False, text: bool = False) -> None:
+        super().__init__(path_type=None if text else Path)
         self.file = file
 
     def convert(self, value: Any, param: click.Parameter | None,
