@@ -4,10 +4,13 @@ Each row runs ``bistair`` in-process and must exit with code 2, print exactly on
 line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
 uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
 patterns with their spec (they decode), ``{zero}`` and ``{corrupt}`` for copies whose frame
-03.png is empty or not an image, ``{blank}`` for Gray code captures alone whose finest
-column bit shows no contrast (every pixel modulated, none decoded: the library answers
-nothing, the command line refuses), and ``{poses}`` for calibration captures of two poses
-that show no board.
+03.png is empty or not an image, ``{nan}`` for an all-NaN ``.npy`` stack of as many
+frames, ``{blank}`` for Gray code captures alone whose finest column bit shows no contrast
+(every pixel modulated, none decoded: the library answers nothing, the command line
+refuses), ``{poses}`` for calibration captures of two poses that show no board, ``{set}``
+for a stereo set (``left/`` and ``right/``: copies of ``{pats}``, a spec and a calibration
+file), ``{link}`` for a symbolic link to ``{pats}`` and ``{ramp}`` for captures of a gamma
+ramp (``ramp.json``, ``gamma.json``).
 """
 
 from __future__ import annotations
@@ -21,8 +24,9 @@ import pytest
 from conftest import cli_run
 
 import bistair
-from bistair.app.jobs import save_patterns
+from bistair.app.jobs import save_patterns, save_ramp
 from bistair.io.atomic import write_image
+from bistair.io.read import read_image
 
 SIM = ["simulate", "--scene", "plane", "--method", "graycode", "--out", "{out}"]
 BIDI = ["patterns", "bidirectional", "--out", "{out}"]
@@ -59,14 +63,56 @@ ROWS = [
     (["demo", "--camera", "0x0", "--out", "{out}"], "camera size 0x0 must be 8 to 8192 whole"),
     (["demo", "--seed", "-1", "--out", "{out}"], "seed must be a whole number of at least 0"),
     # decode: output paths that would break the next run, unreadable frames named
-    (["decode", "{pats}", "--out", "{pats}"], "is the captures' own folder: choose another"),
+    (["decode", "{pats}", "--out", "{pats}"], "pats is the input "),
     (["decode", "{pats}", "--out", "{pats}/00.png/result"], "00.png is a file, not a folder"),
     (["reconstruct", "{pats}", "--calibration", "{pats}/spec.json", "--out", "{out}.xyz"],
      "must name a .ply file: the point cloud is written as PLY"),
     (["patterns", "graycode", "--out", "{pats}/spec.json/new"],
      "spec.json is a file, not a folder"),
     (["decode", "{pats}", "--out", ""], "the output path is empty"),
+    # outputs that are, hold or mix with an input: refused for every command (issue 31)
+    (["stereo", "{set}/left", "{set}/right", "--calibration", "{pats}/spec.json", "--out",
+      "{set}"], "set holds the input "),
+    (["stereo", "{set}/left", "{set}/right", "--calibration", "{pats}/spec.json", "--out",
+      "{set}/left/.."], "set/left/.. holds the input "),
+    (["stereo", "{set}/left", "{set}/right", "--calibration", "{pats}/spec.json", "--out", ""],
+     "the output path is empty"),
+    (["stereo", "{set}/left", "{set}/right", "--calibration", "{set}/stereo.json", "--out",
+      "{set}/right"], "right is the input "),
+    (["decode", "{pats}/*.png", "--out", "{pats}/.."], "holds the input "),
+    (["decode", "{link}", "--out", "{pats}"], "pats is the input "),  # a symbolic link to it
+    (["decode", "{pats}", "--out", "{link}"], "link is the input "),
+    (["decode", "{pats}", "--spec", "{set}/spec.json", "--out", "{set}"], "set holds the input "),
+    (["batch", "{set}", "--out", "{set}"], "set is the input "),
+    (["batch", "{set}", "--out", "{set}/.."], "holds the input "),
+    (["batch", "{set}", "--out", ""], "the output path is empty"),
+    (["import-calibration", "{pats}/spec.json", "--out", "{pats}/spec.json"],
+     "spec.json is the input "),
+    (["import-calibration", "{pats}/spec.json", "--stereo", "--out", "{link}/spec.json"],
+     "spec.json is the input "),
+    (["reconstruct", "{pats}", "--calibration", "{pats}/spec.json", "--out", "{out}.ply",
+      "--depth", "{pats}"], "pats is the input "),
+    (["reconstruct", "{pats}", "--calibration", "{set}/stereo.json", "--out", "{set}/c.ply",
+      "--depth", "{set}"], "set holds the input "),
+    (CALIBRATE[:-1] + ["{poses}"], "poses is the input "),
+    (CALIBRATE[:-1] + ["{poses}/board.json", "--board", "{poses}/board.json"],
+     "board.json is the input "),
+    (["calibrate-stereo", "{poses}", "--board", "{poses}/board.json", "--out",
+      "{poses}/board.json"], "board.json is the input "),
+    (["gamma", "{ramp}", "--out", "{ramp}/gamma.png"], "gamma.png lies in the capture folder"),
+    (["gamma", "{ramp}", "--out", "{ramp}/ramp.json"], "ramp.json is the input "),  # read
+    (["height", "{pats}", "--reference", "{pats}", "--plane", "{zero}:5", "--plane",
+      "{pats}:10", "--out", "{zero}"], "zero is the input "),
+    (["patterns", "graycode", "--gamma-file", "{ramp}/gamma.json", "--out", "{ramp}"],
+     "ramp holds the input "),
+    (["scan", "--spec", "{pats}/spec.json", "--display", "none", "--camera",
+      "sim:plane:64x48", "--out", "{pats}"], "pats holds the input "),
+    (["simulate", "--scene", "plane", "--method", "graycode", "--out", ""],
+     "the output path is empty"),
+    (["demo", "--out", " "], "the output path is empty"),
     (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
+    (["decode", "{nan}", "--spec", "{pats}/spec.json", "--out", "{out}"],
+     "captures contain NaN or infinite values"),  # with no NumPy warning before it
     (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "
                                                  "another format)"),
     (DECODE + ["--threads", "0"], "Invalid value for '--threads': 0 is not in the range x>=1"),
@@ -94,6 +140,12 @@ ROWS = [
     (CALIBRATE + ["--min-poses", "2"], "--min-poses 2 is too few"),
     (CALIBRATE + ["--min-poses", "-3"], "--min-poses -3 is too few"),
     (CALIBRATE, "board found in 0 of 2 poses, need at least 3"),
+    # a board's square refused up front, not by OpenCV after decoding every pose (QA C08)
+    (CALIBRATE + ["--board", "chessboard:9x7:inf"], "board spacing must be a positive number "
+                                                    "of mm, got inf"),
+    (CALIBRATE + ["--board", "chessboard:9x7:nan"], "board spacing must be a positive number"),
+    (["batch", "{set}", "--out", "{out}", "--depth-range", "0:100"],
+     "--depth-range applies to the reconstruction: give --calibration too"),
     # patterns: each field's own range before it enters another field's message
     (BIDI + ["--group-rows", "0"], "group rows must lie in 3..1080 (the projector's height), "
                                    "got 0"),
@@ -152,9 +204,12 @@ ROWS = [
 
 @pytest.fixture(scope="module")
 def inputs(tmp_path_factory):
-    """A decodable folder of graycode patterns and two calibration poses without a board."""
+    """A decodable folder of graycode patterns, two calibration poses without a board, a
+    stereo set (left/ and right/), a symbolic link to the patterns and a gamma ramp."""
     root = tmp_path_factory.mktemp("inputs")
-    save_patterns(bistair.make_spec("graycode", width=64, height=48, period=16), root / "pats")
+    spec = bistair.make_spec("graycode", width=64, height=48, period=16)
+    save_patterns(spec, root / "pats")
+    np.save(root / "nan.npy", np.full((spec.frame_count, 48, 64), np.nan, np.float32))
     for name, content in (("zero", b""), ("corrupt", b"not a png at all")):
         shutil.copytree(root / "pats", root / name)
         (root / name / "03.png").write_bytes(content)
@@ -166,6 +221,15 @@ def inputs(tmp_path_factory):
                   if name.removeprefix("x/") in ("gray-5", "gray-5-inv")]
         images[finest] = 120
         save_captures(images, spec, root / "blank" / orientation)
+    for side in ("left", "right"):
+        shutil.copytree(root / "pats", root / "set" / side)
+    shutil.copy(root / "pats" / "spec.json", root / "set" / "spec.json")
+    (root / "set" / "stereo.json").write_text("{}")
+    (root / "link").symlink_to(root / "pats", target_is_directory=True)
+    save_ramp(16, 16, 9, 8, root / "ramp")  # captured at 80% contrast: a gamma of 1
+    for frame in sorted((root / "ramp").glob("*.png")):
+        write_image(frame, (read_image(frame) * 0.8 + 20).astype(np.uint8))
+    (root / "ramp" / "gamma.json").write_text('{"gamma": 1.0}')
     (root / "poses").mkdir()
     (root / "poses" / "board.json").write_text(json.dumps(
         {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20.0}))
@@ -199,11 +263,13 @@ def row_id(args: list[str]) -> str:
     return " ".join(a for a in args if "{" not in a and a != "--out")
 
 
+@pytest.mark.filterwarnings("error::RuntimeWarning")  # printed before the error otherwise
 @pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
 def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
-    paths = {"out": out, **{name: inputs / name
-                            for name in ("pats", "poses", "zero", "corrupt", "blank")}}
+    paths = {"out": out, "nan": inputs / "nan.npy",
+             **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt", "blank",
+                                                 "set", "link", "ramp")}}
     # a run slower than the progress delay (a cold numba cache compiles for seconds) prints
     # progress lines before the refusal: they are not what this test is about
     monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")

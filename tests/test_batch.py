@@ -180,7 +180,10 @@ def test_batch_refuses_bad_input_with_one_line(scans, tmp_path, monkeypatch, cap
 
     out = tmp_path / "out"
     assert "not found" in refused(tmp_path / "nothing", "--out", out)
-    assert "is the folder of the capture sets" in refused(scans, "--out", scans)
+    assert "is the input " in refused(scans, "--out", scans)
+    assert "holds the input " in refused(scans / "plane", "--out", scans)
+    assert "--depth-range applies to the reconstruction: give --calibration too" in \
+        refused(scans, "--out", out, "--depth-range", "0:100")
     assert "--workers must be 1 or more" in refused(scans, "--out", out, "--workers", 0)
     assert "with --scheduler" in refused(scans, "--out", out, "--workers", 2, "--scheduler",
                                          "tcp://127.0.0.1:1")
@@ -217,6 +220,15 @@ def _bistair(*args, **kwargs) -> subprocess.Popen:
                             stderr=subprocess.PIPE, text=True, **kwargs)
 
 
+def _group_alive(pgid: int) -> bool:
+    """Whether a process of the group ``pgid`` still runs."""
+    try:
+        os.killpg(pgid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
 def _end(proc: subprocess.Popen) -> None:
     """End a process group this test started, if it still runs."""
     if proc.poll() is None:
@@ -224,7 +236,11 @@ def _end(proc: subprocess.Popen) -> None:
     proc.wait(timeout=30)
 
 
-def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
+@pytest.mark.parametrize(("sig", "code"), [(signal.SIGINT, 1), (signal.SIGTERM, 143)],
+                         ids=["ctrl-c", "sigterm"])
+def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path, sig, code):
+    """Ctrl-C (the terminal's whole process group) and SIGTERM (``kill``: this process
+    alone; until issue 31 it left no batch.csv) alike: batch.csv lists the finished sets."""
     root = tmp_path / "root"
     names = [f"s{i:02d}" for i in range(24)]
     for name in names:
@@ -240,14 +256,21 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
         # so an exit code of 0 can only mean a handler that swallowed it
         os.killpg(proc.pid, signal.SIGSTOP)
         unfinished = len(list(out.glob(f"*/{MARKER}"))) < len(names)
-        os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C on the terminal: the whole group
+        if sig == signal.SIGINT:
+            os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C on the terminal: the whole group
+        else:
+            proc.send_signal(signal.SIGTERM)
         os.killpg(proc.pid, signal.SIGCONT)
         _, err = proc.communicate(timeout=60)
     finally:
         _end(proc)
     if not unfinished:
         pytest.skip("the batch finished every set before it was stopped")
-    assert proc.returncode == 1 and "Interrupted" in err and "Traceback" not in err, err
+    assert proc.returncode == code and "Interrupted" in err and "Traceback" not in err, err
+    deadline = time.monotonic() + 30  # no worker outlives the batch (its process group)
+    while _group_alive(proc.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not _group_alive(proc.pid), "a worker process outlived the batch"
     _no_temporaries(out)
     done = {p.parent.name for p in out.glob(f"*/{MARKER}")}
     assert {p.name for p in out.iterdir()} == done | {"batch.csv"}  # no half-written set
@@ -349,6 +372,17 @@ def test_a_set_that_breaks_the_decoder_is_an_error_row(scans, tmp_path, monkeypa
     assert row["status"] == "error"
     assert row["error"] == "RuntimeError: something unforeseen"
     assert not (tmp_path / "out").exists() or not list((tmp_path / "out").iterdir())
+
+
+def test_a_set_never_replaces_its_own_inputs(scans, tmp_path):
+    """A set's folder is replaced as a whole: one that holds the set's spec or calibration
+    (a manifest can say so) is an error row, and they stay (issue 31)."""
+    out = tmp_path / "out" / "plane"
+    out.mkdir(parents=True)
+    spec = shutil.copy(scans / "plane" / "spec.json", out / "spec.json")
+    row = run_set(SetJob("plane", str(scans / "plane"), str(spec), None, str(out)), Options())
+    assert row["status"] == "error" and "plane holds the input " in row["error"], row
+    assert [p.name for p in out.iterdir()] == ["spec.json"]
 
 
 @pytest.mark.parametrize("cell", ["../victim", "{abs}", ".", "a/../.."])

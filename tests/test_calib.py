@@ -284,6 +284,18 @@ def test_calibration_file_round_trip_and_errors(tmp_path):
         assert one_line(exc).startswith(f"calibration file {p}"), name
     with pytest.raises(BistairError, match="not found"):
         load_calibration(tmp_path / "missing.json")
+    # a focal length of 0 or below, refused by name (it failed later, in rectification or
+    # as 'too few pixels shared'; QA of issue 31, S19 and S20)
+    for fx, fy in ((0.0, 1000.0), (-1000.0, -1000.0)):
+        K = np.array(data["projector"]["K"])
+        K[0, 0], K[1, 1] = fx, fy
+        p = tmp_path / "focal.json"
+        p.write_text(json.dumps({**data, "projector": {**data["projector"], "K": K.tolist()}}))
+        with pytest.raises(BistairError) as exc:
+            load_calibration(p)
+        assert one_line(exc) == (f"calibration file {p}: calibration field 'projector.K' has "
+                                 f"the focal lengths fx {fx:g} and fy {fy:g} px: both must be "
+                                 "positive")
 
 
 # -- the whole chain on the virtual rig -----------------------------------------------------------

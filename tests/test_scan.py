@@ -143,6 +143,12 @@ def test_opencv_camera_drops_the_buffered_frames(spec, tmp_path):
     ("sim:plane:64x48", ["--average", 0], "--average must be a whole number from 1"),
     ("sim:paper-sim:64x48", [], "the spec's 1920x1080 patterns do not fit the 1080x1080 "
                                 "projector of sim:paper-sim:64x48"),
+    # options accepted and ignored or out of range until issue 31 (QA N27, N28)
+    ("sim:plane:64x48", ["--exposure", 100], "the sim camera's exposure is its response to "
+                                             "white, above 0 and at most 1, got 100"),
+    ("sim:plane:64x48", ["--exposure", 0], "above 0 and at most 1, got 0"),
+    ("sim:plane:64x48", ["--depth-range", "0:100"], "--depth-range applies to the "
+                                                    "reconstruction: give --calibration too"),
 ])
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, monkeypatch, capsys, camera,
                                                    extra, message):
@@ -168,9 +174,15 @@ def test_scan_needs_spec_and_out_and_a_folder_of_its_own(spec, tmp_path, monkeyp
     code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
                        "--camera", "sim")
     assert code == 2 and "Error: --out is needed for a scan" in err
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "a.txt").write_text("mine")
+    code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
+                       "--camera", "sim:plane:48x32", "--out", tmp_path / "notes")
+    assert code == 2 and "holds files and is not an earlier scan" in err
+    assert sorted(p.name for p in (tmp_path / "notes").iterdir()) == ["a.txt"]
     code, _, err = run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display", "none",
                        "--camera", "sim:plane:48x32", "--out", tmp_path / "pats")
-    assert code == 2 and "holds files and is not an earlier scan" in err
+    assert code == 2 and "pats holds the input " in err  # its own spec (issue 31)
     assert sorted(p.name for p in (tmp_path / "pats").iterdir()) == ["spec.json"]
     code, _, err = run(monkeypatch, capsys, "scan", "--measure-latency", "--display", "none",
                        "--camera", "sim")

@@ -148,6 +148,14 @@ def test_depth_range(scenes):
     assert abs(int(near.mask.sum()) - int(keep.sum())) < 0.01 * keep.sum()
     # the search window shrank with the range: the plane's pixels found no match
     assert near.info["unmatched"] > whole.info["unmatched"] + 0.5 * whole.info["matched"]
+    # a range that keeps nothing is named as the reason, with what matches without it
+    with pytest.raises(BistairError) as exc:
+        stereo(left, right, spec, cal, max_depth=10.0)
+    lo, hi = np.percentile(whole.depth[whole.mask], [1, 99])
+    assert one_line(exc).endswith(
+        f"found their match in the right camera at depths 0 to 10 mm (--depth-range, left "
+        f"camera frame); without it {100 * whole.info['matched_fraction']:.1f}% match, at "
+        f"depths of {lo:.0f} to {hi:.0f} mm: widen or leave out --depth-range")
 
 
 def test_refusals_of_the_function(scenes):
@@ -294,6 +302,8 @@ def test_refusals_of_the_command_line(simulated, tmp_path, monkeypatch, capfd):
          "a camera-projector calibration, not a stereo one"),
         (["stereo", gray / "L", gray / "R", "--calibration", stereo_cal, "--depth-range",
           "9:1"], "--depth-range MIN:MAX needs MIN < MAX"),
+        (["stereo", gray / "L", gray / "R", "--calibration", stereo_cal, "--depth-range",
+          "0:10"], "at depths 0 to 10 mm (--depth-range, left camera frame); without it "),
         (["reconstruct", gray / "L", "--calibration", stereo_cal],
          "a stereo calibration (two cameras: for bistair stereo), not a camera-projector one"),
     ]

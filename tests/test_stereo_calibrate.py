@@ -237,6 +237,8 @@ def test_calibrate_stereo_refusals(boards, tmp_path, monkeypatch, capfd):
         ([few, "--board", "chessboard:9x6:20"], "board found in both images of 2 of 2 poses, "
                                                 "need at least 3"),
         ([boards, "--board", "chessboard:9x6"], "--board must be chessboard:COLSxROWS:SQUARE"),
+        ([boards, "--board", "chessboard:9x6:inf"], "board spacing must be a positive number "
+                                                    "of mm, got inf"),  # not OpenCV's error
         ([boards, "--board", "chessboard:9x6:20", "--min-poses", "2"],
          "min_poses 2 is too few: a stereo calibration needs at least 3 board poses"),
         ([odd, "--board", "chessboard:9x6:20"], "pose pose-00 holds 3 images: one left and one "
@@ -302,3 +304,10 @@ def test_the_two_kinds_of_calibration_file(tmp_path):
         load_calibration(stereo)
     with pytest.raises(BistairError, match="a camera-projector calibration, not a stereo one"):
         load_stereo_calibration(mono)
+    # negative focal lengths, refused by name (QA of issue 31, S19)
+    data = json.loads(stereo.read_text())
+    data["right"]["K"][0][0] = data["right"]["K"][1][1] = -1200.0
+    (tmp_path / "focal.json").write_text(json.dumps(data))
+    with pytest.raises(BistairError, match="calibration field 'right.K' has the focal lengths "
+                                           "fx -1200 and fy -1200 px: both must be positive"):
+        load_stereo_calibration(tmp_path / "focal.json")

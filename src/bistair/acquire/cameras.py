@@ -291,7 +291,7 @@ class SimCamera(Camera):
     placed at the top-left of its projector as a screen shows it. ``board-N`` (N from 0 to
     7) is the 9 x 6 checkerboard of 20 mm of ``bistair simulate --scene calibration`` in its
     pose N, on the default rig (1920 x 1080 projector). Exposure: the response to full
-    white (0.8 by default, :class:`~bistair.sim.Imaging`)."""
+    white, above 0 and at most 1 (0.8 by default, :class:`~bistair.sim.Imaging`)."""
 
     kind = "sim"
     settings = ("exposure",)
@@ -300,6 +300,9 @@ class SimCamera(Camera):
     def __init__(self, scene: str = "paper-sim", size: tuple[int, int] | None = None,
                  **settings: Any) -> None:
         super().__init__(**settings)
+        if self.exposure is not None and not 0 < self.exposure <= 1:  # (NaN too)
+            raise BistairError(f"the sim camera's exposure is its response to white, above 0 "
+                               f"and at most 1, got {self.exposure:g}")
         boards = [f"board-{i}" for i in range(len(POSES))]
         if scene not in (*scene_names(), *boards):
             raise BistairError(f"unknown sim scene {scene!r} (known: "

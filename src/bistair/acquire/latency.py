@@ -78,7 +78,7 @@ def read_settle(path: str | Path, display: str, camera: str) -> float | None:
     path = Path(path)
     if not path.exists():
         return None
-    data = read_json(path, "latency file")
+    data = read_json(path, "latency file", state=True)
     entry = data.get("pairs", {}).get(_key(display, camera)) if isinstance(data, dict) else None
     value = entry.get("settle_ms") if isinstance(entry, dict) else None
     if not isinstance(value, int | float) or not 0 <= value < 60000:
@@ -89,7 +89,7 @@ def read_settle(path: str | Path, display: str, camera: str) -> float | None:
 def save_latency(path: str | Path, latency: Latency) -> None:
     """Add (or replace) a measurement in the latency file, written atomically."""
     path = Path(path)
-    data = read_json(path, "latency file") if path.exists() else {}
+    data = read_json(path, "latency file", state=True) if path.exists() else {}
     if not isinstance(data, dict) or data.get("format") != LATENCY_FORMAT:
         data = {"format": LATENCY_FORMAT, "version": 1, "pairs": {}}
     data.setdefault("pairs", {})[_key(latency.display, latency.camera)] = {

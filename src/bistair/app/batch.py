@@ -289,7 +289,7 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
     message)."""
     start = time.perf_counter()
     try:
-        check_output(job.out, job.captures)
+        check_output(job.out, [job.captures, job.spec, job.calibration])  # (None: none)
         if is_stereo_calibration(job.calibration) or stereo_pair(job.captures):
             return _stereo_set(job, options, prefix, start)
         calibration = None if job.calibration is None else load_calibration(job.calibration)
@@ -404,7 +404,7 @@ def complete_row(job: SetJob, options: Options, run: str | None = None
     them; ``None`` if they are not complete."""
     folder = Path(job.out)
     try:
-        data = read_json(folder / MARKER, "marker")
+        data = read_json(folder / MARKER, "marker", state=True)
     except BistairError:
         return None
     if not isinstance(data, dict) or data.get("format") != MARKER_FORMAT:
@@ -439,10 +439,11 @@ def run_batch(source: str | Path, out: str | Path, spec: str | Path | None = Non
     ``max_depth`` and ``epipolar_tolerance`` to the reconstruction. ``show_progress``: a
     progress bar on the terminal.
 
-    Failing sets are rows with status ``error``; the batch goes on. On Ctrl-C the sets not
-    finished are cancelled, the cluster is closed, ``batch.csv`` lists the finished ones
-    and the exception propagates; no set folder is left half-written and no temporary is
-    left behind.
+    Failing sets are rows with status ``error``; the batch goes on. On Ctrl-C
+    (``KeyboardInterrupt``) or SIGTERM (``SystemExit``, as the command line raises it) the
+    sets not finished are cancelled, the cluster is closed, ``batch.csv`` lists the finished
+    ones and the exception propagates; no set folder is left half-written and no temporary
+    is left behind.
 
     Raises
     ------
@@ -502,7 +503,7 @@ def run_batch(source: str | Path, out: str | Path, spec: str | Path | None = Non
 
                 run_tasks(client, run_set, [(jobs[i], options, prefix) for i in todo],
                           failed, done)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemExit):  # Ctrl-C, or SIGTERM (the command line's exit)
         bar.close()
         remove_run_temporaries(parents, prefix)  # of workers killed mid-write
         for i in todo:  # sets finished while the interrupt came

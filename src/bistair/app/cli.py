@@ -16,11 +16,14 @@ from typing import Any
 import click
 import numpy as np
 
+from ..core.jit import interrupt
 from ..core.memory import keep_freed_memory
 from ..spec import BaseSpec, coerce_field, field_kind
 from .cli_batch import batch
 from .cli_options import (
     CliError,
+    Input,
+    Output,
     _force,
     _quiet,
     _show,
@@ -29,6 +32,7 @@ from .cli_options import (
     _Text,
     _threads,
     _warn,
+    board_file,
     reports_errors,
 )
 from .cli_scan import scan
@@ -82,10 +86,10 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
             if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
                 opt.update(is_flag=False, flag_value="1")
         params.append(click.Option([f"--{f.name.replace('_', '-')}", f.name], **opt))
-    params.append(click.Option(["--gamma-file"], type=click.Path(path_type=Path), default=None,
+    params.append(click.Option(["--gamma-file"], type=Input(), default=None,
                                help="gamma.json from 'bistair gamma': pre-compensate the "
                                "measured projector gamma (instead of --gamma)"))
-    params.append(click.Option(["--out", "-o"], required=True, type=click.Path(path_type=Path),
+    params.append(click.Option(["--out", "-o"], required=True, type=Output(),
                                help="output folder"))
 
     @reports_errors
@@ -120,8 +124,7 @@ _SPEC_TYPES = {int: "INTEGER", float: "NUMBER", str: "TEXT", tuple: "NUMBER,..."
               help="grey levels from black to white")
 @click.option("--bits", type=click.Choice(["8", "16"]), default="8", show_default=True,
               help="bit depth of the frames")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder")
+@click.option("--out", "-o", required=True, type=Output(), help="output folder")
 @reports_errors
 def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -> None:
     """A ramp of uniform grey frames (NN.png and ramp.json) for 'bistair gamma'."""
@@ -132,10 +135,10 @@ def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -
 
 
 @cli.command()
-@click.argument("captures", nargs=-1, required=True)
-@click.option("--ramp", type=click.Path(path_type=Path), default=None,
+@click.argument("captures", nargs=-1, required=True, type=Input(text=True))
+@click.option("--ramp", type=Input(), default=None,
               help="ramp.json of the grey frames [default: ramp.json in the captures' folder]")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.option("--out", "-o", required=True, type=Output(file=True),
               help="gamma file to write (JSON)")
 @reports_errors
 def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
@@ -148,10 +151,10 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
 
 
 @cli.command()
-@click.argument("captures", nargs=-1, required=True)
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.argument("captures", nargs=-1, required=True, type=Input(text=True))
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set [default: spec.json in the captures' folder]")
-@click.option("--out", "-o", required=True, type=click.Path(),
+@click.option("--out", "-o", required=True, type=Output(text=True),
               help="output folder: phase.npy, coord.npy, order.npy, ..., the PNG previews "
               "and info.json")
 @_strategy
@@ -192,7 +195,7 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
 
 
 @cli.command()
-@click.option("--out", "-o", type=click.Path(path_type=Path), default=Path("demo-out"),
+@click.option("--out", "-o", type=Output(), default=Path("demo-out"),
               show_default=True, help="output folder")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="seed of the rendered noise")
@@ -207,13 +210,14 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 
 
 @cli.command()
-@click.argument("captures", type=click.Path(path_type=Path))
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.argument("captures", type=Input())
+@click.option("--out", "-o", required=True, type=Output(file=True),
               help="calibration file to write (JSON)")
 @click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
+              type=Input(text=True, path_of=board_file),
               help="board.json, or e.g. chessboard:9x7:25 (inner corners, square in mm) "
               "[default: CAPTURES/board.json]")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec of both axes for pose folders of captures [default: each "
               "folder's spec.json, else CAPTURES/spec.json]")
 @click.option("--min-poses", type=int, default=3, show_default=True,
@@ -246,8 +250,8 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
 
 
 @cli.command("import-calibration")
-@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.argument("files", nargs=-1, required=True, type=Input())
+@click.option("--out", "-o", required=True, type=Output(file=True),
               help="calibration file to write (JSON)")
 @click.option("--projector-size", default=None, metavar="WxH",
               help="projector size WIDTHxHEIGHT [default: from projector_size, screenResX + "
@@ -291,15 +295,15 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
 
 
 @cli.command()
-@click.argument("captures", type=click.Path(path_type=Path))
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.argument("captures", type=Input())
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set [default: CAPTURES/spec.json]")
-@click.option("--calibration", required=True, type=click.Path(path_type=Path),
+@click.option("--calibration", required=True, type=Input(),
               help="calibration file (JSON) from 'bistair calibrate' or 'bistair "
               "import-calibration'")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.option("--out", "-o", required=True, type=Output(file=True),
               help="point cloud to write (.ply)")
-@click.option("--depth", type=click.Path(path_type=Path), default=None,
+@click.option("--depth", type=Output(), default=None,
               help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
 @_strategy
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
@@ -348,14 +352,15 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 
 
 @cli.command()
-@click.argument("captures", type=click.Path(path_type=Path))
-@click.option("--reference", required=True, type=click.Path(path_type=Path),
+@click.argument("captures", type=Input())
+@click.option("--reference", required=True, type=Input(),
               help="captures of the flat reference plane (same spec)")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set [default: CAPTURES/spec.json]")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.option("--out", "-o", required=True, type=Output(),
               help="output folder: height.npy (mm, NaN where invalid) and height.png")
 @click.option("--plane", "planes", multiple=True, metavar="FOLDER:HEIGHT_MM",
+              type=Input(text=True, path_of=lambda v: v.rpartition(":")[0]),
               help="captures of a plane parallel to the reference and its height in mm "
               "(repeatable; two or more calibrate the height per pixel)")
 @click.option("--geometry", default=None, metavar="DISTANCE,BASELINE,FREQUENCY",
@@ -380,12 +385,21 @@ for _command in (simulate, batch, stereo, calibrate_stereo, scan):
 
 
 def _terminated(signum: int, frame: Any) -> None:
-    """SIGTERM ends the command like Ctrl-C: temporary outputs are removed on the way out."""
-    raise SystemExit(128 + signum)
+    """SIGTERM ends the command like Ctrl-C, with exit code 143: temporary outputs are
+    removed on the way out (raised when a running compiled kernel returns:
+    :func:`~bistair.core.jit.interrupt`)."""
+    interrupt(SystemExit(128 + signum), frame)
+
+
+def _interrupted(signum: int, frame: Any) -> None:
+    """Ctrl-C: Python's KeyboardInterrupt, raised when a running compiled kernel returns."""
+    interrupt(KeyboardInterrupt(), frame)
 
 
 def main() -> None:
     signal.signal(signal.SIGTERM, _terminated)
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # (not if ignored)
+        signal.signal(signal.SIGINT, _interrupted)
     keep_freed_memory()  # a short-lived process: freed arrays serve the next ones
     args = sys.argv[1:] or ["--help"]  # a bare `bistair` shows the help, as --help does
     try:

@@ -11,6 +11,9 @@ import click
 import numpy as np
 
 from .cli_options import (
+    CliError,
+    Input,
+    Output,
     _force,
     _quiet,
     _strategy,
@@ -21,12 +24,12 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
 
 
 @click.command()
-@click.argument("root", type=click.Path(path_type=Path))
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.argument("root", type=Input())
+@click.option("--out", "-o", required=True, type=Output(),
               help="output folder: OUT/<set name>/ per set and OUT/batch.csv")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of every set [default: spec.json in each set's folder]")
-@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+@click.option("--calibration", type=Input(), default=None,
               help="calibration file: also reconstruct every set (cloud.ply, depth.npy)")
 @click.option("--workers", type=int, default=None,
               help="processes of the local cluster [default: the cores]")
@@ -57,11 +60,14 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     columns captures, spec, calibration, out (paths relative to the manifest; empty cells
     take the defaults). Each set writes what 'bistair decode' (and 'reconstruct') write
     into OUT/<set name>/; a failing set is recorded in OUT/batch.csv and the batch goes on.
-    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input.
+    Exit code 0 when every set decoded, 3 when some failed, 2 on bad input; after Ctrl-C
+    1, after SIGTERM 143 (batch.csv lists the finished sets).
     """
     from .batch import run_batch
     from .jobs import parse_depth_range
 
+    if depth_range is not None and calibration is None:
+        raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if calibration is not None:  # a stereo one's baseline under 10 mm: said once
         from ..geometry.stereo_calibration import StereoCalibration, short_baseline
@@ -78,9 +84,11 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
                            min_depth=low, max_depth=high,
                            epipolar_tolerance=epipolar_tolerance,
                            show_progress=sys.stderr.isatty() and not quiet, **options)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C: exit 1; SIGTERM: 143
         click.echo(f"Interrupted: the finished sets are in {out} (listed in batch.csv); "
                    "run again with --resume to go on", err=True)
+        if isinstance(exc, SystemExit):
+            raise
         raise click.exceptions.Abort() from None
     for row in report.failed:
         click.echo(f"failed {row['name']}: {row['error']}", err=quiet)

@@ -1,11 +1,14 @@
 """What the commands of the ``bistair`` command line share: one-line errors and exit
 code 2, the common options (``--quiet``, ``--force``, ``--threads``, ``--strategy``),
-parameter types that say what they take, and the printing of a decode's warnings."""
+parameter types that say what they take (inputs and outputs among them: no output of a
+command may be, hold or mix with one of its inputs), and the printing of a decode's
+warnings."""
 
 from __future__ import annotations
 
 import functools
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import click
@@ -19,18 +22,89 @@ class CliError(click.ClickException):
 
 
 def reports_errors(func: Callable) -> Callable:
-    """Turn :class:`BistairError` into a one-line message and exit code 2."""
+    """Turn :class:`BistairError` into a one-line message and exit code 2; run the command
+    with its :class:`Input` values as its inputs (:func:`bistair.io.inputs.reading`), and
+    refuse first an :class:`Output` that is, holds or mixes with one of them."""
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
+        from ..io.atomic import check_output
+        from ..io.inputs import reading
+
+        ctx = click.get_current_context(silent=True)
+        params = [] if ctx is None else [p for p in ctx.command.params if p.name in kwargs]
+        inputs = [path for p in params if isinstance(p.type, Input)
+                  for path in p.type.paths(kwargs[p.name])]
         try:
-            return func(*args, **kwargs)
+            with reading(*inputs):
+                for p in params:
+                    if isinstance(p.type, Output) and kwargs[p.name] is not None:
+                        check_output(kwargs[p.name], file=p.type.file)
+                return func(*args, **kwargs)
         except BistairError as exc:
             raise CliError(str(exc)) from None
         except MemoryError:
             raise CliError("not enough memory for these captures") from None
 
     return wrapper
+
+
+
+class Input(click.Path):
+    """A path the command reads (a file, a folder or, as text, a glob pattern): no output
+    of the command may be it, hold it or mix with it (:func:`reports_errors`).
+
+    Parameters
+    ----------
+    text : bool
+        Keep the value as text (glob patterns), not a :class:`~pathlib.Path`.
+    path_of : callable, optional
+        The path in a value that holds more (``FOLDER:HEIGHT``), ``None`` for a value that
+        names no file (``chessboard:9x7:25``); by default the value itself.
+    """
+
+    def __init__(self, text: bool = False,
+                 path_of: Callable[[str], str | None] | None = None) -> None:
+        super().__init__(path_type=None if text else Path)
+        self.path_of = path_of
+
+    def paths(self, value: Any) -> list[str]:
+        """The paths of a parameter's value (one, several or none)."""
+        values = [] if value is None else list(value) if isinstance(value, tuple | list) \
+            else [value]
+        found = [str(v) if self.path_of is None else self.path_of(str(v)) for v in values]
+        return [v for v in found if v]
+
+
+
+def board_file(value: str) -> str | None:
+    """The file a ``--board`` value names, ``None`` for a description such as
+    ``chessboard:9x7:25`` (:func:`bistair.geometry.board.is_board_text`).
+
+    >>> board_file("chessboard:9x7:25"), board_file("calib/board.json")
+    (None, 'calib/board.json')
+    """
+    from ..geometry.board import is_board_text
+
+    return None if is_board_text(value) else value
+
+
+
+class Output(click.Path):
+    """A path the command writes, a folder or a ``file`` (kept as ``text`` as typed, e.g.
+    with its final ``/``, or as a :class:`~pathlib.Path`): an empty one is refused here (a
+    path given as ``''`` would otherwise be the current folder), one that is, holds or
+    mixes with an :class:`Input` before the command runs (:func:`reports_errors`)."""
+
+    def __init__(self, file: bool = False, text: bool = False) -> None:
+        super().__init__(path_type=None if text else Path)
+        self.file = file
+
+    def convert(self, value: Any, param: click.Parameter | None,
+                ctx: click.Context | None) -> Any:
+        if isinstance(value, str) and not value.strip():
+            self.fail("the output path is empty", param, ctx)
+        return super().convert(value, param, ctx)
 
 
 

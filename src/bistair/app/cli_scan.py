@@ -11,6 +11,8 @@ import numpy as np
 
 from .cli_options import (
     CliError,
+    Input,
+    Output,
     _quiet,
     _warn,
     reports_errors,
@@ -18,7 +20,7 @@ from .cli_options import (
 
 
 @click.command()
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set to project (from 'bistair patterns')")
 @click.option("--display", required=True, metavar="DISPLAY",
               help="window[:SCREEN] (a full-screen window on the projector's screen, from 0) "
@@ -26,7 +28,7 @@ from .cli_options import (
 @click.option("--camera", required=True, metavar="CAMERA",
               help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
               "sim[:SCENE[:WxH]]")
-@click.option("--out", "-o", type=click.Path(path_type=Path), default=None,
+@click.option("--out", "-o", type=Output(), default=None,
               help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
 @click.option("--settle-ms", type=float, default=None,
               help="wait after showing each pattern [default: as measured by "
@@ -42,7 +44,7 @@ from .cli_options import (
               default=None, help="genicam pixel format")
 @click.option("--decode", "decode_it", is_flag=True,
               help="also decode the scan into OUT/decode/")
-@click.option("--calibration", type=click.Path(path_type=Path), default=None,
+@click.option("--calibration", type=Input(), default=None,
               help="also reconstruct: OUT/decode/cloud.ply, depth.npy")
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="with --calibration: keep points with depth z in [MIN, MAX] mm")
@@ -82,6 +84,8 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     for name, value in (("--spec", spec_path), ("--out", out)):
         if value is None:
             raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
+    if depth_range is not None and calibration is None:
+        raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     from .jobs import parse_depth_range
     from .scan import scan_folder
 

@@ -12,6 +12,7 @@ import click
 
 from .cli_options import (
     CliError,
+    Output,
     _LazyHelp,
     _method_help,
     _quiet,
@@ -28,7 +29,7 @@ from .cli_options import (
 @click.option("--method", "methods", required=True, multiple=True, metavar="METHOD",
               cls=_LazyHelp, help_from=_method_help,
               help="method to render (repeatable): {} or all")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.option("--out", "-o", required=True, type=Output(),
               help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
               "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
               "(OUT/<method>/ each for several methods)")
@@ -121,9 +122,11 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                                camera_size=camera, compensated=compensated, workers=workers,
                                scheduler=scheduler,
                                show_progress=sys.stderr.isatty() and not quiet, **imaging)
-    except KeyboardInterrupt:
+    except (KeyboardInterrupt, SystemExit) as exc:  # Ctrl-C: exit 1; SIGTERM: 143
         click.echo(f"Interrupted: the scenes finished are in {out}; index.csv is not "
                    "written", err=True)
+        if isinstance(exc, SystemExit):
+            raise
         raise click.exceptions.Abort() from None
     for name, error in report.failed:
         click.echo(f"failed {name}: {error}", err=quiet)

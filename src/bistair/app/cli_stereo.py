@@ -9,20 +9,19 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import _quiet, _strategy, _threads, reports_errors
+from .cli_options import Input, Output, _quiet, _strategy, _threads, board_file, reports_errors
 
 
 @click.command("stereo")
-@click.argument("left")
-@click.argument("right")
-@click.option("--spec", "spec_path", type=click.Path(path_type=Path), default=None,
+@click.argument("left", type=Input(text=True))
+@click.argument("right", type=Input(text=True))
+@click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec.json of the pattern set, for both cameras [default: spec.json beside "
               "LEFT]")
-@click.option("--calibration", required=True, type=click.Path(path_type=Path),
+@click.option("--calibration", required=True, type=Input(),
               help="the two cameras' calibration (bistair calibrate-stereo, or "
               "import-calibration --stereo)")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
-              help="output folder")
+@click.option("--out", "-o", required=True, type=Output(), help="output folder")
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="keep points with depth z in [MIN, MAX] mm (left camera frame); also "
               "narrows the search")
@@ -74,11 +73,12 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
 
 
 @click.command("calibrate-stereo")
-@click.argument("poses", type=click.Path(path_type=Path))
+@click.argument("poses", type=Input())
 @click.option("--board", default=None, metavar="chessboard:COLSxROWS:SQUARE",
+              type=Input(text=True, path_of=board_file),
               help="the board: inner corners and square size (mm), or a board.json "
               "[default: POSES/board.json]")
-@click.option("--out", "-o", required=True, type=click.Path(path_type=Path),
+@click.option("--out", "-o", required=True, type=Output(file=True),
               help="stereo calibration file to write (JSON)")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found in both images (3 or more)")

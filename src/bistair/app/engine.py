@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import multiprocessing
 import os
 import signal
 import sys
@@ -182,6 +183,15 @@ def _client(workers: int | None, scheduler: str | None, tasks: int | None
             yield client
         finally:
             client.close()
+    except (KeyboardInterrupt, SystemExit):  # Ctrl-C or SIGTERM: stop now
+        # A worker asked to close finishes its task first (up to 4 s, the nanny's timeout,
+        # before it is killed): the tasks are cancelled and what a worker was writing is a
+        # temporary its caller deletes, so the worker processes (the multiprocessing
+        # children of this process) are killed; the cluster then closes in 0.2-0.5 s, not
+        # 0.9-1.6 s (measured: bistair batch of 8 sets, 2 workers, on 2 busy cores).
+        for child in multiprocessing.active_children():
+            child.kill()
+        raise
     finally:
         cluster.close()
 

@@ -178,13 +178,13 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
         used = stack[:frame_count if select is None else len(select)]
     else:
         used = stack[list(select)]
+    if stack.dtype.kind == "f" and not np.isfinite(stack).all():  # (before NumPy warns)
+        raise BistairError("captures contain NaN or infinite values")
     lit = [stack[i][None] for i in (white, black) if i is not None]
     scale = max(full_scale_of(a) for a in (used, *lit))
     if np.issubdtype(stack.dtype, np.integer):
         clipped = used.max(axis=0) >= scale
     else:
-        if not np.isfinite(stack).all():
-            raise BistairError("captures contain NaN or infinite values")
         clipped = used.max(axis=0) >= scale * (1.0 - 1e-6)
     factor = np.float32(1.0 / scale)
     extra = [None if i is None else np.multiply(stack[i], factor, dtype=np.float32)

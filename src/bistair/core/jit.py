@@ -46,6 +46,10 @@ KERNELS_ENV = "BISTAIR_KERNELS"
 RECORD_ENV = "BISTAIR_RECORD_KERNELS"  # a file: the signatures compiled, added at exit
 _LISTENERS: list[Callable[[], None]] = []
 _STATE: dict[str, Any] = {"told": False, "building": None, "cache_class": None}
+# kernels running in the main thread (where signal handlers run) and a signal's exception
+# that waits for them to return (:func:`interrupt`)
+_SIGNALS: dict[str, Any] = {"depth": 0, "pending": None}
+_MAIN = threading.main_thread().ident
 
 
 def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
@@ -84,13 +88,124 @@ def kernel(parallel: bool = False) -> Callable[[Callable], Callable]:
             compiled = _COMPILED.get(key)
             if compiled is None:
                 compiled = _COMPILED[key] = _dispatcher(fn, parallel)
-            return compiled(*args)
+            main = threading.get_ident() == _MAIN
+            if main:
+                _SIGNALS["depth"] += 1
+            try:
+                return compiled(*args)
+            except SystemError as exc:
+                raise signalled(exc) from None
+            finally:
+                if main:
+                    _SIGNALS["depth"] -= 1
+                    pending = _SIGNALS["pending"]
+                    if pending is not None and _SIGNALS["depth"] == 0:
+                        _SIGNALS["pending"] = None
+                        raise pending
 
         call.py_func = fn  # type: ignore[attr-defined]
         call.parallel = parallel  # type: ignore[attr-defined]
         return call
 
     return wrap
+
+
+def interrupt(exc: BaseException, frame: Any = None) -> None:
+    """Raise a signal handler's exception now, or, when the signal is handled inside
+    numba's call back into Python from a kernel, as the kernel returns.
+
+    A signal that arrives while a kernel runs is handled at the next Python step, which can
+    be inside numba's own call back into Python as the kernel hands its arrays over
+    (``_numba_unpickle``). An exception raised there does not stop the kernel's call
+    cleanly: it comes out as ``SystemError: CPUDispatcher(...) returned a result with an
+    exception set`` (:func:`signalled`), or, on a kernel's first call in a process, is lost
+    and leaves a hole in the results. A handler that calls this instead of raising lets the
+    kernel return whole, and the exception is raised as the call returns. The command line's
+    handlers of SIGINT (Ctrl-C) and SIGTERM do. Anywhere else, numba compiling a kernel
+    included, ``exc`` is raised at once.
+
+    Parameters
+    ----------
+    exc : BaseException
+        What the signal should raise (``KeyboardInterrupt()``, ``SystemExit(143)``); if
+        several signals arrive during one kernel, the first one's.
+    frame : frame, optional
+        The frame the handler was given (where the signal is handled).
+
+    Returns
+    -------
+    None
+        Only inside numba's call back from a kernel in the main thread; else ``exc`` is
+        raised.
+
+    Raises
+    ------
+    BaseException
+        ``exc``, outside numba's call back from a kernel.
+
+    Examples
+    --------
+    >>> interrupt(SystemExit(143))  # no kernel runs: at once
+    Traceback (most recent call last):
+    ...
+    SystemExit: 143
+    """
+    if _SIGNALS["depth"] > 0 and threading.get_ident() == _MAIN and _in_callback(frame):
+        if _SIGNALS["pending"] is None:
+            _SIGNALS["pending"] = exc
+        return
+    raise exc
+
+
+def _in_callback(frame: Any) -> bool:
+    """Whether ``frame`` runs inside numba's ``_numba_unpickle`` (what compiled code calls
+    back into Python for)."""
+    while frame is not None:
+        code = frame.f_code
+        if code.co_name == "_numba_unpickle" and "numba" in code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def signalled(exc: SystemError) -> BaseException:
+    """The ``KeyboardInterrupt`` or ``SystemExit`` behind a kernel's ``SystemError``, else
+    the error itself.
+
+    A signal handler that raises (Python's own for Ctrl-C, where :func:`interrupt` is not
+    used) inside numba's call back into Python as a kernel hands its arrays over makes the
+    kernel's call raise ``SystemError: CPUDispatcher(...) returned a result with an
+    exception set``, caused (through numba's own ``SystemError``) by the handler's
+    exception. Raised instead of the ``SystemError``, it stops the program as the signal
+    should.
+
+    Parameters
+    ----------
+    exc : SystemError
+        What the kernel's call raised.
+
+    Returns
+    -------
+    BaseException
+        The signal's exception that caused ``exc``, or ``exc``.
+
+    Examples
+    --------
+    >>> try:
+    ...     try:
+    ...         raise SystemError("_numba_unpickle ...") from KeyboardInterrupt()
+    ...     except SystemError as inner:
+    ...         raise SystemError("CPUDispatcher(...) ...") from inner
+    ... except SystemError as exc:
+    ...     signalled(exc)
+    KeyboardInterrupt()
+    >>> signalled(SystemError("another"))
+    SystemError('another')
+    """
+    seen: BaseException | None = exc
+    while isinstance(seen, SystemError):
+        seen = seen.__cause__ if seen.__cause__ is not None else seen.__context__
+    return seen if isinstance(seen, KeyboardInterrupt | SystemExit) else exc
 
 
 def dispatcher(func: Callable) -> Any:

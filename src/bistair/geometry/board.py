@@ -18,6 +18,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -48,8 +49,9 @@ class Board:
                                f"got {self.type!r}")
         if min(self.columns, self.rows) < 2 or self.columns * self.rows < 6:
             raise BistairError(f"board of {self.columns}x{self.rows} features is too small")
-        if not self.spacing > 0:
-            raise BistairError(f"board spacing must be positive, got {self.spacing}")
+        if not 0 < self.spacing < math.inf:  # (NaN too)
+            raise BistairError(f"board spacing must be a positive number of mm, got "
+                               f"{self.spacing}")
 
     # -- serialisation ---------------------------------------------------------------------
     @classmethod

@@ -259,9 +259,12 @@ def _device(data: Mapping[str, Any], name: str) -> Device:
     if min(width, height) < 1 or width != int(width) or height != int(height):
         raise BistairError(f"calibration {name} width and height must be positive integers")
     dist = _array(dev, "dist", ((4,), (5,)), f"{name}.")  # k1, k2, p1, p2[, k3]
+    K = _array(dev, "K", ((3, 3),), f"{name}.")
+    if not (K[0, 0] > 0 and K[1, 1] > 0):  # rectifying or projecting with it is nonsense
+        raise BistairError(f"calibration field '{name}.K' has the focal lengths fx "
+                           f"{K[0, 0]:g} and fy {K[1, 1]:g} px: both must be positive")
     rms = dev.get("rms")
-    return Device(int(width), int(height), _array(dev, "K", ((3, 3),), f"{name}."),
-                  dist,
+    return Device(int(width), int(height), K, dist,
                   float(rms) if isinstance(rms, int | float) else None)
 
 

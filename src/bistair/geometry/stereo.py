@@ -63,6 +63,7 @@ from ..spec import BaseSpec
 from .calibration import Calibration, Device
 from .stereo_calibration import StereoCalibration, load_stereo_calibration, short_baseline
 from .stereo_checks import (
+    MIN_MATCHED,
     MISFIT_SAMPLE,
     Coords,
     check_matches,
@@ -369,6 +370,12 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                              calibration.left.size == calibration.right.size,
                              _misfits(coords, rect, settings, m)[0])
     if problems and not force:
+        if info["matched_fraction"] < MIN_MATCHED and (min_depth > 0 or max_depth < math.inf):
+            # the depth range may keep the matches out: say so when it does
+            whole = reconstruct_stereo(left, right, calibration, orientation, rect, 0.0,
+                                       math.inf, tolerance, other_tolerance, gap, wiggle,
+                                       support, smooth, offset, force=True)
+            raise BistairError(_ranged(info, whole, min_depth, max_depth))
         raise BistairError(problems[0])
     info["warnings"] += problems
     short = short_baseline(calibration)
@@ -498,6 +505,23 @@ def readings(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
             continue
         out[name] = (round(misfits, 6), round(share, 6))
     return out
+
+
+def _ranged(info: dict[str, Any], whole: StereoResult, low: float, high: float) -> str:
+    """The refusal of too few matches (``info``) within a depth range, naming the range: the
+    range is to blame when the pair matches without it (``whole``), else the calibration or
+    the cameras' order."""
+    head = (f"only {100 * info['matched_fraction']:.1f}% of the {info['left_decoded']} "
+            "decoded left pixels found their match in the right camera")
+    ask = "is the calibration for these cameras, and are LEFT and RIGHT the right way round?"
+    within = f"{head} at depths {low:g} to {high:g} mm (--depth-range, left camera frame)"
+    found = whole.depth[whole.mask]
+    share = whole.info["matched_fraction"]
+    if share < MIN_MATCHED or not found.size:
+        return f"{within}, and {100 * share:.1f}% without it: {ask}"
+    lo, hi = np.percentile(found, [1, 99])
+    return (f"{within}; without it {100 * share:.1f}% match, at depths of {lo:.0f} to "
+            f"{hi:.0f} mm: widen or leave out --depth-range")
 
 
 def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,

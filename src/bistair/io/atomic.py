@@ -2,8 +2,10 @@
 
 Outputs go to a temporary folder or file beside the destination (named with
 :data:`TEMP_PREFIX` and the process id) and are moved in only when every file is written; a
-folder is replaced as a whole. Temporaries left by a killed process are removed by the next
-run that writes beside them (:func:`remove_stale`), never those of a process still running.
+folder is replaced as a whole. An output that is, holds or mixes with an input of the
+running command is refused first (:func:`check_output`, :mod:`.inputs`). Temporaries left
+by a killed process are removed by the next run that writes beside them
+(:func:`remove_stale`), never those of a process still running.
 
 Examples
 --------
@@ -30,7 +32,8 @@ import numpy as np
 import tifffile
 
 from ..errors import BistairError
-from .read import Captures
+from .inputs import noted
+from .read import IMAGE_SUFFIXES, Captures
 
 
 def _reason(path: Path, exc: OSError) -> str:
@@ -106,18 +109,30 @@ def slug(label: str) -> str:
     return re.sub(r"[^A-Za-z0-9._-]+", "-", label).strip("-") or "-"
 
 
-def check_output(out: str | Path, captures: Captures | None = None) -> Path:
-    """Refuse an output path that is empty or is the captures' own folder (writing there
-    would add files to the next decode of that folder); returns it as a Path.
+def check_output(out: str | Path, captures: Captures | None = None, *,
+                 file: bool = False) -> Path:
+    """Refuse an output path that is empty, or that is, holds or mixes with an input of the
+    running command; returns it as a Path.
+
+    The inputs are ``captures`` and those noted by the running command
+    (:func:`bistair.io.inputs.reading`: what its command line names and what it has read).
+    Refused: an output that is an input (a capture folder, a spec, a calibration file, ...),
+    a folder that holds one (writing there would replace it, or leave the outputs beside
+    it: ``--out SET`` for captures in ``SET/left``, ``--out .`` for captures in the current
+    folder), and an image file written straight into a capture folder (the folder's next
+    read would take it as a capture). Paths are compared resolved (symbolic links
+    followed); an output inside an input folder is otherwise allowed (``--out
+    scan/decoded``).
 
     Parameters
     ----------
     out : str or Path
-        The output folder.
+        The output folder or file.
     captures : str, Path, sequence of str or Path, or None, optional
-        The captures it is made from (as for :func:`capture_files`): a folder, the folder
-        of a file or the folder part of a glob pattern counts as their own folder. Paths
-        are compared resolved.
+        Inputs besides the noted ones (as for :func:`capture_files`): folders, files or
+        glob patterns (a pattern stands for its folder).
+    file : bool
+        ``out`` is a file (else a folder).
 
     Returns
     -------
@@ -127,7 +142,8 @@ def check_output(out: str | Path, captures: Captures | None = None) -> Path:
     Raises
     ------
     BistairError
-        If ``out`` is empty (or blank) or is the captures' own folder.
+        If ``out`` is empty (or blank), is an input, holds one, or is an image file in a
+        capture folder.
 
     Examples
     --------
@@ -136,7 +152,11 @@ def check_output(out: str | Path, captures: Captures | None = None) -> Path:
     >>> check_output("scan", "scan/*.png")  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    bistair.errors.BistairError: the output folder scan is the captures' own folder: ...
+    bistair.errors.BistairError: the output scan is the input scan: choose another output ...
+    >>> check_output(".", ["set/left", "set/right"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the output . holds the input set/left: choose another ...
     >>> check_output(" ")
     Traceback (most recent call last):
     ...
@@ -145,14 +165,23 @@ def check_output(out: str | Path, captures: Captures | None = None) -> Path:
     if str(out).strip() == "":
         raise BistairError("the output path is empty")
     out = Path(out)
-    if captures is not None:
-        items = [captures] if isinstance(captures, str | Path) else list(captures)
-        folders = {Path(i).resolve() if Path(i).is_dir() else Path(i).resolve().parent
-                   for i in items if not any(c in str(i) for c in "*?[")}
-        folders |= {Path(str(i)).parent.resolve() for i in items if any(c in str(i) for c in "*?[")}
-        if out.resolve() in folders:
-            raise BistairError(f"the output folder {out} is the captures' own folder: choose "
-                               "another (the outputs would be read as captures next time)")
+    items = [] if captures is None else \
+        [captures] if isinstance(captures, str | Path) else list(captures)
+    inputs = noted(items)
+    if not inputs:
+        return out
+    target = out.resolve()
+    why = "choose another output (writing there would replace the input or mix with it)"
+    for path, given in inputs.items():
+        if target == path:
+            raise BistairError(f"the output {out} is the input {given}: {why}")
+        if target in path.parents:
+            raise BistairError(f"the output {out} holds the input {given}: {why}")
+        if (file and target.parent == path and target.suffix.lower() in IMAGE_SUFFIXES
+                and not target.name.startswith(".") and path.is_dir()):
+            raise BistairError(f"the output {out} lies in the capture folder {given}: choose "
+                               "another output (the folder's next read would take it as a "
+                               "capture)")
     return out
 
 
@@ -188,9 +217,10 @@ def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
     Raises
     ------
     BistairError
-        If ``out`` exists and is not a folder, or the folder cannot be created or written
-        (any ``OSError``, also one raised in the ``with`` block, in one line). Other errors
-        in the ``with`` block propagate unchanged.
+        If ``out`` is, holds or mixes with an input of the running command
+        (:func:`check_output`), exists and is not a folder, or the folder cannot be created
+        or written (any ``OSError``, also one raised in the ``with`` block, in one line).
+        Other errors in the ``with`` block propagate unchanged.
 
     Examples
     --------
@@ -211,7 +241,7 @@ def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
     ['a.txt']
     >>> shutil.rmtree(tmp)
     """
-    out = Path(out)
+    out = check_output(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")
     parent = out if out.exists() else out.parent
@@ -263,8 +293,9 @@ def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]
     Raises
     ------
     BistairError
-        If ``out`` exists and is not a folder, or the folders cannot be made or renamed
-        (in one line; the old folder is put back).
+        If ``out`` is, holds or mixes with an input of the running command
+        (:func:`check_output`), exists and is not a folder, or the folders cannot be made or
+        renamed (in one line; the old folder is put back).
 
     Examples
     --------
@@ -277,7 +308,7 @@ def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]
     ...     sorted(p.name for p in pathlib.Path(tmp).rglob("*"))
     ['new.txt', 'set']
     """
-    out = Path(out)
+    out = check_output(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")
     try:
@@ -377,9 +408,10 @@ def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
     Raises
     ------
     BistairError
-        If the folder or the temporary file cannot be made, or the rename fails (any
-        ``OSError``, also one raised in the ``with`` block, in one line). Other errors in
-        the ``with`` block propagate unchanged.
+        If ``path`` is, holds or mixes with an input of the running command
+        (:func:`check_output`), the folder or the temporary file cannot be made, or the
+        rename fails (any ``OSError``, also one raised in the ``with`` block, in one line).
+        Other errors in the ``with`` block propagate unchanged.
 
     Examples
     --------
@@ -392,7 +424,7 @@ def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
     (['info.txt'], 'done')
     >>> shutil.rmtree(tmp)
     """
-    path = Path(path)
+    path = check_output(path, file=True)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
         remove_stale(path.parent)

@@ -10,9 +10,10 @@ from typing import Any
 import numpy as np
 
 from ..errors import BistairError
+from .inputs import note
 
 
-def read_json(path: str | Path, what: str) -> Any:
+def read_json(path: str | Path, what: str, *, state: bool = False) -> Any:
     """Parse ``path``; missing, unreadable or malformed files raise a one-line
     :class:`BistairError` naming ``what`` the file is (e.g. ``"spec file"``).
 
@@ -22,6 +23,10 @@ def read_json(path: str | Path, what: str) -> Any:
         The JSON file (UTF-8).
     what : str
         What the file is, for the messages (``"spec file"``, ``"calibration file"``, ...).
+    state : bool
+        The file keeps a state the running command may write back (a latency file, a
+        batch's marker), rather than an input it must not overwrite: not noted
+        (:func:`bistair.io.inputs.note`).
 
     Returns
     -------
@@ -54,6 +59,8 @@ def read_json(path: str | Path, what: str) -> Any:
     bistair.errors.BistairError: spec file /nonexistent.json not found
     """
     path = Path(path)
+    if not state:
+        note(path)
     try:
         return json.loads(path.read_text())
     except FileNotFoundError:

@@ -28,6 +28,7 @@ import tifffile
 from ..codecs import spec_from_dict
 from ..errors import BistairError
 from ..spec import BaseSpec
+from .inputs import note
 from .jsonfile import read_json
 
 READ_THREADS = 3  # frames read at once (1.3 MP PNGs: 3 threads 35 ms, 1 thread 59 ms, 6 38)
@@ -90,6 +91,7 @@ def list_images(folder: Path) -> list[Path]:
     ['1.tif', '2.PNG', '10.png']
     >>> shutil.rmtree(tmp)
     """
+    note(folder)  # an input of the running command (bistair.io.inputs)
     return sorted((p for p in folder.iterdir() if _is_image(p)),
                   key=lambda p: natural_key(p.name))
 
@@ -134,6 +136,7 @@ def read_image(path: str | Path) -> np.ndarray:
     bistair.errors.BistairError: image /nonexistent/00.png not found
     """
     path = Path(path)
+    note(path)
     try:
         if path.stat().st_size == 0:
             raise BistairError(f"image {path} is empty (0 bytes)")
@@ -200,6 +203,7 @@ def capture_files(captures: Captures) -> list[Path]:
     items = [captures] if isinstance(captures, str | Path) else list(captures)
     if not items:
         raise BistairError("no captures given")
+    note(*items)  # inputs of the running command (bistair.io.inputs), and their files below
     files: list[Path] = []
     for item in items:
         text = str(item)
@@ -225,6 +229,7 @@ def capture_files(captures: Captures) -> list[Path]:
                                "them or a .npy stack")
     if len(files) > 1 and any(f.suffix.lower() == ".npy" for f in files):
         raise BistairError("a .npy capture stack must be given alone")
+    note(*files)
     return files
 
 
