@@ -17,7 +17,7 @@ from bistair.core.jit import PI32, TWO_PI32
 from bistair.core.regions import default_cut, fringe_direction
 
 
-@numba.njit(inline="always", cache=True)
+@numba.njit(inline="always", cache=True, error_model="numpy")
 def _wrapped(raw):
     d = raw + PI32
     if d >= TWO_PI32:
@@ -27,7 +27,7 @@ def _wrapped(raw):
     return d - PI32
 
 
-@numba.njit(inline="always", cache=True)
+@numba.njit(inline="always", cache=True, error_model="numpy")
 def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np.float32,
           qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
           half: np.float32) -> bool:
@@ -54,7 +54,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
 
 
 
-@numba.njit(inline="always", cache=True)
+@numba.njit(inline="always", cache=True, error_model="numpy")
 def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
            rel: np.float32) -> bool:
     """Not clearly below ``rel`` of the larger gradient: :func:`_jump`'s first test, which
@@ -65,7 +65,7 @@ def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
 
 
 
-@numba.njit(inline="always", cache=True)
+@numba.njit(inline="always", cache=True, error_model="numpy")
 def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
                       sums: np.ndarray, around: np.ndarray, ahead: np.ndarray) -> None:
     """Row ``y``'s mean wrapped gradients (x, y) and their sample counts over the columns
@@ -120,7 +120,7 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
 
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(parallel=True, cache=True, error_model="numpy", nogil=True)
 def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
                       relative: float) -> tuple[np.ndarray, np.ndarray]:
     """The links across which the fringes' spacing or slant jumps (see
@@ -164,7 +164,7 @@ def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, hal
 
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", nogil=True)
 def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
                relative: float, y0: int, y1: int, vert: np.ndarray, horiz: np.ndarray
                ) -> None:
@@ -212,7 +212,7 @@ def _jump_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
 
 
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(parallel=True, cache=True, error_model="numpy", nogil=True)
 def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
                  noise: np.ndarray, jump_v: np.ndarray, jump_h: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -332,7 +332,7 @@ def fringe_links(phi: np.ndarray, valid: np.ndarray, cut: float, sign: int,
 
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", nogil=True)
 def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.ndarray,
              horiz: np.ndarray, passes: int) -> None:
     """Give valid pixels that were dropped the label of a neighbour they are linked to
@@ -393,7 +393,7 @@ def reattach(labels: np.ndarray, valid: np.ndarray, keep: np.ndarray, vert: np.n
 
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, error_model="numpy", nogil=True)
 def drop_small(labels: np.ndarray, n: int, min_size: int) -> int:
     """Set the labels of regions under ``min_size`` pixels to 0 and number the others
     ``1..`` in their order, in place; returns how many are left.
@@ -435,7 +435,7 @@ def drop_small(labels: np.ndarray, n: int, min_size: int) -> int:
                 labels[y, x] = remap[labels[y, x]]
     return kept
 
-@numba.njit(parallel=True, cache=True)
+@numba.njit(parallel=True, cache=True, error_model="numpy", nogil=True)
 def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
                   min_strong: int, min_size: int, min_region: int) -> np.ndarray:
     """``strong | (weak & region kept)``, a region kept when it holds ``min_region`` pixels

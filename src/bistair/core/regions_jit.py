@@ -118,18 +118,25 @@ def _windows(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below
     w = p.shape[0]
     zero = np.float32(0.0)
     one = np.float32(1.0)
-    for x in range(w - 1):  # vector loops: gradients and counts, selected (no branch)
-        ok = (v[x] & v[x + 1]) != 0
-        g = _wrap_sel(p[x + 1] - p[x])
-        gx[x] = g if ok else zero
-        nx[x + 3] = one if ok else zero
+    # vector loops, each writing one array (more pointers than LLVM checks for overlap
+    # leave a loop scalar): gradients and counts selected (no branch), then the window
+    # means, each in its own loop
+    for x in range(w - 1):
+        gx[x] = _wrap_sel(p[x + 1] - p[x]) if (v[x] & v[x + 1]) != 0 else zero
     gx[w - 1] = zero
+    for x in range(w - 1):
+        nx[x + 3] = one if (v[x] & v[x + 1]) != 0 else zero
     nx[w + 2] = zero
-    for x in range(w):
-        ok = below and (v[x] & vb[x]) != 0
-        g = _wrap_sel(pb[x] - p[x])
-        gy[x] = g if ok else zero
-        ny[x + 3] = one if ok else zero
+    if below:
+        for x in range(w):
+            gy[x] = _wrap_sel(pb[x] - p[x]) if (v[x] & vb[x]) != 0 else zero
+        for x in range(w):
+            ny[x + 3] = one if (v[x] & vb[x]) != 0 else zero
+    else:
+        for x in range(w):
+            gy[x] = zero
+        for x in range(w):
+            ny[x + 3] = zero
     s0 = zero  # the running sums: one dependent add a pixel each, the two side by side
     s1 = zero
     for x in range(w):
@@ -140,41 +147,57 @@ def _windows(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below
     for i in range(w + 4, w + 7):
         sx[i] = s0
         sy[i] = s1
-    a0 = around[0]
-    a1 = around[1]
-    a2 = around[2]
-    for x in range(w):
-        hx = nx[x + 3] + nx[x + 4] + nx[x + 5]
-        hy = ny[x + 3] + ny[x + 4] + ny[x + 5]
-        cx = nx[x] + nx[x + 1] + nx[x + 2] + hx
-        cy = ny[x] + ny[x + 1] + ny[x + 2] + hy
-        a2[x] = min(cx, cy)
-        a0[x] = (sx[x + 6] - sx[x]) / max(cx, one)
-        a1[x] = (sy[x + 6] - sy[x]) / max(cy, one)
+    _means(sx, nx, around[0], ahead[0], ahead_too)
+    _means(sy, ny, around[1], ahead[1], ahead_too)
+    _counts(nx, ny, around[2], ahead[2], ahead_too)
+
+
+@_numba_inline
+def _means(s: np.ndarray, n: np.ndarray, around: np.ndarray, ahead: np.ndarray,
+           ahead_too: bool) -> None:
+    """A row's window means of one gradient (:func:`_windows`): ``around[x] = (s[x+6] -
+    s[x]) / max(count, 1)``, the count ``n[x] + ... + n[x+5]`` (exact), and with
+    ``ahead_too`` ``ahead[x]`` of ``s[x+3]`` and ``n[x+3] + ... + n[x+5]``."""
+    one = np.float32(1.0)
     if ahead_too:
-        h0 = ahead[0]
-        h1 = ahead[1]
-        h2 = ahead[2]
-        for x in range(w):
-            hx = nx[x + 3] + nx[x + 4] + nx[x + 5]
-            hy = ny[x + 3] + ny[x + 4] + ny[x + 5]
-            h2[x] = min(hx, hy)
-            h0[x] = (sx[x + 6] - sx[x + 3]) / max(hx, one)
-            h1[x] = (sy[x + 6] - sy[x + 3]) / max(hy, one)
+        for x in range(around.shape[0]):
+            c = n[x + 3] + n[x + 4] + n[x + 5]
+            ahead[x] = np.divide(s[x + 6] - s[x + 3], max(c, one))
+            c += n[x] + n[x + 1] + n[x + 2]
+            around[x] = np.divide(s[x + 6] - s[x], max(c, one))
+    else:
+        for x in range(around.shape[0]):
+            c = n[x] + n[x + 1] + n[x + 2] + n[x + 3] + n[x + 4] + n[x + 5]
+            around[x] = np.divide(s[x + 6] - s[x], max(c, one))
+
+
+@_numba_inline
+def _counts(nx: np.ndarray, ny: np.ndarray, around: np.ndarray, ahead: np.ndarray,
+            ahead_too: bool) -> None:
+    """A row's window counts (:func:`_windows`): the smaller of the two gradients'."""
+    for x in range(around.shape[0]):
+        cx = nx[x] + nx[x + 1] + nx[x + 2] + nx[x + 3] + nx[x + 4] + nx[x + 5]
+        cy = ny[x] + ny[x + 1] + ny[x + 2] + ny[x + 3] + ny[x + 4] + ny[x + 5]
+        around[x] = min(cx, cy)
+    if ahead_too:
+        for x in range(around.shape[0]):
+            cx = nx[x + 3] + nx[x + 4] + nx[x + 5]
+            cy = ny[x + 3] + ny[x + 4] + ny[x + 5]
+            ahead[x] = min(cx, cy)
 
 
 @_numba_inline
 def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32, pos: bool,
-                st: np.ndarray, raw: np.ndarray) -> None:
+                st: np.ndarray, raw: np.ndarray, back: np.ndarray) -> None:
     """The states of a row's horizontal links, ``st[x+1]`` for the link between ``x`` and
     ``x+1`` (``st[0]``, ``st[W]``: 0): 0 not between two valid pixels, 1 connects, 2 a wrap
     whose phase falls along the phase's direction (``pos``: +1), 3 one whose phase rises, 4
     cut (a step above ``cut32``, or a run of links against the phase's direction that
     falls by more than ``max(0.15, 4 sigma)``, ``sigma`` ``sqrt(2)`` times the larger
-    noise ``nz`` of a link's ends)."""
+    noise ``nz`` of a link's ends). ``raw``, ``back``: scratch rows (``back`` padded to a
+    multiple of 8 bytes, 0 from ``W-1``)."""
     w = p.shape[0]
     zero = np.float32(0.0)
-    back = False
     for x in range(w - 1):  # a vector loop
         ok = (v[x] & v[x + 1]) != 0
         r = p[x + 1] - p[x] if pos else p[x] - p[x + 1]
@@ -182,23 +205,25 @@ def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32,
         a = abs(r)
         s = np.uint8(3) if r > zero else np.uint8(2)
         s = s if a > PI32 else (np.uint8(4) if a > cut32 else np.uint8(1))
-        s = s if ok else np.uint8(0)
-        st[x + 1] = s
-        back |= (s == 1) & (r < zero)
+        st[x + 1] = s if ok else np.uint8(0)
     st[0] = 0
     st[w] = 0
-    if not back:
-        return
+    for x in range(w - 1):  # links that connect against the phase's direction
+        back[x] = (st[x + 1] == 1) & (raw[x] < zero)
     sqrt2 = math.sqrt(2.0)
+    words = back.view(np.uint64)
     x = 0
-    while x < w - 1:  # runs of connecting links against the phase's direction
-        if not (st[x + 1] == 1 and raw[x] < 0):
+    while x < w - 1:  # their runs (eight links at a time skipped where there is none)
+        if (x & 7) == 0 and words[x >> 3] == 0:
+            x += 8
+            continue
+        if not back[x]:
             x += 1
             continue
         start = x
         fall = 0.0
         spread = 0.0
-        while x < w - 1 and st[x + 1] == 1 and raw[x] < 0:
+        while x < w - 1 and back[x]:
             fall += -np.float64(raw[x])
             spread = max(spread, sqrt2 * np.float64(max(nz[x], nz[x + 1])))
             x += 1
@@ -232,7 +257,12 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
     raw = np.zeros(w, np.float32)
     st = np.zeros(w + 1, np.uint8)  # horizontal link states (``_row_states``)
     vs = np.zeros(w, np.uint8)  # vertical link states, the same codes (2: the upper end)
-    maybe = np.zeros(w, np.uint8)
+    padded = (w + 7) // 8 * 8  # flags scanned eight at a time: 0 past the row's links
+    back = np.zeros(padded, np.uint8)
+    maybe_h = np.zeros(padded, np.uint8)
+    maybe_v = np.zeros(padded, np.uint8)
+    words_h = maybe_h.view(np.uint64)
+    words_v = maybe_v.view(np.uint64)
     hconn = np.zeros((2, w), np.uint8)
     drop = np.zeros((2, w), np.uint8)
     first = max(y0 - 1, 0)
@@ -248,26 +278,30 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
         inside = y0 <= y < y1
         _windows(p, v, pb, vb, below, inside, gx, gy, nx, ny, sx, sy, around[cur], ahead)
         if inside:  # the horizontal links of row y
-            _row_states(p, v, nz, cut32, pos, st, raw)
+            _row_states(p, v, nz, cut32, pos, st, raw, back)
             if cuts:
                 ch = cut_h[y]
                 for x in range(w - 1):
                     s = st[x + 1]
                     st[x + 1] = np.uint8(4) if (s == 1) & (ch[x] != 0) else s
-            # the period jumps, left window [x-3, x) against right window [x+1, x+4): the
-            # cheap first test for every link in a vector loop, the rest where it passes
+            # the period jumps of links x = i+3, left window [i, i+3) against right window
+            # [i+4, i+7): the cheap first test for every link in a vector loop, the rest
+            # where it passes (indices a loop counter from 0 plus a constant: a negative
+            # index would wrap, and its test keeps the loop scalar)
             a0 = ahead[0]
             a1 = ahead[1]
             a2 = ahead[2]
-            for x in range(HALF, w - 1):
-                lo = x - HALF
-                maybe[x] = (st[x + 1] == 1) & _steep(a0[lo], a1[lo], a0[x + 1], a1[x + 1], rel)
-            for x in range(HALF, w - 1):
-                if maybe[x]:
-                    lo = x - HALF
-                    if _jump(a0[lo], a1[lo], a2[lo], a0[x + 1], a1[x + 1], a2[x + 1], nz[x],
-                             nz[x + 1], rel, fhalf):
-                        st[x + 1] = 4
+            for i in range(w - 1 - HALF):
+                maybe_h[i] = (st[i + HALF + 1] == 1) & _steep(a0[i], a1[i], a0[i + HALF + 1],
+                                                              a1[i + HALF + 1], rel)
+            for k in range(words_h.shape[0]):
+                if words_h[k] == 0:  # (most words)
+                    continue
+                for i in range(8 * k, 8 * k + 8):
+                    if maybe_h[i] and _jump(a0[i], a1[i], a2[i], a0[i + HALF + 1],
+                                            a1[i + HALF + 1], a2[i + HALF + 1], nz[i + HALF],
+                                            nz[i + HALF + 1], rel, fhalf):
+                        st[i + HALF + 1] = 4
             hb = hconn[cur]
             dr = drop[cur]
             for x in range(w):
@@ -302,11 +336,14 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
         c1 = c[1]
         c2 = c[2]
         for x in range(w):
-            maybe[x] = (vs[x] == 1) & _steep(b0[x], b1[x], c0[x], c1[x], rel)
-        for x in range(w):
-            if maybe[x] and _jump(b0[x], b1[x], b2[x], c0[x], c1[x], c2[x], na[x], nz[x], rel,
-                                  fhalf):
-                vs[x] = 4
+            maybe_v[x] = (vs[x] == 1) & _steep(b0[x], b1[x], c0[x], c1[x], rel)
+        for k in range(words_v.shape[0]):
+            if words_v[k] == 0:
+                continue
+            for x in range(8 * k, 8 * k + 8):
+                if maybe_v[x] and _jump(b0[x], b1[x], b2[x], c0[x], c1[x], c2[x], na[x], nz[x],
+                                        rel, fhalf):
+                    vs[x] = 4
         dp = drop[prv]
         dc = drop[cur]
         for x in range(w):
