@@ -541,3 +541,82 @@ def coherent_before(phi, weak, strong, phase_noise, min_strong=10, min_size=100)
     """``bistair.core.measure.coherent_pixels`` of 02b6580."""
     labels, n = regions_before(phi, weak, min_size=1, phase_noise=phase_noise)
     return keep_coherent(labels, weak, strong, n, min_strong, min_size, 20)
+
+
+class Watch:
+    """While open (``with Watch() as seen``), every fringe-region labelling a decode runs
+    is checked against the passes above on the same arguments: the links of each
+    ``link_bits`` call (``links_before``), the labels of each ``fringe_regions`` call
+    (``regions_before``) and the pixels of each ``coherent_pixels`` call
+    (``coherent_before``). ``seen`` counts the calls per kind; ``differ`` lists the calls
+    that did not give the same (a decode goes on with the new result)."""
+
+    def __init__(self) -> None:
+        self.seen = {"link_bits": 0, "fringe_regions": 0, "coherent_pixels": 0}
+        self.differ: list[str] = []
+        self._undo: list[tuple] = []
+
+    def __enter__(self) -> Watch:
+        import sys
+
+        from bistair.core import measure, regions
+
+        def links(phi, valid, noise, cut, sign, relative, cut_v, cut_h, cuts):
+            bits = link_bits(phi, valid, noise, cut, sign, relative, cut_v, cut_h, cuts)
+            vert, horiz, keep = links_before(phi, valid, cut, sign, noise,
+                                             (cut_v, cut_h) if cuts else None)
+            self.seen["link_bits"] += 1
+            if not same_links(bits, vert, horiz, keep, valid):
+                self.differ.append(f"link_bits {phi.shape}")
+            return bits
+
+        def fringes(phi, valid, cut=None, min_size=20, phase_noise=None, boundaries=None,
+                    sign=None):
+            labels, n = fringe_regions(phi, valid, cut, min_size, phase_noise, boundaries,
+                                       sign)
+            want, n_want = regions_before(phi, valid, cut, min_size, phase_noise, boundaries,
+                                          sign)
+            self.seen["fringe_regions"] += 1
+            if n != n_want or not np.array_equal(labels, want) or labels.dtype != want.dtype:
+                self.differ.append(f"fringe_regions {phi.shape} min_size {min_size}")
+            return labels, n
+
+        def coherent(phi, weak, strong, phase_noise, min_strong=10, min_size=100):
+            got = coherent_pixels(phi, weak, strong, phase_noise, min_strong, min_size)
+            self.seen["coherent_pixels"] += 1
+            if not np.array_equal(got, coherent_before(phi, weak, strong, phase_noise,
+                                                       min_strong, min_size)):
+                self.differ.append(f"coherent_pixels {phi.shape}")
+            return got
+
+        link_bits = regions.link_bits
+        fringe_regions = regions.fringe_regions
+        coherent_pixels = measure.coherent_pixels
+        self._patch(regions, "link_bits", links)
+        for module in list(sys.modules.values()):  # where the codecs imported it
+            if getattr(module, "__name__", "").startswith("bistair.") and \
+                    getattr(module, "fringe_regions", None) is fringe_regions:
+                self._patch(module, "fringe_regions", fringes)
+        self._patch(measure, "coherent_pixels", coherent)
+        return self
+
+    def _patch(self, module, name: str, value) -> None:
+        self._undo.append((module, name, getattr(module, name)))
+        setattr(module, name, value)
+
+    def __exit__(self, *exc) -> None:
+        for module, name, value in reversed(self._undo):
+            setattr(module, name, value)
+
+
+def same_links(bits, vert, horiz, keep, valid) -> bool:
+    """Whether the bytes of ``link_bits`` say what the three masks and the validity say
+    (and no link leaves the image)."""
+    from bistair.core.regions_jit import KEPT, LINK_DOWN, LINK_RIGHT, VALID
+
+    return (np.array_equal((bits & KEPT) > 0, keep)
+            and np.array_equal((bits & VALID) > 0, valid)
+            and np.array_equal((bits[:, :-1] & LINK_RIGHT) > 0, horiz)
+            and np.array_equal((bits[:-1] & LINK_DOWN) > 0, vert)
+            and not (bits[:, -1] & LINK_RIGHT).any() and not (bits[-1] & LINK_DOWN).any()
+            and not (bits & ~np.uint8(15)).any())
