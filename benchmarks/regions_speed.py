@@ -95,9 +95,7 @@ def cases(frames: np.ndarray, spec) -> dict:
                                            ltype=cv2.CV_32S)
     labels_old, n_old = old.regions_before(fphi, fvalid, cut, 20, noise, edges, sign)
     bits = new.link_bits(fphi, fvalid, noise, cut, sign, 0.3, edges[0], edges[1], True)
-    lab, roots, n, size, lit = new.label_kept(bits, new.NO_CUTS, False, new.TILE)
-    after_cc = lab.copy()
-    new.reattach(lab, bits, roots, size.copy(), lit, new.NO_CUTS, False, 3)
+    lab, roots, n, size, lit = new.label_kept(bits, new.NO_CUTS, False, new.TILE, 3)
     remap = np.arange(n + 1, dtype=np.int32)
     c_lab, c_n = old.regions_before(phi, weak, None, 1, sigma)
     h, w = fphi.shape
@@ -112,10 +110,9 @@ def cases(frames: np.ndarray, spec) -> dict:
                                                       edges[0], edges[1], True),
         "old cv2.connectedComponents": lambda: cv2.connectedComponents(
             keep.view(np.uint8), connectivity=4, ltype=cv2.CV_32S),
-        "new label_kept": lambda: new.label_kept(bits, new.NO_CUTS, False, new.TILE),
         "old reattach": lambda: old.reattach(lab_cc.copy(), fvalid, keep, vert, horiz, 3),
-        "new reattach": lambda: new.reattach(after_cc.copy(), bits, roots, size.copy(),
-                                             lit.copy(), new.NO_CUTS, False, 3),
+        "new label_kept (+ reattach)": lambda: new.label_kept(bits, new.NO_CUTS, False,
+                                                              new.TILE, 3),
         "old drop_small": lambda: old.drop_small(labels_old.copy(), n_old, 20),
         "new relabel": lambda: new.relabel(lab.copy(), roots, remap),
         "old keep_coherent": lambda: old.keep_coherent(c_lab, weak, strong, c_n, 10, 100, 20),

@@ -127,7 +127,7 @@ def test_labels_are_opencvs(h, w, seed, kind, tile, count):
     bits = (keep * np.uint8(4) | rng.integers(0, 2, (h, w), np.uint8) * np.uint8(8)
             ).astype(np.uint8)
     labels, roots, n, size, bright = label_kept(bits, strong if count else NO_CUTS, count,
-                                                tile)
+                                                tile, 0)
     n_cv, want = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
                                          ltype=cv2.CV_32S)
     assert n == n_cv - 1
@@ -216,7 +216,7 @@ def test_labels_of_a_checkerboard(shape):
     y, x = np.mgrid[0:shape[0], 0:shape[1]]
     keep = (x + y) % 2 == 0
     labels, roots, n, size, _ = label_kept(keep.astype(np.uint8) * np.uint8(4), NO_CUTS,
-                                           False, TILE)
+                                           False, TILE, 0)
     n_cv, want = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
                                          ltype=cv2.CV_32S)
     assert n == n_cv - 1 == keep.sum() and np.array_equal(roots[labels], want)

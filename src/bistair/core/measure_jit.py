@@ -80,8 +80,13 @@ def keep_coherent(labels: np.ndarray, roots: np.ndarray, size: np.ndarray,
         lab = labels[y]
         s = strong[y]
         o = out[y]
-        for x in range(w):
-            o[x] = s[x] or keep[roots[lab[x]]]
+        last = np.int32(0)
+        kept = False
+        for x in range(w):  # a run of one label looked up once
+            if lab[x] != last:
+                last = lab[x]
+                kept = keep[roots[last]]
+            o[x] = s[x] or kept
     return out
 
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, reattach, relabel, wrap_links
+from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, relabel, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -262,9 +262,9 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                   boundaries: tuple[np.ndarray, np.ndarray] | None = None,
                   sign: int | None = None, strong: np.ndarray | None = None) -> Labelling:
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
-    labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), the kept
-    pixels labelled with per-region counts (:func:`~bistair.core.regions_jit.label_kept`),
-    dropped pixels reattached (:func:`~bistair.core.regions_jit.reattach`).
+    labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
+    pixels labelled and the dropped ones reattached, with per-region counts
+    (:func:`~bistair.core.regions_jit.label_kept`).
 
     Parameters
     ----------
@@ -305,10 +305,9 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     del noise
     counted = strong is not None
     mask = np.ascontiguousarray(strong, dtype=bool) if counted else NO_CUTS
-    labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE)
     # the pixels dropped beside a cut link (thin lines along the wraps) join the region
-    # they still link to, a few rounds
-    reattach(labels, bits, roots, size, lit, mask, counted, 3)
+    # they still link to: three rounds
+    labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE, 3)
     return Labelling(labels, roots, int(n), size, lit)
 
 

@@ -9,11 +9,10 @@ A decode runs them in this order (:func:`bistair.core.regions.label_fringes`):
 1. :func:`link_bits`: one byte a pixel, ``LINK_RIGHT | LINK_DOWN | KEPT | VALID``;
 2. :func:`label_kept`: provisional labels of the kept pixels (4-connected), their regions
    numbered ``1..n`` in raster order of each region's first pixel (as
-   ``cv2.connectedComponents(kept, connectivity=4)`` numbers them), pixels and pixels of
-   a second mask per region;
-3. :func:`reattach`: valid pixels that were not kept take the label of a neighbour they are
-   linked to, the counts follow;
-4. :func:`relabel`: the final labels, written row by row in raster order (the hook for
+   ``cv2.connectedComponents(kept, connectivity=4)`` numbers them), the valid pixels not
+   kept reattached to a region they link to, pixels and pixels of a second mask counted
+   per region;
+3. :func:`relabel`: the final labels, written row by row in raster order (the hook for
    sums per (region, row): see its docstring).
 
 Each gives exactly what the passes it replaced gave (``period_jump_links``,
@@ -31,9 +30,9 @@ Examples
 ...                  NO_CUTS, NO_CUTS, False)
 >>> (bits[0, 28:32] & KEPT).tolist()  # the wrap between columns 29 and 30: 29 dropped
 [4, 0, 4, 4]
->>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, TILE)
->>> n, size.tolist()
-(2, [0, 116, 120])
+>>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, TILE, 3)
+>>> n, size.tolist()  # column 29 reattached
+(2, [0, 120, 120])
 """
 
 from __future__ import annotations
@@ -102,25 +101,22 @@ def _wrap_sel(raw: np.float32) -> np.float32:
 
 
 @_numba_inline
-def _windows(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below: bool,
-             ahead_too: bool, gx: np.ndarray, gy: np.ndarray, nx: np.ndarray,
-             ny: np.ndarray, sx: np.ndarray, sy: np.ndarray, around: np.ndarray,
-             ahead: np.ndarray) -> None:
-    """A row's mean wrapped gradients (x, y) and sample counts over the columns
-    ``[x-3, x+3)`` (``around`` (3, W): for the vertical links) and ``[x, x+3)`` (``ahead``
-    (3, W), with ``ahead_too``: for the horizontal ones), clipped to the image.
-
-    As ``period_jumps`` computes them: a window's sum is the difference of two float32
-    running sums along the row (``sx``, ``sy``: (W+7,), ``S[clip(i-3, 0, W)]`` at ``i``,
-    the first four 0), counts exact (``nx``, ``ny``: (W+6,), 0/1 at ``x+3``, the first
-    and last three 0). ``p``, ``v``: the row's phase and validity (0/1); ``pb``, ``vb``:
-    the next row's (read only if ``below``)."""
+def _gradients(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below: bool,
+               g: np.ndarray) -> None:
+    """A row's wrapped gradients and their counts, for :func:`_windows`: ``g[0]``, ``g[1]``
+    the gradients along the row and down the column (0 where a pixel of the pair is not
+    valid, or at the image's last column and row), ``g[2]``, ``g[3]`` (from ``x+3``, the
+    first and last three 0) 1 where they count. ``p``, ``v``: the row's phase and
+    validity (0/1); ``pb``, ``vb``: the next row's (read only if ``below``). Vector loops,
+    each writing one array (more pointers than LLVM checks for overlap leave a loop
+    scalar), selected rather than branched."""
     w = p.shape[0]
     zero = np.float32(0.0)
     one = np.float32(1.0)
-    # vector loops, each writing one array (more pointers than LLVM checks for overlap
-    # leave a loop scalar): gradients and counts selected (no branch), then the window
-    # means, each in its own loop
+    gx = g[0]
+    gy = g[1]
+    nx = g[2]
+    ny = g[3]
     for x in range(w - 1):
         gx[x] = _wrap_sel(p[x + 1] - p[x]) if (v[x] & v[x + 1]) != 0 else zero
     gx[w - 1] = zero
@@ -137,19 +133,65 @@ def _windows(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below
             gy[x] = zero
         for x in range(w):
             ny[x + 3] = zero
-    s0 = zero  # the running sums: one dependent add a pixel each, the two side by side
+
+
+@_numba_inline
+def _windows(g: np.ndarray, s: np.ndarray, twice: bool, around: np.ndarray,
+             ahead: np.ndarray, ahead_too: bool, around2: np.ndarray, ahead2: np.ndarray,
+             ahead2_too: bool) -> None:
+    """The mean wrapped gradients (x, y) and sample counts over the columns ``[x-3, x+3)``
+    (``around`` (3, W): for the vertical links) and ``[x, x+3)`` (``ahead`` (3, W), with
+    ``ahead_too``: for the horizontal ones), clipped to the image, of the row whose
+    :func:`_gradients` are ``g[0]``; with ``twice`` also of the row of ``g[1]``
+    (``around2``, ``ahead2``).
+
+    As ``period_jumps`` computes them: a window's sum is the difference of two float32
+    running sums along the row (``s[r, k]``: (W+7,), ``S[clip(i-3, 0, W)]`` at ``i``, the
+    first four 0), counts exact. The running sums are one dependent add a pixel each: two
+    rows' four side by side wait a quarter as long as one gradient's."""
+    w = around.shape[1]
+    zero = np.float32(0.0)
+    gx = g[0, 0]
+    gy = g[0, 1]
+    sx = s[0, 0]
+    sy = s[0, 1]
+    s0 = zero
     s1 = zero
-    for x in range(w):
-        s0 += gx[x]
-        s1 += gy[x]
-        sx[x + 4] = s0
-        sy[x + 4] = s1
+    if twice:
+        hx = g[1, 0]
+        hy = g[1, 1]
+        tx = s[1, 0]
+        ty = s[1, 1]
+        s2 = zero
+        s3 = zero
+        for x in range(w):
+            s0 += gx[x]
+            s1 += gy[x]
+            s2 += hx[x]
+            s3 += hy[x]
+            sx[x + 4] = s0
+            sy[x + 4] = s1
+            tx[x + 4] = s2
+            ty[x + 4] = s3
+        for i in range(w + 4, w + 7):
+            tx[i] = s2
+            ty[i] = s3
+    else:
+        for x in range(w):
+            s0 += gx[x]
+            s1 += gy[x]
+            sx[x + 4] = s0
+            sy[x + 4] = s1
     for i in range(w + 4, w + 7):
         sx[i] = s0
         sy[i] = s1
-    _means(sx, nx, around[0], ahead[0], ahead_too)
-    _means(sy, ny, around[1], ahead[1], ahead_too)
-    _counts(nx, ny, around[2], ahead[2], ahead_too)
+    for r in range(2 if twice else 1):
+        a = around if r == 0 else around2
+        b = ahead if r == 0 else ahead2
+        too = ahead_too if r == 0 else ahead2_too
+        _means(s[r, 0], g[r, 2], a[0], b[0], too)
+        _means(s[r, 1], g[r, 3], a[1], b[1], too)
+        _counts(g[r, 2], g[r, 3], a[2], b[2], too)
 
 
 @_numba_inline
@@ -198,9 +240,13 @@ def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32,
     multiple of 8 bytes, 0 from ``W-1``)."""
     w = p.shape[0]
     zero = np.float32(0.0)
+    # the difference along the phase's direction, times +-1 rather than chosen by ``pos``
+    # (a select on a flag left the loops around scalar): ``p[x] - p[x+1]`` but for the
+    # sign of a zero, which nothing reads
+    along = np.float32(1.0) if pos else np.float32(-1.0)
     for x in range(w - 1):  # a vector loop
         ok = (v[x] & v[x + 1]) != 0
-        r = p[x + 1] - p[x] if pos else p[x] - p[x + 1]
+        r = (p[x + 1] - p[x]) * along
         raw[x] = r
         a = abs(r)
         s = np.uint8(3) if r > zero else np.uint8(2)
@@ -246,14 +292,10 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
     pos = sign > 0
     wl = np.uint8(2) if pos else np.uint8(3)  # the wrap state that drops a link's left end
     wr = np.uint8(5) - wl  # ... and the one that drops its right end
-    gx = np.zeros(w, np.float32)
-    gy = np.zeros(w, np.float32)
-    nx = np.zeros(w + 6, np.float32)
-    ny = np.zeros(w + 6, np.float32)
-    sx = np.zeros(w + 7, np.float32)
-    sy = np.zeros(w + 7, np.float32)
-    around = np.zeros((2, 3, w), np.float32)  # rows y-1 and y, at y % 2
-    ahead = np.zeros((3, w), np.float32)
+    g = np.zeros((2, 4, w + 6), np.float32)  # the gradients of two rows (``_gradients``)
+    sums = np.zeros((2, 2, w + 7), np.float32)  # their running sums
+    around = np.zeros((4, 3, w), np.float32)  # windows of rows y-1, y, y+1, at y % 4
+    ahead = np.zeros((2, 3, w), np.float32)  # ... of rows y, y+1, at y % 2
     raw = np.zeros(w, np.float32)
     st = np.zeros(w + 1, np.uint8)  # horizontal link states (``_row_states``)
     vs = np.zeros(w, np.uint8)  # vertical link states, the same codes (2: the upper end)
@@ -266,17 +308,22 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
     hconn = np.zeros((2, w), np.uint8)
     drop = np.zeros((2, w), np.uint8)
     first = max(y0 - 1, 0)
-    for y in range(first, min(y1 + 1, h)):
+    last = min(y1 + 1, h)
+    for y in range(first, last):
         cur = y & 1
         prv = cur ^ 1
         p = phi[y]
         v = valid[y]
         nz = noise[y]
-        below = y < h - 1
-        pb = phi[y + 1] if below else p
-        vb = valid[y + 1] if below else v
         inside = y0 <= y < y1
-        _windows(p, v, pb, vb, below, inside, gx, gy, nx, ny, sx, sy, around[cur], ahead)
+        if (y - first) & 1 == 0:  # the windows of rows y and y+1
+            for r in range(2 if y + 1 < last else 1):
+                yr = y + r
+                below = yr < h - 1
+                _gradients(phi[yr], valid[yr], phi[yr + 1] if below else p,
+                           valid[yr + 1] if below else v, below, g[r])
+            _windows(g, sums, y + 1 < last, around[y & 3], ahead[y & 1], inside,
+                     around[(y + 1) & 3], ahead[(y + 1) & 1], y0 <= y + 1 < y1)
         if inside:  # the horizontal links of row y
             _row_states(p, v, nz, cut32, pos, st, raw, back)
             if cuts:
@@ -288,9 +335,9 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
             # [i+4, i+7): the cheap first test for every link in a vector loop, the rest
             # where it passes (indices a loop counter from 0 plus a constant: a negative
             # index would wrap, and its test keeps the loop scalar)
-            a0 = ahead[0]
-            a1 = ahead[1]
-            a2 = ahead[2]
+            a0 = ahead[cur, 0]
+            a1 = ahead[cur, 1]
+            a2 = ahead[cur, 2]
             for i in range(w - 1 - HALF):
                 maybe_h[i] = (st[i + HALF + 1] == 1) & _steep(a0[i], a1[i], a0[i + HALF + 1],
                                                               a1[i + HALF + 1], rel)
@@ -327,8 +374,8 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
             for x in range(w):
                 s = vs[x]
                 vs[x] = np.uint8(4) if (s == 1) & (cv[x] != 0) else s
-        b = around[prv]
-        c = around[cur]
+        b = around[(y - 1) & 3]
+        c = around[y & 3]
         b0 = b[0]
         b1 = b[1]
         b2 = b[2]
@@ -454,14 +501,16 @@ def _union(parent: np.ndarray, a: np.int32, b: np.int32) -> None:
 @_numba_called
 def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: int, y1: int,
                 base: int, labels: np.ndarray, parent: np.ndarray, size: np.ndarray,
-                bright: np.ndarray) -> int:
+                bright: np.ndarray, dropped: np.ndarray) -> tuple[int, int]:
     """Label the kept pixels of rows ``y0 .. y1-1`` by runs along the rows (a run takes the
     label of the pixel above its first pixel, or a new id from ``base``; the labels above
     the rest of the run are joined to it), counting each id's pixels (``size``) and
-    ``strong`` pixels (``bright``, with ``count_strong``); returns the ids made. The rows
-    above ``y0`` are not looked at."""
+    ``strong`` pixels (``bright``, with ``count_strong``), and list the valid pixels not
+    kept (``dropped``: ``(y - y0) * W + x``, in raster order). Returns the ids made and the
+    pixels listed. The rows above ``y0`` are not looked at."""
     w = bits.shape[1]
     nxt = base
+    listed = 0
     for y in range(y0, y1):
         b = bits[y]
         lab = labels[y]
@@ -469,9 +518,13 @@ def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: in
             lab[x] = 0
         up = labels[y - 1] if y > y0 else lab  # (the zeros of this row: no label above)
         s = strong[y] if count_strong else b  # (uint8 rows)
+        row = (y - y0) * w
         x = 0
         while x < w:
             if not b[x] & KEPT:
+                if b[x] & VALID:
+                    dropped[listed] = row + x
+                    listed += 1
                 x += 1
                 continue
             start = x
@@ -497,22 +550,68 @@ def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: in
                 x += 1
             size[cur] += x - start
             bright[cur] += lit
-    return nxt - base
+    return nxt - base, listed
+
+
+@_numba_called
+def _reattach(labels: np.ndarray, bits: np.ndarray, ty: np.ndarray, tx: np.ndarray,
+              roots: np.ndarray, size: np.ndarray, bright: np.ndarray, strong: np.ndarray,
+              count_strong: bool, passes: int) -> None:
+    """Give the pixels ``(ty, tx)`` (valid, not kept, label 0) the label of a neighbour
+    they are linked to (below, above, right, left: the first labelled one), ``passes``
+    times; each pass reads the labels the previous one left. A pixel takes its
+    neighbour's label as it is (a provisional id, or 0), so the regions ``roots[labels]``
+    are those of the same reattachment on final labels; the counts per region follow."""
+    n = ty.shape[0]
+    got = np.zeros(n, np.int32)
+    for _ in range(passes):
+        if n == 0:
+            break
+        for i in range(n):
+            y = ty[i]
+            x = tx[i]
+            g = np.int32(0)
+            if bits[y, x] & LINK_DOWN:
+                g = labels[y + 1, x]
+            if g == 0 and y > 0 and bits[y - 1, x] & LINK_DOWN:
+                g = labels[y - 1, x]
+            if g == 0 and bits[y, x] & LINK_RIGHT:
+                g = labels[y, x + 1]
+            if g == 0 and x > 0 and bits[y, x - 1] & LINK_RIGHT:
+                g = labels[y, x - 1]
+            got[i] = g
+        m = 0
+        for i in range(n):
+            g = got[i]
+            labels[ty[i], tx[i]] = g
+            if g == 0:
+                ty[m] = ty[i]
+                tx[m] = tx[i]
+                m += 1
+            else:
+                r = roots[g]
+                size[r] += 1
+                if count_strong:
+                    bright[r] += strong[ty[i], tx[i]] != 0
+        n = m
 
 
 @kernel(parallel=True)
-def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: int
-               ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
-    """4-connected regions of the ``KEPT`` pixels of :func:`link_bits`: provisional labels,
-    each one's region ``1..n`` numbered in raster order of the region's first pixel (the
-    numbering of ``cv2.connectedComponents(kept, connectivity=4)``), and per region its
-    pixels and, with ``count_strong``, its ``strong`` pixels, all in one scan.
+def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: int,
+               passes: int) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
+    """The fringe regions of :func:`link_bits`' bytes, before their final numbering:
+    4-connected regions of the ``KEPT`` pixels, numbered ``1..n`` in raster order of each
+    region's first pixel (the numbering of ``cv2.connectedComponents(kept,
+    connectivity=4)``), then the valid pixels that were not kept given the label of a
+    neighbour they still link to (below, above, right, left: the first labelled one,
+    ``passes`` rounds, each reading the labels the last one left); per region its pixels
+    and, with ``count_strong``, its ``strong`` pixels, gathered in the same scan.
 
-    Tiles of ``tile`` rows are labelled on every core (union-find, the ids of tile ``t``
-    from ``t * cap + 1``, ``cap`` the most runs a tile can hold), joined across their
-    boundary rows, then the roots (each tree's smallest id: the id of its region's first
-    pixel) numbered in id order. The final labels are ``roots[labels]``
-    (:func:`relabel`).
+    Tiles of ``tile`` rows are labelled on every core (union-find by runs along the rows,
+    the ids of tile ``t`` from ``t * cap + 1``, ``cap`` the most runs a tile can hold),
+    joined across their boundary rows, then the roots (each tree's smallest id: the id of
+    its region's first pixel) numbered in id order. The final labels are
+    ``roots[labels]`` (:func:`relabel`).
 
     Parameters
     ----------
@@ -525,39 +624,48 @@ def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: i
         Count ``strong``.
     tile : int
         Rows a task labels (the result does not depend on it).
+    passes : int
+        Rounds of reattachment (0: none).
 
     Returns
     -------
     labels : (H, W) int32 array
-        Provisional ids, 0 outside the kept pixels.
+        Provisional ids, 0 outside the regions.
     roots : (ids,) int32 array
         The region of each id (defined at the ids in use and at 0, which is 0).
     n : int
         Number of regions.
     size : (n+1,) int64 array
-        Kept pixels per region (``size[0]`` 0).
+        Pixels per region (``size[0]`` 0).
     bright : (n+1,) int64 array
-        Kept ``strong`` pixels per region (zeros without ``count_strong``).
+        ``strong`` pixels per region (zeros without ``count_strong``).
 
     Examples
     --------
-    >>> bits = np.uint8([[4, 4, 0, 4], [0, 4, 0, 4], [4, 0, 4, 4]])
-    >>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, 1)
+    >>> bits = np.uint8([[4, 4, 0, 4], [8, 4, 0, 4], [4, 0, 4, 4]])
+    >>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, 1, 0)
     >>> n, roots[labels].tolist(), size.tolist()
     (3, [[1, 1, 0, 2], [0, 1, 0, 2], [3, 0, 2, 2]], [0, 3, 4, 1])
+    >>> bits[1, 0] |= LINK_RIGHT  # the valid pixel not kept links to its right
+    >>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, 1, 3)
+    >>> roots[labels].tolist()[1], size.tolist()
+    ([1, 1, 0, 2], [0, 4, 4, 1])
     """
     h, w = bits.shape
     tiles = (h + tile - 1) // tile
     cap = tile * ((w + 1) // 2)  # runs of kept pixels a tile can hold: ids it may make
     labels = np.empty((h, w), np.int32)
-    parent = np.empty(tiles * cap + 1, np.int32)  # touched only where ids are made
+    parent = np.empty(tiles * cap + 1, np.int32)  # these three touched only where used
     size = np.empty(tiles * cap + 1, np.int32)
     bright = np.empty(tiles * cap + 1, np.int32)
+    dropped = np.empty(tiles * tile * w, np.int32)
     made = np.zeros(tiles, np.int64)
+    listed = np.zeros(tiles, np.int64)
     strong8 = strong.view(np.uint8)
     for t in prange(tiles):
-        made[t] = _label_rows(bits, strong8, count_strong, t * tile, min(t * tile + tile, h),
-                              t * cap + 1, labels, parent, size, bright)
+        made[t], listed[t] = _label_rows(bits, strong8, count_strong, t * tile,
+                                         min(t * tile + tile, h), t * cap + 1, labels,
+                                         parent, size, bright, dropped[t * tile * w:])
     for t in range(1, tiles):  # join the tiles across their boundary rows
         below = labels[t * tile]
         above = labels[t * tile - 1]
@@ -588,110 +696,34 @@ def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: i
             r = parent[i]
             region_size[r] += size[i]
             region_bright[r] += bright[i]
-    return labels, parent, n, region_size, region_bright
-
-
-@kernel(parallel=True)
-def reattach(labels: np.ndarray, bits: np.ndarray, roots: np.ndarray, size: np.ndarray,
-             bright: np.ndarray, strong: np.ndarray, count_strong: bool, passes: int) -> None:
-    """Give valid pixels that were not kept the label of a neighbour they are linked to
-    (below, above, right, left: the first labelled one), ``passes`` times, in place; each
-    pass reads the labels the previous one left. The region counts of :func:`label_kept`
-    (``size``, and ``bright`` with ``count_strong``) follow.
-
-    A pixel takes its neighbour's label as it is (a provisional id of
-    :func:`label_kept`, or 0): the final labels ``roots[labels]`` are those of a
-    reattachment on final labels.
-
-    Parameters
-    ----------
-    labels : (H, W) int32 array
-        Labels (0: none), changed in place.
-    bits : (H, W) uint8 array
-        :func:`link_bits`: the pixels reattached are ``VALID`` and not ``KEPT``.
-    roots : int32 array
-        The region of each label (:func:`label_kept`).
-    size, bright : (n+1,) int64 arrays
-        Pixels and ``strong`` pixels per region, added to.
-    strong : (H, W) bool array
-        The second mask (read only with ``count_strong``).
-    count_strong : bool
-        Count ``strong`` pixels.
-    passes : int
-        Rounds of reattachment.
-
-    Examples
-    --------
-    >>> labels = np.int32([[1, 0, 2], [1, 1, 2]])
-    >>> bits = np.uint8([[12, 8 | 2 | 1, 12], [12 | 1, 12 | 1, 12]])
-    >>> size = np.int64([0, 3, 2])
-    >>> reattach(labels, bits, np.int32([0, 1, 2]), size, np.zeros(3, np.int64), NO_CUTS,
-    ...          False, 1)
-    >>> labels.tolist(), size.tolist()  # linked right and below: the one below wins
-    ([[1, 1, 2], [1, 1, 2]], [0, 4, 2])
-    """
-    h, w = labels.shape
-    rows = np.zeros(h + 1, np.int64)
-    for y in prange(h):
-        b = bits[y]
+    if passes > 0:
+        ty = np.empty(listed.sum(), np.int64)
+        tx = np.empty(listed.sum(), np.int64)
         k = 0
-        for x in range(w):
-            k += (b[x] & (KEPT | VALID)) == VALID
-        rows[y + 1] = k
-    for y in range(h):
-        rows[y + 1] += rows[y]
-    n = rows[h]
-    ty = np.empty(n, np.int64)
-    tx = np.empty(n, np.int64)
-    for y in prange(h):
-        b = bits[y]
-        i = rows[y]
-        for x in range(w):
-            if (b[x] & (KEPT | VALID)) == VALID:
-                ty[i] = y
-                tx[i] = x
-                i += 1
-    got = np.zeros(n, np.int32)
-    for _ in range(passes):
-        if n == 0:
-            break
-        for i in range(n):
-            y = ty[i]
-            x = tx[i]
-            g = np.int32(0)
-            if bits[y, x] & LINK_DOWN:
-                g = labels[y + 1, x]
-            if g == 0 and y > 0 and bits[y - 1, x] & LINK_DOWN:
-                g = labels[y - 1, x]
-            if g == 0 and bits[y, x] & LINK_RIGHT:
-                g = labels[y, x + 1]
-            if g == 0 and x > 0 and bits[y, x - 1] & LINK_RIGHT:
-                g = labels[y, x - 1]
-            got[i] = g
-        m = 0
-        for i in range(n):
-            g = got[i]
-            labels[ty[i], tx[i]] = g
-            if g == 0:
-                ty[m] = ty[i]
-                tx[m] = tx[i]
-                m += 1
-            else:
-                r = roots[g]
-                size[r] += 1
-                if count_strong:
-                    bright[r] += strong[ty[i], tx[i]]
-        n = m
+        for t in range(tiles):
+            for i in range(t * tile * w, t * tile * w + listed[t]):
+                ty[k] = t * tile + dropped[i] // w
+                tx[k] = dropped[i] % w
+                k += 1
+        _reattach(labels, bits, ty, tx, parent, region_size, region_bright, strong8,
+                  count_strong, passes)
+    return labels, parent, n, region_size, region_bright
 
 
 @_numba_called
 def _relabel_rows(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, y0: int,
                   y1: int) -> None:
-    """:func:`relabel` of rows ``y0 .. y1-1``."""
+    """:func:`relabel` of rows ``y0 .. y1-1`` (a run of one label looked up once)."""
     for y in range(y0, y1):
         row = labels[y]
+        last = np.int32(0)
+        final = np.int32(0)
         for x in range(row.shape[0]):
-            row[x] = remap[roots[row[x]]]
+            lab = row[x]
+            if lab != last:
+                last = lab
+                final = remap[roots[lab]]
+            row[x] = final
 
 
 @kernel(parallel=True)
