@@ -36,6 +36,7 @@ import decode_speed  # noqa: E402
 import bistair  # noqa: E402
 from bistair.core import measure, regions  # noqa: E402
 from bistair.core.jit import set_threads  # noqa: E402
+from bistair.core.measure_jit import keep_coherent  # noqa: E402
 from bistair.core.memory import keep_freed_memory  # noqa: E402
 
 
@@ -98,6 +99,7 @@ def cases(frames: np.ndarray, spec) -> dict:
     lab, roots, n, size, lit = new.label_kept(bits, new.NO_CUTS, False, new.TILE, 3)
     remap = np.arange(n + 1, dtype=np.int32)
     c_lab, c_n = old.regions_before(phi, weak, None, 1, sigma)
+    coh = regions.label_fringes(phi, weak, phase_noise=sigma, strong=strong)
     h, w = fphi.shape
     print(f"{h}x{w}: valid {fvalid.mean():.2f}, kept {keep.mean():.2f}, "
           f"{n_cc - 1} components, {n_old} regions; coherent labelling: weak "
@@ -114,8 +116,11 @@ def cases(frames: np.ndarray, spec) -> dict:
         "new label_kept (+ reattach)": lambda: new.label_kept(bits, new.NO_CUTS, False,
                                                               new.TILE, 3),
         "old drop_small": lambda: old.drop_small(labels_old.copy(), n_old, 20),
-        "new relabel": lambda: new.relabel(lab.copy(), roots, remap),
+        "copy of the labels": lambda: lab.copy(),
+        "new relabel (+ the copy)": lambda: new.relabel(lab.copy(), roots, remap),
         "old keep_coherent": lambda: old.keep_coherent(c_lab, weak, strong, c_n, 10, 100, 20),
+        "new keep_coherent": lambda: keep_coherent(coh.labels, coh.roots, coh.size,
+                                                   coh.strong, strong, 10, 100, 20),
         "old fringe_regions": lambda: old.regions_before(fphi, fvalid, None, 20, noise, edges,
                                                          sign),
         "new fringe_regions": lambda: regions.fringe_regions(fphi, fvalid, None, 20, noise,

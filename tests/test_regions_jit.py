@@ -221,3 +221,55 @@ def test_labels_of_a_checkerboard(shape):
                                          ltype=cv2.CV_32S)
     assert n == n_cv - 1 == keep.sum() and np.array_equal(roots[labels], want)
     assert (size[1:] == 1).all()
+
+
+def test_the_cheap_noise_test_passes_where_the_exact_one_does():
+    """link_bits runs the period-jump test only where cheap forms of its first two tests
+    pass: the second's (no square root, no division, a looser margin) must pass wherever
+    the test's own does, at any scale (noise from 0 to overflow, near the threshold)."""
+    import math
+
+    import numba
+
+    from bistair.core import regions_jit
+
+    link_bits(np.zeros((2, 2), np.float32), np.ones((2, 2), bool),
+              np.zeros((2, 2), np.float32), 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False)
+    loud = regions_jit._loud  # compiled with the module's first kernel
+
+    @numba.njit
+    def check(px, py, qx, qy, pn, qn, noise_p, noise_q) -> int:
+        misses = 0
+        for i in range(px.size):
+            one = np.float32(1.0)
+            dx, dy = px[i] - qx[i], py[i] - qy[i]
+            d2 = dx * dx + dy * dy
+            # _jump's second test, as it is written there
+            spread = np.float32(2.0) * max(noise_p[i] / np.float32(math.sqrt(max(pn[i], one))),
+                                           noise_q[i] / np.float32(math.sqrt(max(qn[i], one))))
+            limit = np.float32(4.0) * spread
+            passes = not (d2 < limit * limit * np.float32(0.9999))
+            inv_p = np.float32(1.0) / np.float32(math.sqrt(pn[i]))
+            inv_q = np.float32(1.0) / np.float32(math.sqrt(qn[i]))
+            if passes and not loud(px[i], py[i], qx[i], qy[i], noise_p[i], noise_q[i], inv_p,
+                                   inv_q):
+                misses += 1
+        return misses
+
+    rng = np.random.default_rng(4)
+    n = 200_000
+    px, py, qx, qy = (rng.normal(0, 0.3, n).astype(np.float32) for _ in range(4))
+    pn, qn = (rng.integers(3, 7, n).astype(np.float32) for _ in range(2))
+    dx, dy = px - qx, py - qy
+    d = np.sqrt(dx.astype(np.float64) ** 2 + dy.astype(np.float64) ** 2)
+    # noise putting the threshold at the step itself, a few units in the last place apart
+    near = d / (8.0 * np.maximum(1 / np.sqrt(pn), 1 / np.sqrt(qn)))
+    noise_p = (near * rng.choice([1.0, 1 - 1e-7, 1 + 1e-7, 1 - 3e-5, 1 + 3e-5], n)
+               ).astype(np.float32)
+    noise_q = (noise_p * rng.uniform(0, 1, n)).astype(np.float32)
+    scales = rng.choice([1.0, 1e-18, 1e-22, 1e-40, 1e18, 1e20], n)
+    px, py, qx, qy = (a * scales.astype(np.float32) for a in (px, py, qx, qy))
+    noise_p, noise_q = (a * scales.astype(np.float32) for a in (noise_p, noise_q))
+    noise_p[::97] = np.nan
+    noise_q[::89] = 0.0
+    assert check(px, py, qx, qy, pn, qn, noise_p, noise_q) == 0

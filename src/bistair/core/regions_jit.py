@@ -91,6 +91,29 @@ def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
 
 
 @_numba_inline
+def _loud(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
+          noise_p: np.float32, noise_q: np.float32, inv_p: np.float32,
+          inv_q: np.float32) -> bool:
+    """Not clearly below the noise: a looser form of :func:`_jump`'s second test (its
+    ``4 * spread`` from ``1/sqrt(count)`` given as ``inv_p``, ``inv_q``, and compared with
+    0.999 for 0.9999), true wherever that test passes, and for limits too small to compare
+    (True for NaN); without a square root or a division, for a vector loop."""
+    dx, dy = px - qx, py - qy
+    d2 = dx * dx + dy * dy
+    limit = np.float32(8.0) * max(noise_p * inv_p, noise_q * inv_q)
+    square = limit * limit
+    return not (d2 < square * np.float32(0.999)) or square < np.float32(1e-30)
+
+
+@_numba_inline
+def _inverse_root(count: np.float32, inv3: np.float32, inv4: np.float32, inv5: np.float32,
+                  inv6: np.float32) -> np.float32:
+    """``1/sqrt(count)`` for a window count of 3 to 6, chosen by selects (for a vector
+    loop; what the other counts give is not read)."""
+    return inv3 if count == 3 else (inv4 if count == 4 else (inv5 if count == 5 else inv6))
+
+
+@_numba_inline
 def _wrap_sel(raw: np.float32) -> np.float32:
     """:func:`bistair.core.jit._wrapped` as two selects (the same value for every input,
     NaN and infinities included: after the first step ``d`` is never below 0)."""
@@ -290,6 +313,10 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
     rel = np.float32(relative)
     fhalf = np.float32(HALF)
     pos = sign > 0
+    inv3 = np.float32(1.0) / np.float32(math.sqrt(3.0))  # 1/sqrt(a window's count): 3 to
+    inv4 = np.float32(0.5)  # 6 where it may cut (scalars, not an array: one pointer
+    inv5 = np.float32(1.0) / np.float32(math.sqrt(5.0))  # fewer for LLVM's overlap checks)
+    inv6 = np.float32(1.0) / np.float32(math.sqrt(6.0))
     wl = np.uint8(2) if pos else np.uint8(3)  # the wrap state that drops a link's left end
     wr = np.uint8(5) - wl  # ... and the one that drops its right end
     g = np.zeros((2, 4, w + 6), np.float32)  # the gradients of two rows (``_gradients``)
@@ -332,15 +359,25 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
                     s = st[x + 1]
                     st[x + 1] = np.uint8(4) if (s == 1) & (ch[x] != 0) else s
             # the period jumps of links x = i+3, left window [i, i+3) against right window
-            # [i+4, i+7): the cheap first test for every link in a vector loop, the rest
-            # where it passes (indices a loop counter from 0 plus a constant: a negative
-            # index would wrap, and its test keeps the loop scalar)
+            # [i+4, i+7): the counts and cheap forms of the first two tests for every link
+            # in a vector loop, the test itself where they pass (indices a loop counter
+            # from 0 plus a constant: a negative index would wrap, and its test keeps the
+            # loop scalar)
             a0 = ahead[cur, 0]
             a1 = ahead[cur, 1]
             a2 = ahead[cur, 2]
+            many = 0
             for i in range(w - 1 - HALF):
-                maybe_h[i] = (st[i + HALF + 1] == 1) & _steep(a0[i], a1[i], a0[i + HALF + 1],
-                                                              a1[i + HALF + 1], rel)
+                j = i + HALF + 1
+                m = ((st[j] == 1) & (a2[i] >= fhalf) & (a2[j] >= fhalf)
+                     & _steep(a0[i], a1[i], a0[j], a1[j], rel))
+                maybe_h[i] = m
+                many += m
+            if many * 32 > w:  # (the second where many pass the first: fine fringes)
+                for i in range(w - 1 - HALF):  # (a window of 3 counts 3 where it may cut)
+                    j = i + HALF + 1
+                    maybe_h[i] &= _loud(a0[i], a1[i], a0[j], a1[j], nz[i + HALF], nz[j],
+                                        inv3, inv3)
             for k in range(words_h.shape[0]):
                 if words_h[k] == 0:  # (most words)
                     continue
@@ -382,8 +419,17 @@ def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float
         c0 = c[0]
         c1 = c[1]
         c2 = c[2]
-        for x in range(w):
-            maybe_v[x] = (vs[x] == 1) & _steep(b0[x], b1[x], c0[x], c1[x], rel)
+        many = 0
+        for x in range(w):  # (two loops: fewer arrays a loop, see _gradients)
+            m = ((vs[x] == 1) & (b2[x] >= fhalf) & (c2[x] >= fhalf)
+                 & _steep(b0[x], b1[x], c0[x], c1[x], rel))
+            maybe_v[x] = m
+            many += m
+        if many * 32 > w:
+            for x in range(w):
+                maybe_v[x] &= _loud(b0[x], b1[x], c0[x], c1[x], na[x], nz[x],
+                                    _inverse_root(b2[x], inv3, inv4, inv5, inv6),
+                                    _inverse_root(c2[x], inv3, inv4, inv5, inv6))
         for k in range(words_v.shape[0]):
             if words_v[k] == 0:
                 continue
