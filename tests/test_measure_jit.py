@@ -125,6 +125,10 @@ def test_keep_coherent_is_numpys(shape):
     size = np.bincount(region.ravel(), minlength=n + 1)
     size[0] = 0
     bright = np.bincount(region[strong], minlength=n + 1)
-    for thresholds in [(10, 100, 20), (1, 10**9, 1), (3, 20, 2), (10**9, 10**9, 0)]:
+    k = int(np.argsort(size[1:])[n // 2]) + 1  # thresholds on a region's own counts too
+    for thresholds in [(10, 100, 20), (1, 10**9, 1), (3, 20, 2), (10**9, 10**9, 0),
+                       (bright[k], size[k], size[k]), (bright[k] + 1, size[k] + 1, 1),
+                       (bright[k], 10**9, 1)]:
+        thresholds = tuple(int(t) for t in thresholds)
         got = keep_coherent(labels, roots, size, bright, strong, *thresholds)
         assert np.array_equal(got, _keep_coherent_numpy(region, strong, *thresholds))

@@ -552,7 +552,8 @@ class Watch:
     that did not give the same (a decode goes on with the new result)."""
 
     def __init__(self) -> None:
-        self.seen = {"link_bits": 0, "fringe_regions": 0, "coherent_pixels": 0}
+        self.seen = {"link_bits": 0, "fringe_regions": 0, "coherent_pixels": 0,
+                     "codec cuts": 0}
         self.differ: list[str] = []
         self._undo: list[tuple] = []
 
@@ -566,6 +567,7 @@ class Watch:
             vert, horiz, keep = links_before(phi, valid, cut, sign, noise,
                                              (cut_v, cut_h) if cuts else None)
             self.seen["link_bits"] += 1
+            self.seen["codec cuts"] += int(cuts and (cut_v.any() or cut_h.any()))
             if not same_links(bits, vert, horiz, keep, valid):
                 self.differ.append(f"link_bits {phi.shape}")
             return bits
