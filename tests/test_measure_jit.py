@@ -99,36 +99,36 @@ def test_fit_residual_energy_is_numpys(steps, convention, shape):
         assert got == pytest.approx(want, rel=1e-5)
 
 
-def _keep_coherent_numpy(labels, weak, strong, n, min_strong, min_size, min_region):
-    size = np.bincount(labels.ravel(), minlength=n + 1)
-    bright = np.bincount(labels.ravel(), weights=strong.ravel(), minlength=n + 1)
+def _keep_coherent_numpy(region, strong, min_strong, min_size, min_region):
+    size = np.bincount(region.ravel())
+    bright = np.bincount(region.ravel(), weights=strong.ravel(), minlength=size.size)
     keep = ((bright >= min_strong) | (size >= min_size)) & (size >= min_region)
     keep[0] = False
-    return strong | (weak & keep[labels])
+    return strong | keep[region]
 
 
 @pytest.mark.parametrize("shape", [(1, 1), (7, 33), (300, 41), (1100, 90)])
 def test_keep_coherent_is_numpys(shape):
-    """Counted in blocks of rows and runs along them: the same pixels as counting each."""
+    """Regions given as provisional labels and their roots, counted by the labelling: the
+    pixels of the NumPy formula on the regions."""
     weak = RNG.random(shape) < 0.7
     strong = weak & (RNG.random(shape) < 0.3)
-    n = 40
+    n, ids = 40, 300
+    roots = np.concatenate([[0], RNG.integers(1, n + 1, ids)]).astype(np.int32)
+    roots[1:n + 1] = np.arange(1, n + 1)  # every region has an id
     # runs of one label along the rows, as fringe regions have, and single pixels
-    labels = np.repeat(RNG.integers(1, n + 1, (shape[0], shape[1] // 5 + 1)), 5, axis=1)
+    labels = np.repeat(RNG.integers(1, ids + 1, (shape[0], shape[1] // 5 + 1)), 5, axis=1)
     labels = labels[:, :shape[1]].astype(np.int32)
-    labels[RNG.random(shape) < 0.1] = RNG.integers(1, n + 1)
+    labels[RNG.random(shape) < 0.1] = RNG.integers(1, ids + 1)
     labels[~weak] = 0  # regions of the weak mask
-    for thresholds in [(10, 100, 20), (1, 10**9, 1), (3, 20, 2), (10**9, 10**9, 0)]:
-        got = keep_coherent(labels, weak, strong, n, *thresholds)
-        assert np.array_equal(got, _keep_coherent_numpy(labels, weak, strong, n, *thresholds))
-
-
-def test_keep_coherent_with_many_regions():
-    """More regions than the row blocks' counts have room for: one block."""
-    shape = (600, 3000)
-    labels = np.arange(shape[0] * shape[1], dtype=np.int32).reshape(shape) // 2 + 1
-    n = int(labels.max())
-    weak = np.ones(shape, bool)
-    strong = RNG.random(shape) < 0.5
-    got = keep_coherent(labels, weak, strong, n, 2, 100, 1)
-    assert np.array_equal(got, _keep_coherent_numpy(labels, weak, strong, n, 2, 100, 1))
+    region = roots[labels]
+    size = np.bincount(region.ravel(), minlength=n + 1)
+    size[0] = 0
+    bright = np.bincount(region[strong], minlength=n + 1)
+    k = int(np.argsort(size[1:])[n // 2]) + 1  # thresholds on a region's own counts too
+    for thresholds in [(10, 100, 20), (1, 10**9, 1), (3, 20, 2), (10**9, 10**9, 0),
+                       (bright[k], size[k], size[k]), (bright[k] + 1, size[k] + 1, 1),
+                       (bright[k], 10**9, 1)]:
+        thresholds = tuple(int(t) for t in thresholds)
+        got = keep_coherent(labels, roots, size, bright, strong, *thresholds)
+        assert np.array_equal(got, _keep_coherent_numpy(region, strong, *thresholds))

@@ -1,15 +1,34 @@
-"""The fringe regions' compiled passes (bistair.core.regions_jit) give exactly what the NumPy
-formulation gives: the period-jump links of bistair.core.regions.period_jumps, and the
-fringe direction."""
+"""The fringe regions' compiled passes (bistair.core.regions_jit) give exactly what the passes
+they replaced gave (tests/support/regions_before.py, bistair 02b6580: period_jump_links +
+fringe_links for the links, cv2.connectedComponents + reattach + drop_small for the regions,
+keep_coherent for the coherent dim pixels), and their period jumps what the NumPy reference
+bistair.core.regions.period_jumps gives: on random fields and masks (hypothesis), on renders
+decoded by several codecs at several noise levels, and on every real capture in
+../shared/data that a decode labels."""
 
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
+from conftest import warped_scene
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from support import regions_before as before
+from support.real_parts import parts
 
+import bistair
 from bistair.core.jit import set_threads
-from bistair.core.regions import period_jumps
-from bistair.core.regions_jit import period_jump_links
+from bistair.core.measure import coherent_pixels
+from bistair.core.regions import fringe_regions, period_jumps
+from bistair.core.regions_jit import NO_CUTS, TILE, label_kept, link_bits
+from bistair.io.read import read_with_spec
+from bistair.sim import Imaging, expose, preset, trace
+from bistair.sim.presets import preset_spec
+from bistair.sim.warp import render_warp
+
+PROPERTY = settings(max_examples=60, deadline=None, derandomize=True, database=None,
+                    suppress_health_check=[HealthCheck.too_slow])
 
 
 def test_median_sign():
@@ -25,25 +44,241 @@ def test_median_sign():
         assert (want >= 0) == (got >= 0)
 
 
-
-@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (9, 1), (2, 5), (37, 41), (70, 1200)])
-@pytest.mark.parametrize("half", [1, 3, 5])
-@pytest.mark.parametrize("threads", [1, None])
-def test_period_jump_links_are_numpys(shape, half, threads):
-    # fringes whose period and slant change from place to place, noise, invalid pixels
-    h, w = shape
-    rng = np.random.default_rng(h * w + half)
+def field(h: int, w: int, seed: int, noise: float = 0.05, holes: float = 0.15,
+          nan: bool = False, ties: bool = False) -> tuple[np.ndarray, ...]:
+    """Fringes whose period and slant change from block to block, phase noise, invalid
+    pixels (NaN phases there with ``nan``), per-pixel phase noise; with ``ties`` phases
+    on a grid of pi/8, where differences land on pi and on the cut."""
+    rng = np.random.default_rng(seed)
     y, x = np.mgrid[0:h, 0:w].astype(np.float64)
     period = np.where((x // 37 + y // 23) % 2 == 0, 20.0, 33.0)
-    phi = ((2 * np.pi * (x + 0.3 * y) / period + rng.normal(0, 0.05, shape)) % (2 * np.pi)
-           ).astype(np.float32)
-    valid = rng.random(shape) > 0.15
-    noise = rng.uniform(0.001, 0.05, shape).astype(np.float32)
-    expected = period_jumps(phi, valid, noise, 0.3, half)
+    slant = np.where((x // 29) % 3 == 0, 0.3, -0.2)
+    phi = 2 * np.pi * (x + slant * y) / period + rng.normal(0, noise, (h, w))
+    if ties:
+        phi = np.round(phi / (np.pi / 8)) * (np.pi / 8)
+    phi = (phi % (2 * np.pi)).astype(np.float32)
+    valid = rng.random((h, w)) > holes
+    if nan:
+        phi[~valid & (rng.random((h, w)) < 0.5)] = np.nan
+    sigma = rng.uniform(0.001, 0.05, (h, w)).astype(np.float32)
+    return phi, valid, sigma
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (9, 1), (2, 5), (37, 41), (70, 1200)])
+@pytest.mark.parametrize("threads", [1, None])
+def test_period_jumps_are_numpys(shape, threads):
+    """The links of link_bits are those of the old link pass cut where the NumPy
+    reference finds period jumps (windows of 3 gradients, as a decode runs it)."""
+    phi, valid, sigma = field(*shape, seed=shape[0] * shape[1])
+    jumps = period_jumps(phi, valid, sigma, 0.3, 3)
+    want = before.fringe_links(phi, valid, 1.5, 1, sigma, *jumps)
     try:
         set_threads(threads)
-        got = period_jump_links(phi, valid, noise, half, 0.3)
+        bits = link_bits(phi, valid, sigma, 1.5, 1, 0.3, NO_CUTS, NO_CUTS, False)
     finally:
         set_threads(None)
-    assert np.array_equal(got[0], expected[0]) and np.array_equal(got[1], expected[1])
-    assert got[1].any() or w < 2 * half + 2 or h * w < 1000
+    assert before.same_links(bits, *want, valid)
+    # the reference cut links here that nothing else cuts
+    unjumped = before.fringe_links(phi, valid, 1.5, 1, sigma, *(np.zeros_like(j) for j in jumps))
+    assert not np.array_equal(unjumped[1], want[1]) or shape[0] * shape[1] < 1000
+
+
+@PROPERTY
+@given(h=st.integers(1, 100), w=st.integers(1, 90), seed=st.integers(0, 2**32 - 1),
+       noise=st.sampled_from([0.0, 0.05, 0.3, 3.0]), holes=st.sampled_from([0.0, 0.1, 0.6]),
+       sign=st.sampled_from([1, -1]), cut=st.sampled_from([0.6, np.pi / 4, 2.2]),
+       nan=st.booleans(), ties=st.booleans(), cuts=st.booleans())
+def test_links_are_the_old_passes(h, w, seed, noise, holes, sign, cut, nan, ties, cuts):
+    """Every link and kept pixel, for any field: wraps, steps, backward runs, period jumps
+    and a codec's cuts, across tile edges (up to four tiles of rows)."""
+    phi, valid, sigma = field(h, w, seed, noise, holes, nan, ties)
+    rng = np.random.default_rng(seed + 1)
+    edges = (rng.random((h - 1, w)) < 0.05, rng.random((h, w - 1)) < 0.05) if cuts else None
+    want = before.links_before(phi, valid, cut, sign, sigma, edges)
+    got = link_bits(phi, valid, sigma, float(np.float32(cut)), sign, 0.3,
+                    *(edges if cuts else (NO_CUTS, NO_CUTS)), cuts)
+    assert before.same_links(got, *want, valid)
+
+
+def masks(draw_rng: np.random.Generator, h: int, w: int, kind: str) -> np.ndarray:
+    """Masks of random pixels, of stripes with gaps (fringe regions), or of thin spirals
+    and combs whose parts meet far from where they start (joins across tiles)."""
+    if kind == "random":
+        return draw_rng.random((h, w)) < draw_rng.uniform(0.2, 0.8)
+    y, x = np.mgrid[0:h, 0:w]
+    if kind == "stripes":
+        mask = (x + (y // 7)) % int(draw_rng.integers(3, 12)) > 0
+        return mask & (draw_rng.random((h, w)) > 0.03)
+    comb = (x % 4 == 0) | (y == h - 1) | ((y % 13 == 0) & (x % 8 < 6))
+    return comb & (draw_rng.random((h, w)) > 0.01)
+
+
+@PROPERTY
+@given(h=st.integers(1, 120), w=st.integers(1, 90), seed=st.integers(0, 2**32 - 1),
+       kind=st.sampled_from(["random", "stripes", "comb"]),
+       tile=st.sampled_from([1, 2, 3, 7, TILE, 200]), count=st.booleans())
+def test_labels_are_opencvs(h, w, seed, kind, tile, count):
+    """The labels of label_kept are cv2.connectedComponents' (4-connected, their numbering
+    too) for any mask and tile height; its counts are each region's pixels and strong
+    pixels."""
+    rng = np.random.default_rng(seed)
+    keep = masks(rng, h, w, kind)
+    strong = rng.random((h, w)) < 0.3
+    bits = (keep * np.uint8(4) | rng.integers(0, 2, (h, w), np.uint8) * np.uint8(8)
+            ).astype(np.uint8)
+    labels, roots, n, size, bright = label_kept(bits, strong if count else NO_CUTS, count,
+                                                tile, 0)
+    n_cv, want = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
+                                         ltype=cv2.CV_32S)
+    assert n == n_cv - 1
+    assert np.array_equal(roots[labels], want)
+    assert np.array_equal(size, np.bincount(want[keep], minlength=n + 1))
+    expected = np.bincount(want[keep & strong], minlength=n + 1) if count else np.zeros(n + 1)
+    assert np.array_equal(bright, expected)
+
+
+@PROPERTY
+@given(h=st.integers(1, 90), w=st.integers(1, 90), seed=st.integers(0, 2**32 - 1),
+       noise=st.sampled_from([0.05, 0.5, 3.0]), holes=st.sampled_from([0.0, 0.1, 0.5]),
+       min_size=st.sampled_from([1, 2, 20, 60]), cuts=st.booleans())
+def test_regions_are_the_old_passes(h, w, seed, noise, holes, min_size, cuts):
+    """fringe_regions' labels and count, and coherent_pixels' pixels, for any field."""
+    phi, valid, sigma = field(h, w, seed, noise, holes)
+    rng = np.random.default_rng(seed + 2)
+    edges = (rng.random((h - 1, w)) < 0.05, rng.random((h, w - 1)) < 0.05) if cuts else None
+    labels, n = fringe_regions(phi, valid, None, min_size, sigma, edges)
+    want, n_want = before.regions_before(phi, valid, None, min_size, sigma, edges)
+    assert n == n_want and labels.dtype == np.int32 and np.array_equal(labels, want)
+    strong = valid & (rng.random((h, w)) < rng.uniform(0, 0.3))
+    for thresholds in [(10, 100), (1, 5), (3, 10**9)]:
+        assert np.array_equal(coherent_pixels(phi, valid, strong, sigma, *thresholds),
+                              before.coherent_before(phi, valid, strong, sigma, *thresholds))
+
+
+HARD = dict(gamma=2.2, read_noise=0.03, camera_blur=1.2, projector_blur=1.0, ambient=0.15)
+
+
+def render(scene: str, method: str, noise: float | None, **params):
+    """Captures of a small scene: a warp (``warp<seed>``) or a preset of the simulator
+    (320 x 256 with hard optics, or with ``noise`` None 640 x 512 as
+    tests/support/pre_speed.py renders it: mugs-on-wall's stair edges, the codec's cuts,
+    show at that size)."""
+    if scene.startswith("warp"):
+        spec = bistair.make_spec(method, width=1080, height=1080, period=30, **params)
+        scene = warped_scene(int(scene[4:]), noise, 1.2, size=(240, 320))
+        return render_warp(spec, scene)[0], spec
+    spec = (preset_spec(scene, method, **params) if method == "bidirectional" else
+            bistair.make_spec(method, width=1920, height=1080, period=30, **params))
+    if noise is None:
+        rig, sc = preset(scene, camera_size=(640, 512))
+        imaging = Imaging(seed=3)
+        return expose(trace(rig, sc, imaging), bistair.encode(spec), imaging), spec
+    rig, sc = preset(scene, camera_size=(320, 256))
+    imaging = Imaging(**{**HARD, "read_noise": noise}, seed=5)
+    return expose(trace(rig, sc, imaging), bistair.encode(spec), imaging), spec
+
+
+RENDERS = [  # scene, method, noise, options
+    ("warp0", "bidirectional", 0.01, {}), ("warp1", "bidirectional", 0.08, {}),
+    ("warp2", "bidirectional", 0.03, {"strategy": "paper"}), ("warp3", "lv", 0.05, {}),
+    ("warp4", "phase-coding", 0.02, {}), ("warp5", "graycode", 0.04, {"strategy": "region"}),
+    ("paper-sim", "bidirectional", 0.03, {}), ("mugs-on-wall", "bidirectional", 0.06, {}),
+    ("two-masks", "lv", 0.1, {}), ("mugs-on-wall", "bidirectional", None, {}),
+]
+
+
+@pytest.mark.parametrize(("scene", "method", "noise", "options"), RENDERS,
+                         ids=[f"{s}-{m}-{n}" for s, m, n, _ in RENDERS])
+def test_renders_label_as_before(scene, method, noise, options):
+    """Every labelling a decode of a render runs (its coherent dim pixels, its codec's
+    regions with the codec's cuts): the same links, labels and pixels as before."""
+    images, spec = render(scene, method, noise)
+    with before.Watch() as watch:
+        try:
+            bistair.decode(images, spec, force=True, **options)
+        except bistair.BistairError:
+            pass  # refused after its labellings ran
+    assert watch.differ == []
+    assert watch.seen["link_bits"] >= 1 and watch.seen["fringe_regions"] >= 1
+    if noise is None:  # (the one render here whose decoder cuts links itself)
+        assert watch.seen["codec cuts"] >= 1
+
+
+REAL = list(parts())
+
+
+@pytest.mark.parametrize(("name", "folder", "spec", "options"), REAL,
+                         ids=[p[0] for p in REAL])
+def test_real_captures_label_as_before(name, folder, spec, options):
+    stack, spec = read_with_spec(folder, spec)
+    with before.Watch() as watch:
+        bistair.decode(stack, spec, force=True, **options)
+    if watch.seen["link_bits"] == 0:
+        pytest.skip("its decode labels no fringe regions")
+    assert watch.differ == []
+
+
+@pytest.mark.parametrize("shape", [(64, 1001), (33, 2), (1, 7)])
+def test_labels_of_a_checkerboard(shape):
+    """The most runs a row can hold (every other pixel) and a region a pixel: the ids a
+    tile may make are all used, none overflows into the next tile's."""
+    y, x = np.mgrid[0:shape[0], 0:shape[1]]
+    keep = (x + y) % 2 == 0
+    labels, roots, n, size, _ = label_kept(keep.astype(np.uint8) * np.uint8(4), NO_CUTS,
+                                           False, TILE, 0)
+    n_cv, want = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
+                                         ltype=cv2.CV_32S)
+    assert n == n_cv - 1 == keep.sum() and np.array_equal(roots[labels], want)
+    assert (size[1:] == 1).all()
+
+
+def test_the_cheap_noise_test_passes_where_the_exact_one_does():
+    """link_bits runs the period-jump test only where cheap forms of its first two tests
+    pass: the second's (no square root, no division, a looser margin) must pass wherever
+    the test's own does, at any scale (noise from 0 to overflow, near the threshold)."""
+    import math
+
+    import numba
+
+    from bistair.core import regions_jit
+
+    link_bits(np.zeros((2, 2), np.float32), np.ones((2, 2), bool),
+              np.zeros((2, 2), np.float32), 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False)
+    loud = regions_jit._loud  # compiled with the module's first kernel
+
+    @numba.njit
+    def check(px, py, qx, qy, pn, qn, noise_p, noise_q) -> int:
+        misses = 0
+        for i in range(px.size):
+            one = np.float32(1.0)
+            dx, dy = px[i] - qx[i], py[i] - qy[i]
+            d2 = dx * dx + dy * dy
+            # _jump's second test, as it is written there
+            spread = np.float32(2.0) * max(noise_p[i] / np.float32(math.sqrt(max(pn[i], one))),
+                                           noise_q[i] / np.float32(math.sqrt(max(qn[i], one))))
+            limit = np.float32(4.0) * spread
+            passes = not (d2 < limit * limit * np.float32(0.9999))
+            inv_p = np.float32(1.0) / np.float32(math.sqrt(pn[i]))
+            inv_q = np.float32(1.0) / np.float32(math.sqrt(qn[i]))
+            if passes and not loud(px[i], py[i], qx[i], qy[i], noise_p[i], noise_q[i], inv_p,
+                                   inv_q):
+                misses += 1
+        return misses
+
+    rng = np.random.default_rng(4)
+    n = 200_000
+    px, py, qx, qy = (rng.normal(0, 0.3, n).astype(np.float32) for _ in range(4))
+    pn, qn = (rng.integers(3, 7, n).astype(np.float32) for _ in range(2))
+    dx, dy = px - qx, py - qy
+    d = np.sqrt(dx.astype(np.float64) ** 2 + dy.astype(np.float64) ** 2)
+    # noise putting the threshold at the step itself, a few units in the last place apart
+    near = d / (8.0 * np.maximum(1 / np.sqrt(pn), 1 / np.sqrt(qn)))
+    noise_p = (near * rng.choice([1.0, 1 - 1e-7, 1 + 1e-7, 1 - 3e-5, 1 + 3e-5], n)
+               ).astype(np.float32)
+    noise_q = (noise_p * rng.uniform(0, 1, n)).astype(np.float32)
+    scales = rng.choice([1.0, 1e-18, 1e-22, 1e-40, 1e18, 1e20], n)
+    px, py, qx, qy = (a * scales.astype(np.float32) for a in (px, py, qx, qy))
+    noise_p, noise_q = (a * scales.astype(np.float32) for a in (noise_p, noise_q))
+    noise_p[::97] = np.nan
+    noise_q[::89] = 0.0
+    assert check(px, py, qx, qy, pn, qn, noise_p, noise_q) == 0

@@ -26,7 +26,7 @@ from .captures import Prepared, ScaledStack, check_decodable, modulation_thresho
 from .measure_jit import fit_residual_energy, keep_coherent, phase_noise, pixel_validity
 from .phase import phase_of_sums, shifts_of
 from .phase_jit import nstep_sums
-from .regions import MIN_REGION, fringe_regions
+from .regions import MIN_REGION, label_fringes
 
 
 @dataclass(frozen=True)
@@ -282,10 +282,11 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any())
     (True, False)
     """
-    # the regions fringe_regions drops as too small are left out here, without its
-    # relabelling pass
-    labels, n = fringe_regions(phi, weak, min_size=1, phase_noise=phase_noise)
-    return keep_coherent(labels, weak, strong, n, min_strong, min_size, MIN_REGION)
+    # the regions fringe_regions drops as too small are left out here; the labelling
+    # counted each region's pixels and strong pixels: no relabelling, no counting pass
+    lab = label_fringes(phi, weak, phase_noise=phase_noise, strong=strong)
+    return keep_coherent(lab.labels, lab.roots, lab.size, lab.strong, strong, min_strong,
+                         min_size, MIN_REGION)
 
 
 def _chi2_median(dof: int) -> float:

@@ -23,23 +23,29 @@ prange = range  # numba's prange once the first kernel of this module compiles
 
 
 @kernel(parallel=True)
-def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: int,
-                  min_strong: int, min_size: int, min_region: int) -> np.ndarray:
-    """``strong | (weak & region kept)``, a region kept when it holds ``min_region`` pixels
-    and ``min_strong`` strong pixels or ``min_size`` pixels (see
+def keep_coherent(labels: np.ndarray, roots: np.ndarray, size: np.ndarray,
+                  bright: np.ndarray, strong: np.ndarray, min_strong: int, min_size: int,
+                  min_region: int) -> np.ndarray:
+    """``strong | region kept``, a region kept when it holds ``min_region`` pixels and
+    ``min_strong`` strong pixels or ``min_size`` pixels (see
     :func:`bistair.core.measure.coherent_pixels`; ``min_region``: the regions
     :func:`bistair.core.regions.fringe_regions` would drop as too small).
+
+    The regions are those of :func:`bistair.core.regions.label_fringes` on the weak mask,
+    whose scan counted each one's pixels and strong pixels: one pass over the labels here.
+    A labelled pixel is always weak (valid for the labelling).
 
     Parameters
     ----------
     labels : (H, W) int32 array
-        Fringe regions of the weak mask, 0 outside any (never kept).
-    weak : (H, W) bool array
-        Pixels with at least the lower modulation threshold.
+        Provisional labels of the fringe regions of the weak mask, 0 outside any (never
+        kept).
+    roots : int32 array
+        The region of each label (``roots[0]`` is 0).
+    size, bright : (n+1,) int64 arrays
+        Pixels and strong pixels per region.
     strong : (H, W) bool array
         Pixels with at least the full modulation threshold.
-    n : int
-        Highest label.
     min_strong : int
         Strong pixels that keep a region.
     min_size : int
@@ -55,50 +61,34 @@ def keep_coherent(labels: np.ndarray, weak: np.ndarray, strong: np.ndarray, n: i
     Examples
     --------
     >>> labels = np.int32([[1, 1, 1, 2, 2, 0]])
+    >>> roots = np.int32([0, 1, 2])
+    >>> size, bright = np.int64([0, 3, 2]), np.int64([0, 1, 0])
     >>> strong = np.array([[True, False, False, False, False, False]])
-    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 1).tolist()
+    >>> keep_coherent(labels, roots, size, bright, strong, 1, 10, 1).tolist()
     [[True, True, True, False, False, False]]
-    >>> keep_coherent(labels, np.ones((1, 6), bool), strong, 2, 1, 10, 4).tolist()
+    >>> keep_coherent(labels, roots, size, bright, strong, 1, 10, 4).tolist()
     [[True, False, False, False, False, False]]
     """
     h, w = labels.shape
-    # counted in blocks of rows (each its own counts: as many as leave them under 8 MB),
-    # a run of one label along a row at a time; pixels outside the weak mask are label 0
-    blocks = min(16, max(1, h // 256), max(1, (1 << 20) // (n + 1)))
-    size = np.zeros((blocks, n + 1), np.int32)
-    bright = np.zeros((blocks, n + 1), np.int32)
-    for b in prange(blocks):
-        sizes = size[b]
-        brights = bright[b]
-        for y in range(b * h // blocks, (b + 1) * h // blocks):
-            run = 0
-            run_size = 0
-            run_bright = 0
-            for x in range(w):
-                lab = labels[y, x] if weak[y, x] else 0
-                if lab != run:
-                    sizes[run] += run_size
-                    brights[run] += run_bright
-                    run = lab
-                    run_size = 0
-                    run_bright = 0
-                run_size += 1
-                run_bright += strong[y, x]
-            sizes[run] += run_size
-            brights[run] += run_bright
+    n = size.shape[0] - 1
     keep = np.zeros(n + 1, np.bool_)
     for i in range(1, n + 1):
-        total = 0
-        lit = 0
-        for b in range(blocks):
-            total += size[b, i]
-            lit += bright[b, i]
-        keep[i] = (lit >= min_strong or total >= min_size) and total >= min_region
+        keep[i] = ((bright[i] >= min_strong or size[i] >= min_size)
+                   and size[i] >= min_region)
     out = np.empty((h, w), np.bool_)
     for y in prange(h):
-        for x in range(w):
-            out[y, x] = strong[y, x] or (weak[y, x] and keep[labels[y, x]])
+        lab = labels[y]
+        s = strong[y]
+        o = out[y]
+        last = np.int32(0)
+        kept = False
+        for x in range(w):  # a run of one label looked up once
+            if lab[x] != last:
+                last = lab[x]
+                kept = keep[roots[last]]
+            o[x] = s[x] or kept
     return out
+
 
 
 def fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,

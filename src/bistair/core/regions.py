@@ -22,11 +22,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import drop_small, fringe_links, period_jump_links, reattach, wrap_links
+from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, relabel, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -77,9 +76,9 @@ def _backward_runs(raw: np.ndarray, ok: np.ndarray, sigma: np.ndarray) -> np.nda
 
 def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
                  relative: float = 0.3, half: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`~bistair.core.regions_jit.period_jump_links`, which a decode
-    runs: the links across which the fringes' spacing or slant jumps (vertical links
-    (H-1, W), horizontal links (H, W-1)) to cut.
+    """NumPy reference of the period jumps that :func:`~bistair.core.regions_jit.link_bits`
+    cuts (with ``half`` 3, as a decode runs it): the links across which the fringes'
+    spacing or slant jumps (vertical links (H-1, W), horizontal links (H, W-1)) to cut.
 
     Where one surface hides another the wrapped phase may happen to run on across the edge,
     but its gradient (the fringe period and slant in the image) jumps. Both gradient
@@ -88,8 +87,6 @@ def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
     averages differ by more than ``relative`` of the larger gradient and by more than four
     times their noise (``sigma``: per-pixel phase noise, radians). Only links between two
     valid pixels are cut (no other link joins a region).
-
-    The NumPy formulation of :func:`~bistair.core.regions_jit.period_jump_links`.
 
     Parameters
     ----------
@@ -243,6 +240,77 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     return float(np.clip(3.0 * grad, 0.6, 2.2))
 
 
+@dataclass(frozen=True)
+class Labelling:
+    """Fringe regions as :func:`label_fringes` leaves them: provisional labels and the
+    region of each, before their final numbering (:func:`fringe_regions` numbers them;
+    :func:`~bistair.core.measure.coherent_pixels` reads them as they are).
+
+    The region of pixel ``(y, x)`` is ``roots[labels[y, x]]`` (0: none); regions are
+    numbered ``1..n`` in raster order of their first kept pixel.
+    """
+
+    labels: np.ndarray  # (H, W) int32 provisional ids, 0 outside any region
+    roots: np.ndarray  # int32: the region of each id (defined at the ids in use)
+    n: int  # regions
+    size: np.ndarray  # (n+1,) int64 pixels per region, the reattached ones included
+    strong: np.ndarray  # (n+1,) int64 pixels of the ``strong`` mask per region (0 without)
+
+
+def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
+                  phase_noise: np.ndarray | None = None,
+                  boundaries: tuple[np.ndarray, np.ndarray] | None = None,
+                  sign: int | None = None, strong: np.ndarray | None = None) -> Labelling:
+    """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
+    labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
+    pixels labelled and the dropped ones reattached, with per-region counts
+    (:func:`~bistair.core.regions_jit.label_kept`).
+
+    Parameters
+    ----------
+    phi, valid, cut, phase_noise, boundaries, sign
+        As :func:`fringe_regions`.
+    strong : (H, W) bool array, optional
+        A mask whose pixels are counted per region (``Labelling.strong``).
+
+    Returns
+    -------
+    Labelling
+        The provisional labels, their regions and the counts per region.
+
+    Examples
+    --------
+    >>> x = np.arange(60.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (4, 1)).astype(np.float32)
+    >>> lab = label_fringes(phi, np.ones(phi.shape, bool), strong=phi > 3)
+    >>> lab.n, lab.size.tolist(), lab.strong.tolist()
+    (2, [0, 120, 120], [0, 64, 64])
+    >>> lab.roots[lab.labels[0, [0, 29, 30, 59]]].tolist()
+    [1, 1, 2, 2]
+    """
+    valid = np.ascontiguousarray(valid, dtype=bool)
+    if cut is None:
+        cut = default_cut(phi, valid)
+    h, w = phi.shape
+    noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
+             else np.ascontiguousarray(phase_noise, dtype=np.float32))
+    if sign is None:
+        sign = fringe_direction(phi, valid)
+    cut_v, cut_h = NO_CUTS, NO_CUTS
+    if boundaries is not None:
+        cut_v, cut_h = (np.ascontiguousarray(b, dtype=bool) for b in boundaries)
+    bits = link_bits(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
+                     float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
+                     boundaries is not None)
+    del noise
+    counted = strong is not None
+    mask = np.ascontiguousarray(strong, dtype=bool) if counted else NO_CUTS
+    # the pixels dropped beside a cut link (thin lines along the wraps) join the region
+    # they still link to: three rounds
+    labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE, 3)
+    return Labelling(labels, roots, int(n), size, lit)
+
+
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                    min_size: int = MIN_REGION, phase_noise: np.ndarray | None = None,
                    boundaries: tuple[np.ndarray, np.ndarray] | None = None,
@@ -254,10 +322,13 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     :func:`fringe_direction`) by more than noise explains (``phase_noise``: per-pixel phase
     noise in radians, 0.02 when not given): that is where one surface meets another.
     ``boundaries`` adds links to cut that a codec found itself (vertical links (H-1, W),
-    horizontal links (H, W-1)).
+    horizontal links (H, W-1)). A link cut at a wrap drops its high-phase pixel, any
+    other cut both; the pixels kept are labelled (4-connected), then the dropped ones join
+    a region they still link to (:func:`label_fringes`).
 
-    Returns ``(labels, n)``: int32 labels 1..n, 0 outside any region. Regions smaller than
-    ``min_size`` pixels are dropped (left 0) so that noise islands never vote.
+    Returns ``(labels, n)``: int32 labels 1..n in raster order of each region's first
+    kept pixel, 0 outside any region. Regions smaller than ``min_size`` pixels are dropped
+    (left 0, the others numbered on) so that noise islands never vote.
 
     Parameters
     ----------
@@ -298,30 +369,16 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     >>> n, labels[0, [0, 9, 10, 29, 30]].tolist()
     (3, [1, 1, 2, 2, 3])
     """
-    valid = np.asarray(valid, dtype=bool)
-    if cut is None:
-        cut = default_cut(phi, valid)
-    h, w = phi.shape
-    noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
-             else np.ascontiguousarray(phase_noise, dtype=np.float32))
-    if sign is None:
-        sign = fringe_direction(phi, valid)
-    jump_v, jump_h = period_jump_links(phi, valid, noise, 3, 0.3)
-    if boundaries is not None:  # the links are this call's own arrays: marked in place
-        jump_v |= boundaries[0]
-        jump_h |= boundaries[1]
-    vert, horiz, keep = fringe_links(phi, valid, float(np.float32(cut)), sign, noise,
-                                     jump_v, jump_h)
-    del jump_v, jump_h
-    n, labels = cv2.connectedComponents(keep.view(np.uint8), connectivity=4,
-                                        ltype=cv2.CV_32S)
-    n -= 1
-    # Reattach the removed pixels through links that are not cut (a few passes, on the
-    # removed pixels only: they are thin lines along the wraps).
-    reattach(labels, valid, keep, vert, horiz, 3)
+    lab = label_fringes(phi, valid, cut, phase_noise, boundaries, sign)
+    n = lab.n
+    remap = np.arange(n + 1, dtype=np.int32)
     if min_size > 1:  # (every region has a pixel)
-        n = drop_small(labels, n, min_size)
-    return labels, int(n)
+        kept = lab.size >= min_size
+        kept[0] = False
+        remap = np.where(kept, np.cumsum(kept), 0).astype(np.int32)
+        n = int(kept.sum())
+    relabel(lab.labels, lab.roots, remap)
+    return lab.labels, n
 
 
 def core_weight(phi: np.ndarray) -> np.ndarray:
