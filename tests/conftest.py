@@ -22,6 +22,21 @@ SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 CFPE = SHARED / "data" / "cfpe"
+# seconds a test waits for a command it started (to start writing, to end after a signal,
+# to finish) before calling it hung: a guard against hangs only, so long enough for a
+# loaded two-core machine (issue 31: six test runs at once ran a minute's work in several)
+PATIENCE = 600.0
+
+
+@pytest.fixture(scope="session", autouse=True)
+def no_progress_lines():
+    """No progress lines on stderr unless a test asks for them (``BISTAIR_PROGRESS_DELAY``
+    set by the test itself): a command prints them once it has run 5 s in a log, so whether
+    they appear before a result or an error depends on the machine's load, not the code.
+    Session-wide, so that the fixtures of wider scope see it too."""
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
+        yield
 
 
 def isolated_blobs(seed: int, stretch: float, period: float = 30.0) -> tuple[Blob, ...]:

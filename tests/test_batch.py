@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import cli_run
+from conftest import PATIENCE, cli_run
 
 from bistair.app import batch as batch_module
 from bistair.app import engine
@@ -232,7 +232,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
     out = tmp_path / "out"
     proc = _bistair("batch", root, "--out", out, "--workers", 1)
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + PATIENCE
         while not list(out.glob(f"*/{MARKER}")) and time.monotonic() < deadline:
             assert proc.poll() is None, proc.communicate()
             time.sleep(0.01)
@@ -242,7 +242,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
         unfinished = len(list(out.glob(f"*/{MARKER}"))) < len(names)
         os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C on the terminal: the whole group
         os.killpg(proc.pid, signal.SIGCONT)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=PATIENCE)
     finally:
         _end(proc)
     if not unfinished:
@@ -254,7 +254,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path):
     assert set(_rows(out)) == done
     proc = _bistair("batch", root, "--out", out, "--workers", 1, "--resume")
     try:
-        text, err = proc.communicate(timeout=120)
+        text, err = proc.communicate(timeout=PATIENCE)
     finally:
         _end(proc)
     assert proc.returncode == 0, err
@@ -282,7 +282,7 @@ def scheduler(tmp_path_factory):
     try:
         start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
               "--scheduler-file", info, "--idle-timeout", "600")
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + PATIENCE
         address = None
         while address is None and time.monotonic() < deadline:
             assert procs[0].poll() is None, (folder / "scheduler.log").read_text()

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import PATIENCE
 
 from bistair.io.atomic import output_folder, remove_stale
 
@@ -23,7 +24,7 @@ def _start(out: Path) -> subprocess.Popen:
 
 
 def _wait_for_temp(parent: Path, proc: subprocess.Popen) -> Path:
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + PATIENCE
     while time.monotonic() < deadline and proc.poll() is None:
         found = list(parent.glob(f".bistair-{proc.pid}-*"))
         if found and any(found[0].rglob("*.png")):
@@ -43,7 +44,7 @@ def test_signal_while_writing_leaves_nothing(tmp_path: Path, sig: signal.Signals
     writing = temp.exists()
     proc.send_signal(sig)
     proc.send_signal(signal.SIGCONT)
-    _, err = proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=PATIENCE)
     if not writing:
         pytest.skip("the command finished writing before it was stopped (busy machine)")
     assert proc.returncode != 0, "the signal was swallowed: the command went on and exited 0"
