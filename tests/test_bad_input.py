@@ -4,8 +4,10 @@ Each row runs ``bistair`` in-process and must exit with code 2, print exactly on
 line on stderr, starting with ``Error:`` and holding the fragment, and leave its output path
 uncreated. ``{out}`` stands for the output path, ``{pats}`` for a folder of small graycode
 patterns with their spec (they decode), ``{zero}`` and ``{corrupt}`` for copies whose frame
-03.png is empty or not an image, and ``{poses}`` for calibration captures of two poses that
-show no board.
+03.png is empty or not an image, ``{nospec}`` for a copy without its spec, ``{dataset}`` for
+a data set laid out as ``simulate --count`` writes it (two scenes, each set a folder below,
+and ``index.csv``), and ``{poses}`` for calibration captures of two poses that show no
+board. Paths in a message are written the same way.
 """
 
 from __future__ import annotations
@@ -64,6 +66,20 @@ ROWS = [
     (["patterns", "graycode", "--out", "{pats}/spec.json/new"],
      "spec.json is a file, not a folder"),
     (["decode", "{pats}", "--out", ""], "the output path is empty"),
+    # a first hour's slips: no spec beside the captures, a misspelt method, a data set's
+    # folder given to batch instead of its index.csv (issue 31)
+    (["decode", "{nospec}", "--out", "{out}"], "nospec/spec.json not found: give the spec "
+                                              "that made the patterns with --spec FILE"),
+    (["reconstruct", "{nospec}", "--calibration", "{pats}/spec.json", "--out", "{out}.ply"],
+     "nospec/spec.json not found: give the spec that made the patterns with --spec FILE"),
+    (["patterns", "bidirectinal", "--out", "{out}"],
+     "unknown method 'bidirectinal', did you mean 'bidirectional'? (methods: bidirectional, "
+     "lv, phase-coding, graycode, multifreq; also: gamma)"),
+    (["patterns", "fourier", "--out", "{out}"], "unknown method 'fourier' (methods: "),
+    (["batch", "{dataset}", "--out", "{out}"], "no capture sets in {dataset}: none of its 2 "
+     "sub-folders holds images; {dataset}/index.csv lists the sets of a data set: bistair "
+     "batch {dataset}/index.csv"),
+    (["batch", "{pats}", "--out", "{out}"], "it is one capture set itself: bistair decode"),
     (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
     (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "
                                                  "another format)"),
@@ -150,6 +166,13 @@ def inputs(tmp_path_factory):
     for name, content in (("zero", b""), ("corrupt", b"not a png at all")):
         shutil.copytree(root / "pats", root / name)
         (root / name / "03.png").write_bytes(content)
+    shutil.copytree(root / "pats", root / "nospec")
+    (root / "nospec" / "spec.json").unlink()
+    for scene in ("scene-0000", "scene-0001"):  # as simulate --count lays a data set out
+        shutil.copytree(root / "pats", root / "dataset" / scene / "graycode")
+    (root / "dataset" / "index.csv").write_text(
+        "name,captures,calibration\n" + "".join(f"scene-000{i},scene-000{i}/graycode,\n"
+                                                for i in range(2)))
     (root / "poses").mkdir()
     (root / "poses" / "board.json").write_text(json.dumps(
         {"type": "checkerboard", "columns": 9, "rows": 6, "spacing": 20.0}))
@@ -178,10 +201,8 @@ def row_id(args: list[str]) -> str:
 @pytest.mark.parametrize(("args", "message"), ROWS, ids=[row_id(args) for args, _ in ROWS])
 def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, capsys):
     out = tmp_path / "out"
-    paths = {"out": out, **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt")}}
-    # a run slower than the progress delay (a cold numba cache compiles for seconds) prints
-    # progress lines before the refusal: they are not what this test is about
-    monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
+    paths = {"out": out, **{name: inputs / name for name in ("pats", "poses", "zero", "corrupt",
+                                                             "nospec", "dataset")}}
     cwd = tmp_path / "cwd"  # where a relative (or empty) output path would land
     cwd.mkdir()
     monkeypatch.chdir(cwd)
@@ -192,7 +213,7 @@ def test_refused_with_one_line(args, message, inputs, tmp_path, monkeypatch, cap
              if line.strip() and not line.startswith("Warning: skipped pose-0")]
     assert code == 2, err
     assert len(lines) == 1 and lines[0].startswith("Error: "), err
-    assert message in lines[0], lines[0]
+    assert message.format(**paths) in lines[0], lines[0]
     # nothing written: not the output, not beside the inputs (an output path that is an
     # input folder), not in the working directory (an empty or relative output path)
     assert not out.exists()

@@ -203,8 +203,15 @@ def test_sets_of_a_folder_leave_out_hidden_folders_and_the_output(scans, tmp_pat
     root = tmp_path / "root"
     for name in ("s10", "s2", ".hidden", "out"):
         (root / name).mkdir(parents=True)
+    for name in ("s10", "s2", ".hidden"):
+        (root / name / "00.png").write_bytes(b"x")  # listed, not read
     (root / "notes.txt").write_text("x")
     assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
+    (root / "s2" / "00.png").unlink()  # a set folder without images: still a set (it fails)
+    assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
+    (root / "s10" / "00.png").unlink()
+    with pytest.raises(BistairError, match="none of its 2 sub-folders holds images"):
+        find_sets(root, root / "out")
     with pytest.raises(BistairError, match="no capture sets"):
         find_sets(tmp_path / "root" / "s2", tmp_path / "o")
 
