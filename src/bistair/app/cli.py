@@ -50,7 +50,7 @@ class _MethodCommands(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
         from ..codecs import REGISTRY
 
-        return [*REGISTRY, *super().list_commands(ctx)]
+        return [*REGISTRY, *(c for c in super().list_commands(ctx) if c not in REGISTRY)]
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         from ..codecs import REGISTRY
@@ -67,7 +67,7 @@ class _MethodCommands(click.Group):
 
         name = args[0] if args else ""
         if name and not name.startswith("-") and self.get_command(ctx, name) is None:
-            others = super().list_commands(ctx)
+            others = [c for c in super().list_commands(ctx) if c not in REGISTRY]
             close = difflib.get_close_matches(name, [*REGISTRY, *others], n=1)
             ctx.fail(f"unknown method {name!r}"
                      + (f", did you mean {close[0]!r}?" if close else "")
