@@ -77,8 +77,8 @@ ROWS = [
      "lv, phase-coding, graycode, multifreq; also: gamma)"),
     (["patterns", "fourier", "--out", "{out}"], "unknown method 'fourier' (methods: "),
     (["batch", "{dataset}", "--out", "{out}"], "no capture sets in {dataset}: none of its 2 "
-     "sub-folders holds images; {dataset}/index.csv lists the sets of a data set: bistair "
-     "batch {dataset}/index.csv"),
+     "sub-folders holds images (or L/ and R/); {dataset}/index.csv lists the sets of a data "
+     "set: bistair batch {dataset}/index.csv"),
     (["batch", "{pats}", "--out", "{out}"], "it is one capture set itself: bistair decode"),
     (["decode", "{zero}", "--out", "{out}"], "03.png is empty (0 bytes)"),
     (["decode", "{corrupt}", "--out", "{out}"], "03.png: not a readable image (corrupt or of "

@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -210,9 +211,14 @@ def test_sets_of_a_folder_leave_out_hidden_folders_and_the_output(scans, tmp_pat
     (root / "s2" / "00.png").unlink()  # a set folder without images: still a set (it fails)
     assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
     (root / "s10" / "00.png").unlink()
-    with pytest.raises(BistairError, match="none of its 2 sub-folders holds images"):
+    with pytest.raises(BistairError, match=r"none of its 2 sub-folders holds images \(or L/"):
         find_sets(root, root / "out")
-    with pytest.raises(BistairError, match="no capture sets"):
+    (root / "s2" / "L").mkdir()
+    (root / "s2" / "R").mkdir()  # a stereo set (two cameras): a set
+    assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
+    pair = f"bistair stereo {root / 's2' / 'L'} {root / 's2' / 'R'}"
+    with pytest.raises(BistairError, match="it is one set of two cameras itself: "
+                                           + re.escape(pair)):
         find_sets(tmp_path / "root" / "s2", tmp_path / "o")
 
 

@@ -161,8 +161,8 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
     ------
     BistairError
         ``root`` missing, the output folder is ``root`` itself, no sets (no sub-folder
-        holds images: the message points to the ``index.csv`` of a data set there), a bad
-        manifest or two sets writing to the same folder.
+        holds images or a stereo pair: the message points to the ``index.csv`` of a data
+        set there), a bad manifest or two sets writing to the same folder.
     """
     root, out = Path(root), Path(out).absolute()
     spec = None if spec is None else str(Path(spec).absolute())
@@ -185,7 +185,7 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
                                "(it holds images or a spec.json): choose another")
         subs = sorted((p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")
                        and p.resolve() != out.resolve()), key=lambda p: natural_key(p.name))
-        if not any(list_images(p) for p in subs):
+        if not any(list_images(p) or stereo_pair(p) for p in subs):
             raise BistairError(_no_sets(root, subs))
         jobs = [SetJob(p.name, str(p.absolute()), spec, calibration, str(out / p.name))
                 for p in subs]
@@ -211,7 +211,7 @@ def _no_sets(root: Path, subs: list[Path]) -> str:
     ``index.csv`` of a data set (``bistair simulate --count``: its sets lie one level
     deeper), the folder itself to ``bistair decode``, or a manifest."""
     index = root / "index.csv"
-    what = (f"none of its {len(subs)} sub-folders holds images" if subs
+    what = (f"none of its {len(subs)} sub-folders holds images (or L/ and R/)" if subs
             else "it has no sub-folders (each set is a sub-folder of images)")
     if index.is_file():
         return (f"no capture sets in {root}: {what}; {index} lists the sets of a data set: "
@@ -219,6 +219,10 @@ def _no_sets(root: Path, subs: list[Path]) -> str:
     if list_images(root):
         return (f"no capture sets in {root}: {what}; it is one capture set itself: bistair "
                 f"decode {root}")
+    pair = stereo_pair(root)
+    if pair is not None:
+        return (f"no capture sets in {root}: {what}; it is one set of two cameras itself: "
+                f"bistair stereo {pair[0]} {pair[1]}")
     if subs:
         return (f"no capture sets in {root}: {what} (for sets further down, list them in a "
                 ".csv manifest: see bistair batch --help)")
