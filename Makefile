@@ -6,22 +6,31 @@ STAMP := $(VENV)/.installed
 
 .PHONY: test demo lint bench docs clean
 
+# Once: the environment, then the kernels compiled in a step of their own (pip would compile
+# them inside its quiet build, without a word). The times: measured on two-core machines,
+# some busy with other work (README)
 $(STAMP): pyproject.toml
+	@echo "== installing bistair and its dependencies into $(VENV) (2-5 minutes, once)"
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	BISTAIR_NO_PREBUILD=1 $(BIN)/python -m pip install --quiet -e '.[dev]'
+	@echo "== compiling the decode kernels for this machine into src/bistair/_kernels (about 2 minutes on two cores, up to 16 on a busy machine; once)"
+	$(BIN)/python -m bistair.app.kernels src/bistair/_kernels \
+		|| echo "warning: some kernels were not compiled: they compile on their first call"
 	touch $(STAMP)
 
 # the tests on up to four processes (pytest-xdist), each test file in one of them
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py
+	@echo "== lint (ruff), then the tests on up to 4 processes (half an hour to an hour on two cores)"
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py docs/site_settings.py
 	$(BIN)/python -m pytest -q -n auto --maxprocesses 4 --dist loadfile
 
 demo: $(STAMP)
+	@echo "== bistair demo: the paper's simulation at 1280 x 1024, every method (2-3 minutes)"
 	$(BIN)/bistair demo --out demo-out
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py
+	$(BIN)/ruff check src tests benchmarks examples docs/conf.py docs/spec_fields.py docs/site_settings.py
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/decode_speed.py

@@ -63,17 +63,7 @@ sphinx_gallery_conf = {
     "plot_gallery": "True",
 }
 
-html_theme = "pydata_sphinx_theme"
-html_title = "bistair"
 html_static_path = ["_static"]
-html_theme_options = {
-    "navigation_with_keys": False,
-    "show_toc_level": 2,
-    "navbar_align": "left",
-    "footer_start": ["copyright"],
-    "footer_end": [],
-}
-html_show_sourcelink = False
 nitpicky = False
 suppress_warnings = ["myst.header"]
 
@@ -138,7 +128,15 @@ _write_api()
 
 # -- every spec field of every method, from the spec classes (docs/guide/spec-fields.md) ----
 sys.path.insert(0, str(Path(__file__).parent))
+import site_settings  # noqa: E402
 from spec_fields import write_spec_fields_page  # noqa: E402
+
+# -- the theme, no typographic replacements, the sidebars, the CLI reference's commands ----
+smartquotes = site_settings.smartquotes
+html_theme = site_settings.html_theme
+html_title = site_settings.html_title
+html_theme_options = site_settings.html_theme_options
+html_show_sourcelink = site_settings.html_show_sourcelink
 
 write_spec_fields_page()
 
@@ -154,4 +152,5 @@ def _skip_foreign(app, what, name, obj, skip, options):  # noqa: ANN001, ANN202
 
 def setup(app):  # noqa: ANN001, ANN201
     app.connect("autodoc-skip-member", _skip_foreign)
+    site_settings.setup_site(app)
 

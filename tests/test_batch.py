@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -16,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import cli_run
+from conftest import PATIENCE, cli_run
 
 from bistair.app import batch as batch_module
 from bistair.app import engine
@@ -206,9 +207,21 @@ def test_sets_of_a_folder_leave_out_hidden_folders_and_the_output(scans, tmp_pat
     root = tmp_path / "root"
     for name in ("s10", "s2", ".hidden", "out"):
         (root / name).mkdir(parents=True)
+    for name in ("s10", "s2", ".hidden"):
+        (root / name / "00.png").write_bytes(b"x")  # listed, not read
     (root / "notes.txt").write_text("x")
     assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
-    with pytest.raises(BistairError, match="no capture sets"):
+    (root / "s2" / "00.png").unlink()  # a set folder without images: still a set (it fails)
+    assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
+    (root / "s10" / "00.png").unlink()
+    with pytest.raises(BistairError, match=r"none of its 2 sub-folders holds images \(or L/"):
+        find_sets(root, root / "out")
+    (root / "s2" / "L").mkdir()
+    (root / "s2" / "R").mkdir()  # a stereo set (two cameras): a set
+    assert [j.name for j in find_sets(root, root / "out")] == ["s2", "s10"]
+    pair = f"bistair stereo {root / 's2' / 'L'} {root / 's2' / 'R'}"
+    with pytest.raises(BistairError, match="it is one set of two cameras itself: "
+                                           + re.escape(pair)):
         find_sets(tmp_path / "root" / "s2", tmp_path / "o")
 
 
@@ -248,7 +261,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path, s
     out = tmp_path / "out"
     proc = _bistair("batch", root, "--out", out, "--workers", 1)
     try:
-        deadline = time.monotonic() + 120
+        deadline = time.monotonic() + PATIENCE
         while not list(out.glob(f"*/{MARKER}")) and time.monotonic() < deadline:
             assert proc.poll() is None, proc.communicate()
             time.sleep(0.01)
@@ -261,7 +274,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path, s
         else:
             proc.send_signal(signal.SIGTERM)
         os.killpg(proc.pid, signal.SIGCONT)
-        _, err = proc.communicate(timeout=60)
+        _, err = proc.communicate(timeout=PATIENCE)
     finally:
         _end(proc)
     if not unfinished:
@@ -277,7 +290,7 @@ def test_ctrl_c_leaves_no_half_written_set_and_resume_goes_on(scans, tmp_path, s
     assert set(_rows(out)) == done
     proc = _bistair("batch", root, "--out", out, "--workers", 1, "--resume")
     try:
-        text, err = proc.communicate(timeout=120)
+        text, err = proc.communicate(timeout=PATIENCE)
     finally:
         _end(proc)
     assert proc.returncode == 0, err
@@ -305,7 +318,7 @@ def scheduler(tmp_path_factory):
     try:
         start("scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
               "--scheduler-file", info, "--idle-timeout", "600")
-        deadline = time.monotonic() + 60
+        deadline = time.monotonic() + PATIENCE
         address = None
         while address is None and time.monotonic() < deadline:
             assert procs[0].poll() is None, (folder / "scheduler.log").read_text()

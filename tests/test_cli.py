@@ -59,6 +59,14 @@ def test_bare_command_shows_the_help(monkeypatch, capsys):
     assert out.startswith("Usage: bistair") and "decode" in out
 
 
+def test_a_bare_group_shows_its_help(monkeypatch, capsys):
+    """``bistair patterns`` alone: its help on stdout, exit 0 (click 8.2 raises a usage
+    error for it, which was printed as 'Error: Usage: ...', exit 2)."""
+    code, out, err = run(monkeypatch, capsys, "patterns")
+    assert (code, err) == (0, "")
+    assert out.startswith("Usage: bistair patterns") and "bidirectional" in out
+
+
 def test_swapped_stair_pair_is_named_in_the_refusal(pats, tmp_path, monkeypatch, capsys):
     spec = json.loads((pats / "spec.json").read_text())
     frames = spec["frames"]

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import PATIENCE
 
 import bistair
 from bistair.app.jobs import save_patterns
@@ -27,7 +28,7 @@ def _start(out: Path) -> subprocess.Popen:
 
 
 def _wait_for_temp(parent: Path, proc: subprocess.Popen) -> Path:
-    deadline = time.monotonic() + 120
+    deadline = time.monotonic() + PATIENCE
     while time.monotonic() < deadline and proc.poll() is None:
         found = list(parent.glob(f".bistair-{proc.pid}-*"))
         if found and any(found[0].rglob("*.png")):
@@ -47,7 +48,7 @@ def test_signal_while_writing_leaves_nothing(tmp_path: Path, sig: signal.Signals
     writing = temp.exists()
     proc.send_signal(sig)
     proc.send_signal(signal.SIGCONT)
-    _, err = proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=PATIENCE)
     if not writing:
         pytest.skip("the command finished writing before it was stopped (busy machine)")
     assert proc.returncode != 0, "the signal was swallowed: the command went on and exited 0"

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import cli_run
+from conftest import PATIENCE, cli_run
 from support.scan_devices import Screen
 
 from bistair.acquire import scan
@@ -278,7 +278,7 @@ def test_a_signal_mid_scan_leaves_nothing(tmp_path, sig):
         if "pattern 3 of 36" in line:
             break
     proc.send_signal(sig)
-    _, err = proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=PATIENCE)
     assert proc.returncode != 0 and "Traceback" not in err
     assert list(runs.iterdir()) == []
 

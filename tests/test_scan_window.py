@@ -15,17 +15,15 @@ from __future__ import annotations
 
 import json
 import os
-import select
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 
 import numpy as np
 import pytest
-from conftest import cli_run
+from conftest import PATIENCE, cli_run
+from support.xserver import own_xvfb
 
 from bistair.acquire import displays
 from bistair.acquire.cameras import ScreenCamera
@@ -42,39 +40,14 @@ run = cli_run
 
 @pytest.fixture(scope="module")
 def xvfb():
-    """The display name (``:N``) of an Xvfb started on a free display number."""
-    exe = shutil.which("Xvfb")
-    if exe is None:
-        pytest.skip("no X server can be started: Xvfb is not installed (.ci/run installs the "
-                    "xvfb package with apt)")
-    read, write = os.pipe()
-    log = tempfile.TemporaryFile()
-    proc = subprocess.Popen([exe, "-displayfd", str(write), "-screen", "0",
-                             f"{SCREEN[0]}x{SCREEN[1]}x24", "-nolisten", "tcp"],
-                            pass_fds=(write,), stdout=subprocess.DEVNULL, stderr=log)
-    os.close(write)
-    number, deadline = b"", time.monotonic() + 30
-    while not number.endswith(b"\n") and time.monotonic() < deadline and proc.poll() is None:
-        if select.select([read], [], [], 0.2)[0]:
-            chunk = os.read(read, 16)
-            if not chunk:
-                break
-            number += chunk
-    os.close(read)
-    if not number.strip().isdigit():
-        proc.kill()
-        proc.wait()
-        log.seek(0)
-        why = (log.read().decode(errors="replace").strip().splitlines() or ["no message"])[-1]
-        pytest.skip(f"no X server can be started: Xvfb failed ({why})")
-    yield f":{number.decode().strip()}"
-    proc.terminate()
-    proc.wait(timeout=10)
-    log.close()
+    """The display (``:N``) of an Xvfb of this module's own, 1920x1080, on a free number."""
+    with own_xvfb(SCREEN) as display:
+        yield display
 
 
 @pytest.fixture()
 def x11(xvfb, monkeypatch):
+    """The tests' X server as the window system (whatever DISPLAY the user has)."""
     monkeypatch.setenv("DISPLAY", xvfb)
     monkeypatch.setenv("SDL_VIDEODRIVER", "x11")
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
@@ -182,6 +155,29 @@ def test_screens_and_monitors_that_are_not_there(x11):
             pass
 
 
+def test_the_x_server_outlives_its_clients(x11):
+    """Screenshot connections and windows opened and closed one after the other, each the
+    server's only client: an X server that resets when its last client leaves refuses about
+    one connection in three meanwhile ('Cannot connect to display', issue 31)."""
+    for _ in range(100):
+        with ScreenCamera() as camera:
+            assert camera.describe()["area"]["width"] == SCREEN[0]
+    for _ in range(5):
+        with WindowDisplay() as window:
+            assert window.size == SCREEN
+
+
+def test_each_x_server_takes_a_display_of_its_own(x11, monkeypatch):
+    """A second server started beside the module's takes another free number, and each
+    answers for itself (another X server on the machine is never in the way)."""
+    with own_xvfb((640, 480)) as other:
+        assert other != x11
+        for display, size in ((x11, SCREEN), (other, (640, 480))):
+            monkeypatch.setenv("DISPLAY", display)
+            with ScreenCamera() as camera:
+                assert camera.grab().image.shape == size[::-1]
+
+
 def test_no_window_system_is_one_line(monkeypatch):
     monkeypatch.delenv("DISPLAY", raising=False)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
@@ -218,6 +214,6 @@ def test_ctrl_c_closes_the_window_and_writes_nothing(x11, tmp_path):
         if "pattern 3 of 11" in line:
             break
     proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=60)
+    _, err = proc.communicate(timeout=PATIENCE)
     assert proc.returncode == 1 and "Aborted" in err and "Traceback" not in err
     assert list(runs.iterdir()) == []

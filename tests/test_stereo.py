@@ -43,12 +43,6 @@ SIZE = (320, 256)
 DIST_L, DIST_R = (-0.08, 0.1, 0.001, -0.0005, 0.0), (-0.06, 0.05, -0.0008, 0.0007, 0.0)
 
 
-@pytest.fixture(autouse=True)
-def no_progress_lines(monkeypatch):
-    """Slow runs print progress on stderr; these tests read stderr for one line."""
-    monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
-
-
 def tilted_rig() -> StereoRig:
     """A pair that is not level: distortion on both cameras, the right one 6 mm higher and
     rolled by 1.5 degrees."""

@@ -33,12 +33,6 @@ from bistair.sim.stereo import StereoRig, write_board_pairs
 KEYS = ("M1", "D1", "M2", "D2", "R", "T")
 
 
-@pytest.fixture(autouse=True)
-def no_progress_lines(monkeypatch):
-    """Slow runs print progress on stderr; these tests read stderr for one line."""
-    monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
-
-
 def write_fs(path, items: dict):
     """Write ``items`` with cv2.FileStorage (format from the suffix); a list is written as a
     sequence, a scalar as a scalar, the rest as a matrix."""

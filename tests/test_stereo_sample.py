@@ -28,7 +28,6 @@ def sample(tmp_path_factory):
 
 def test_the_sample_reconstructs_through_the_command_line(sample, tmp_path, monkeypatch,
                                                           capfd):
-    monkeypatch.setenv("BISTAIR_PROGRESS_DELAY", "3600")
     cal = tmp_path / "stereo.json"
     code, stdout, err = cli_run(monkeypatch, capfd, "import-calibration", sample["yml"],
                                 "--stereo", "--keys", KEYS, "--out", cal)

@@ -59,7 +59,14 @@ from ..geometry.calibration import load_calibration
 from ..geometry.triangulate import check_depth_range
 from ..io.atomic import check_output, output_file, replace_folder
 from ..io.jsonfile import read_json, write_json
-from ..io.read import IMAGE_SUFFIXES, capture_files, default_spec_path, load_spec, natural_key
+from ..io.read import (
+    IMAGE_SUFFIXES,
+    capture_files,
+    default_spec_path,
+    list_images,
+    load_spec,
+    natural_key,
+)
 from .engine import (
     BATCH_PREFIX,
     check_workers,
@@ -153,8 +160,9 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
     Raises
     ------
     BistairError
-        ``root`` missing, the output folder is ``root`` itself, no sets, a bad manifest or
-        two sets writing to the same folder.
+        ``root`` missing, the output folder is ``root`` itself, no sets (no sub-folder
+        holds images or a stereo pair: the message points to the ``index.csv`` of a data
+        set there), a bad manifest or two sets writing to the same folder.
     """
     root, out = Path(root), Path(out).absolute()
     spec = None if spec is None else str(Path(spec).absolute())
@@ -177,10 +185,10 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
                                "(it holds images or a spec.json): choose another")
         subs = sorted((p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")
                        and p.resolve() != out.resolve()), key=lambda p: natural_key(p.name))
+        if not any(list_images(p) or stereo_pair(p) for p in subs):
+            raise BistairError(_no_sets(root, subs))
         jobs = [SetJob(p.name, str(p.absolute()), spec, calibration, str(out / p.name))
                 for p in subs]
-        if not jobs:
-            raise BistairError(f"no capture sets in {root}: each set is a sub-folder")
     resolved = out.resolve()
     for job in jobs:
         folder = Path(job.captures)
@@ -196,6 +204,30 @@ def find_sets(root: str | Path, out: str | Path, spec: str | Path | None = None,
                                f"{job.out}: give them different out cells")
         seen[key] = job.name
     return jobs
+
+
+def _no_sets(root: Path, subs: list[Path]) -> str:
+    """Why a folder given to a batch holds no capture set, and what to give instead: the
+    ``index.csv`` of a data set (``bistair simulate --count``: its sets lie one level
+    deeper), the folder itself to ``bistair decode``, or a manifest."""
+    index = root / "index.csv"
+    what = (f"none of its {len(subs)} sub-folders holds images (or L/ and R/)" if subs
+            else "it has no sub-folders (each set is a sub-folder of images)")
+    if index.is_file():
+        return (f"no capture sets in {root}: {what}; {index} lists the sets of a data set: "
+                f"bistair batch {index}")
+    if list_images(root):
+        return (f"no capture sets in {root}: {what}; it is one capture set itself: bistair "
+                f"decode {root}")
+    pair = stereo_pair(root)
+    if pair is not None:
+        return (f"no capture sets in {root}: {what}; it is one set of two cameras itself: "
+                f"bistair stereo {pair[0]} {pair[1]}")
+    if subs:
+        return (f"no capture sets in {root}: {what} (for sets further down, list them in a "
+                ".csv manifest: see bistair batch --help)")
+    return (f"no capture sets in {root}: it has no sub-folders (each set is a sub-folder of "
+            "images, or a row of a .csv manifest)")
 
 
 def read_manifest(path: str | Path, out: str | Path, spec: str | None = None,

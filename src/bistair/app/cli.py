@@ -8,6 +8,7 @@ not pay for the imaging and geometry libraries.
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import signal
 import sys
 from pathlib import Path
@@ -53,7 +54,7 @@ class _MethodCommands(click.Group):
     def list_commands(self, ctx: click.Context) -> list[str]:
         from ..codecs import REGISTRY
 
-        return [*REGISTRY, *super().list_commands(ctx)]
+        return [*REGISTRY, *(c for c in super().list_commands(ctx) if c not in REGISTRY)]
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
         from ..codecs import REGISTRY
@@ -62,6 +63,21 @@ class _MethodCommands(click.Group):
         if codec is None:
             return super().get_command(ctx, cmd_name)
         return _spec_command(codec.name, codec.spec_class, codec.summary)
+
+    def resolve_command(self, ctx: click.Context, args: list[str]
+                        ) -> tuple[str | None, click.Command | None, list[str]]:
+        """An unknown name is refused with the closest method and the list of them."""
+        from ..codecs import REGISTRY
+
+        name = args[0] if args else ""
+        if name and not name.startswith("-") and self.get_command(ctx, name) is None:
+            others = [c for c in super().list_commands(ctx) if c not in REGISTRY]
+            close = difflib.get_close_matches(name, [*REGISTRY, *others], n=1)
+            ctx.fail(f"unknown method {name!r}"
+                     + (f", did you mean {close[0]!r}?" if close else "")
+                     + f" (methods: {', '.join(REGISTRY)}"
+                     + (f"; also: {', '.join(others)})" if others else ")"))
+        return super().resolve_command(ctx, args)
 
 
 @cli.group(cls=_MethodCommands)
@@ -396,6 +412,10 @@ def _interrupted(signum: int, frame: Any) -> None:
     interrupt(KeyboardInterrupt(), frame)
 
 
+# a group called without a command (click 8.2 and later; 8.1 shows the help itself)
+_NO_ARGS = getattr(click.exceptions, "NoArgsIsHelpError", ())
+
+
 def main() -> None:
     signal.signal(signal.SIGTERM, _terminated)
     if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # (not if ignored)
@@ -407,6 +427,9 @@ def main() -> None:
     except click.exceptions.Abort:
         click.echo("Aborted.", err=True)
         sys.exit(1)
+    except _NO_ARGS as exc:  # `bistair patterns` alone shows its help, as a bare `bistair`
+        click.echo(exc.ctx.get_help())
+        sys.exit(0)
     except click.UsageError as exc:  # one line, like every other refusal
         where = f" (see '{exc.ctx.command_path} --help')" if exc.ctx is not None else ""
         click.echo(f"Error: {exc.format_message()}{where}", err=True)

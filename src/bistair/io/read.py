@@ -361,7 +361,8 @@ def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
     Raises
     ------
     BistairError
-        Captures or a spec file that cannot be read.
+        Captures or a spec file that cannot be read; no ``spec`` given and no
+        ``spec.json`` beside the captures (the message names ``--spec``).
 
     Examples
     --------
@@ -373,12 +374,22 @@ def find_spec(captures: Captures, spec: BaseSpec | str | Path | None = None,
     ...                                              period=16).to_json())
     >>> find_spec(tmp, tmp / "spec.json").method
     'graycode'
+    >>> (tmp / "spec.json").unlink()
+    >>> try:
+    ...     find_spec(tmp, files=[tmp / "00.png"])
+    ... except BistairError as exc:
+    ...     print(*str(exc).replace(str(tmp), "caps").split(": "), sep="\\n")
+    spec file caps/spec.json not found
+    give the spec that made the patterns with --spec FILE (spec= from Python)
     >>> shutil.rmtree(tmp)
     """
     if isinstance(spec, BaseSpec):
         return spec
     if spec is None:
         spec = default_spec_path(captures, files)
+        if not spec.exists():
+            raise BistairError(f"spec file {spec} not found: give the spec that made the "
+                               "patterns with --spec FILE (spec= from Python)")
     return load_spec(spec)
 
 
