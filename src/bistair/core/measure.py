@@ -24,7 +24,7 @@ import numpy as np
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
 from .measure_jit import fit_residual_energy, front_end, keep_coherent, phase_noise
 from .phase import shifts_of
-from .phase_jit import offset_parts
+from .phase_jit import offset_parts, shift_weights
 from .regions import MIN_REGION, fringe_regions
 from .sample import Sample, chi2_median, clip_level, kernel_view, set_noise, take_sample
 
@@ -240,16 +240,13 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         max(0.005, 2.0 * noise)
     sample = None if not check else take_sample(prepared, start, steps, pair, lowest,
                                                 threshold, shift_sign, phase_offset)
-    shifts = shifts_of(steps, shift_sign)
-    hi, lo = offset_parts(phase_offset)
     contrast = prepared.white is not None and prepared.black is not None
     none = np.zeros((1, 1), np.float32)
     raw, first, cos_frame = kernel_view(prepared, start, steps, pair)
     phi, mod, avg, valid, strong, sigma, theta, stair_mod, weak = front_end(  # pass 1
         raw, first, int(steps), cos_frame, float(prepared.scale),
-        np.sin(shifts).astype(np.float32), np.cos(shifts).astype(np.float32), hi, lo,
-        np.float32(2.0 / steps), clip_level(prepared), float(lowest), float(threshold),
-        np.float32(noise / np.sqrt(steps / 2.0)),
+        *shift_weights(steps, shift_sign), *offset_parts(phase_offset), clip_level(prepared),
+        float(lowest), float(threshold), np.float32(noise / np.sqrt(steps / 2.0)),
         prepared.white if contrast else none, prepared.black if contrast else none, contrast)
     if not maps:
         avg = None

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import chunk_count, kernel, kernel_frames
-from .phase_jit import _angle, _hypot32, _phase
+from .phase_jit import _angle, _hypot32, _phase, _quarter_sums, _quarter_turns
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -237,13 +237,13 @@ TILE_ROWS = 16  # rows a task of the full pass works on
 @kernel(parallel=True)
 def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
               sin_w: np.ndarray, cos_w: np.ndarray, off_hi: np.float32, off_lo: np.float32,
-              mod_scale: np.float32, full: float, lowest: float, threshold: float,
-              sigma_scale: np.float32, white: np.ndarray, black: np.ndarray, contrast: bool
+              full: float, lowest: float, threshold: float, sigma_scale: np.float32,
+              white: np.ndarray, black: np.ndarray, contrast: bool
               ) -> tuple[np.ndarray, ...]:
     """Pass 1 of a decode: every pixel of an N-step set (and its stair pair) measured in one
     pass over tiles of rows on every core, each frame read once.
 
-    Per pixel: the N-step sums (frame by frame along the row, in frame order), the wrapped
+    Per pixel: the N-step sums (:func:`~bistair.core.phase_jit._set_sums`), the wrapped
     phase less the phase offset in ``[0, 2*pi)`` (:func:`~bistair.core.phase_jit._phase`,
     the float32 arctangent of :func:`~bistair.core.phase_jit.arctan2_32`), the modulation
     ``2/N * hypot`` and the average (float32); whether a frame of the set or of the pair
@@ -265,11 +265,10 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
     scale : float
         Factor that turns a raw value into a fraction of full scale.
     sin_w, cos_w : (N,) float32 arrays
-        Sine and cosine of each frame's phase shift.
+        Sine and cosine of each frame's phase shift
+        (:func:`~bistair.core.phase_jit.shift_weights`).
     off_hi, off_lo : float32
         The phase offset (:func:`~bistair.core.phase_jit.offset_parts`).
-    mod_scale : float32
-        ``2/N``.
     full : float
         The raw value at which a frame clips.
     lowest, threshold : float
@@ -294,28 +293,27 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
 
     Examples
     --------
+    >>> from bistair.core.phase_jit import shift_weights
     >>> raw = np.zeros((4, 2, 3), np.uint8)
     >>> raw[0], raw[2] = 200, 100  # a phase of 0, a modulation of 50 levels
     >>> raw[0, 0, 0], raw[2, 0, 0] = 110, 100  # 5 levels
-    >>> d = 2 * np.pi * np.arange(4) / 4
     >>> dummy = np.zeros((1, 1), np.float32)
-    >>> out = front_end(raw, 0, 4, -1, 1 / 255, np.sin(d).astype(np.float32),
-    ...                 np.cos(d).astype(np.float32), np.float32(0), np.float32(0),
-    ...                 np.float32(0.5), 255.0, 0.01, 0.1, np.float32(0.01), dummy, dummy,
-    ...                 False)
+    >>> out = front_end(raw, 0, 4, -1, 1 / 255, *shift_weights(4), np.float32(0),
+    ...                 np.float32(0), 255.0, 0.01, 0.1, np.float32(0.01), dummy, dummy, False)
     >>> phi, valid, strong, weak = out[0], out[3], out[4], out[8]
     >>> float(phi.max()), bool(valid.all()), strong[0].tolist(), weak
     (0.0, True, [False, True, True], 1)
     """
     _, h, w = raw.shape
     s32 = np.float32(scale)
-    n32 = np.float32(steps)
     zero = np.float32(0.0)
+    full32 = np.float32(full)
     low32 = np.float32(lowest)
     thr32 = np.float32(threshold)
     sat32 = np.float32(1.02)
     need32 = np.float32(2.0 * lowest)
     floor32 = np.float32(1e-6)
+    quarter = _quarter_turns(sin_w, cos_w)
     phi = np.empty((h, w), np.float32)
     mod = np.empty((h, w), np.float32)
     avg = np.empty((h, w), np.float32)
@@ -334,31 +332,49 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
         top = np.empty(w, raw.dtype)
         count = 0
         for y in range(t * TILE_ROWS, min(h, (t + 1) * TILE_ROWS)):
-            a = avg[y]
-            first = raw[start, y]
-            for x in range(w):
-                s[x] = zero
-                c[x] = zero
-                a[x] = zero
-                top[x] = first[x]
-            for n in range(steps):  # frame by frame along the row: the loops vectorise
-                sw = sin_w[n]
-                cw = cos_w[n]
-                row = raw[start + n, y]
-                for x in range(w):
-                    v = row[x]
-                    top[x] = max(top[x], v)
-                    f = np.float32(v) * s32
-                    s[x] += sw * f
-                    c[x] += cw * f
-                    a[x] += f
             p = phi[y]
             m = mod[y]
-            for x in range(w):
-                num = -s[x]
-                a[x] = a[x] / n32
-                p[x] = _phase(num, c[x], off_hi, off_lo)
-                m[x] = _hypot32(num, c[x]) * mod_scale
+            a = avg[y]
+            if quarter:  # four quarter-turn shifts: each pixel's sums in registers
+                r0 = raw[start, y]
+                r1 = raw[start + 1, y]
+                r2 = raw[start + 2, y]
+                r3 = raw[start + 3, y]
+                for x in range(w):
+                    v0 = r0[x]
+                    v1 = r1[x]
+                    v2 = r2[x]
+                    v3 = r3[x]
+                    top[x] = max(max(v0, v1), max(v2, v3))
+                    num, den, av = _quarter_sums(v0, v1, v2, v3, s32, sin_w, cos_w)
+                    p[x] = _phase(num, den, off_hi, off_lo)
+                    m[x] = _hypot32(num, den) * np.float32(0.5)
+                    a[x] = av
+            else:  # frame by frame along the row, in frame order: the loops vectorise
+                n32 = np.float32(steps)
+                first = raw[start, y]
+                for x in range(w):
+                    s[x] = zero
+                    c[x] = zero
+                    a[x] = zero
+                    top[x] = first[x]
+                for n in range(steps):
+                    sw = sin_w[n]
+                    cw = cos_w[n]
+                    row = raw[start + n, y]
+                    for x in range(w):
+                        v = row[x]
+                        top[x] = max(top[x], v)
+                        f = np.float32(v) * s32
+                        s[x] += sw * f
+                        c[x] += cw * f
+                        a[x] += f
+                mod_scale = np.float32(2.0) / n32
+                for x in range(w):
+                    num = -s[x]
+                    a[x] = a[x] / n32
+                    p[x] = _phase(num, c[x], off_hi, off_lo)
+                    m[x] = _hypot32(num, c[x]) * mod_scale
             if pair >= 0:
                 cos_row = raw[pair, y]
                 sin_row = raw[pair + 1, y]
@@ -373,15 +389,17 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
             ok_row = valid[y]
             st_row = strong[y]
             sg = sigma[y]
-            for x in range(w):
+            for x in range(w):  # (bitwise: the loop vectorises)
                 mx = m[x]
-                ok = mx >= low32 and not (np.float64(top[x]) >= full and a[x] + mx > sat32)
-                if contrast:
-                    ok = ok and white[y, x] - black[y, x] >= need32
-                st = ok and mx >= thr32
+                ok = (mx >= low32) & ~((np.float32(top[x]) >= full32) & (a[x] + mx > sat32))
                 ok_row[x] = ok
-                st_row[x] = st
-                count += ok and not st
-                sg[x] = sigma_scale / (mx if mx >= floor32 else floor32)
+                st_row[x] = ok & (mx >= thr32)
+                sg[x] = sigma_scale / max(mx, floor32)
+            if contrast:
+                for x in range(w):
+                    ok_row[x] = ok_row[x] & (white[y, x] - black[y, x] >= need32)
+                    st_row[x] = st_row[x] & ok_row[x]
+            for x in range(w):  # (a loop of its own: counted inside, nothing vectorised)
+                count += ok_row[x] ^ st_row[x]
         weak[t] = count
     return phi, mod, avg, valid, strong, sigma, theta, stair_mod, weak.sum()

@@ -26,6 +26,7 @@ Examples
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -115,6 +116,60 @@ def _hypot32(a: np.float32, b: np.float32) -> np.float32:
     (correctly rounded; values of a capture neither overflow nor matter where they
     underflow)."""
     return np.sqrt(a * a + b * b)
+
+
+@_numba_inline
+def _quarter_turns(sin_w: np.ndarray, cos_w: np.ndarray) -> bool:
+    """Four shifts a quarter turn apart (:func:`shift_weights` of N = 4): weights 0 where
+    :func:`_quarter_sums` leaves them out."""
+    return (sin_w.size == 4 and sin_w[0] == 0 and sin_w[2] == 0 and cos_w[1] == 0
+            and cos_w[3] == 0)
+
+
+@_numba_inline
+def _quarter_sums(v0: Any, v1: Any, v2: Any, v3: Any, scale: np.float32,
+                  sin_w: np.ndarray, cos_w: np.ndarray
+                  ) -> tuple[np.float32, np.float32, np.float32]:
+    """``(num, den, avg)`` of a pixel's four quarter-turn frames (raw values times
+    ``scale``): ``-(s1*f1 + s3*f3)``, ``c0*f0 + c2*f2`` and the mean, float32; what the
+    frame-by-frame sums over all four weights give (the others are 0), in fewer
+    operations."""
+    f0 = np.float32(v0) * scale
+    f1 = np.float32(v1) * scale
+    f2 = np.float32(v2) * scale
+    f3 = np.float32(v3) * scale
+    num = -(sin_w[1] * f1 + sin_w[3] * f3)
+    den = cos_w[0] * f0 + cos_w[2] * f2
+    return num, den, (((f0 + f1) + f2) + f3) * np.float32(0.25)
+
+
+def shift_weights(steps: int, shift_sign: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Sine and cosine of each frame's phase shift ``shift_sign*2*pi*n/steps``, float32,
+    those within 1e-12 of 0 or of 1 in size made exactly so (``sin(pi)`` is 0, not 1.2e-16):
+    the weights of the N-step sums.
+
+    Parameters
+    ----------
+    steps : int
+        Number of frames ``N``.
+    shift_sign : int
+        +1 or -1.
+
+    Returns
+    -------
+    sin_w, cos_w : (N,) float32 arrays
+
+    Examples
+    --------
+    >>> [w.tolist() for w in shift_weights(4, -1)]
+    [[0.0, -1.0, 0.0, 1.0], [1.0, 0.0, -1.0, 0.0]]
+    """
+    d = shift_sign * 2.0 * math.pi * np.arange(steps) / steps
+    out = []
+    for w in (np.sin(d), np.cos(d)):
+        near = np.round(w)
+        out.append(np.where(np.abs(w - near) < 1e-12, near, w).astype(np.float32) + 0.0)
+    return out[0], out[1]
 
 
 def offset_parts(offset: float) -> tuple[np.float32, np.float32]:

@@ -14,17 +14,18 @@ Two things come from it:
 
 **The grid** (:func:`sample_grid`, column layout, the coded axis along the rows): runs of
 three adjacent rows every :data:`ROW_STEP` rows and pairs of adjacent columns every
-:data:`COL_STEP` columns, 3/32 of the pixels. A sample's maps are small images of the
-sampled rows and columns (``full[np.ix_(sample.rows, sample.cols)]``); a check takes
+:data:`COL_STEP` columns, 3/64 of the pixels (61 thousand of 1.3 million). A sample's
+maps are small images of the sampled rows and columns
+(``full[np.ix_(sample.rows, sample.cols)]``); a check takes
 differences inside a run (down the columns: ``a[1::3] - a[0::3]``) or a pair (along the
 rows: ``a[:, 1::2] - a[:, 0::2]``) and never across them (:meth:`Sample.blocks`).
 
 Examples
 --------
 >>> import numpy as np
->>> rows, cols = sample_grid(40, 12)
+>>> rows, cols = sample_grid(40, 20)
 >>> rows.tolist(), cols.tolist()
-([6, 7, 8, 22, 23, 24], [1, 2, 5, 6, 9, 10])
+([6, 7, 8, 22, 23, 24], [1, 2, 9, 10, 17, 18])
 """
 
 from __future__ import annotations
@@ -37,11 +38,11 @@ from scipy import special
 from .captures import Prepared
 from .jit import kernel_frames
 from .phase import shifts_of
-from .phase_jit import offset_parts
-from .sample_jit import residual_energy, sample_pixels, second_differences
+from .phase_jit import offset_parts, shift_weights
+from .sample_jit import masked_median, residual_energy, sample_pixels, second_differences
 
 ROW_STEP = 16  # a run of three adjacent rows every ROW_STEP rows
-COL_STEP = 4  # a pair of adjacent columns every COL_STEP columns
+COL_STEP = 8  # a pair of adjacent columns every COL_STEP columns
 
 
 @dataclass(frozen=True)
@@ -103,7 +104,7 @@ class Sample:
 
         Examples
         --------
-        >>> rows, cols = sample_grid(40, 12)
+        >>> rows, cols = sample_grid(40, 20)
         >>> s = Sample(rows, cols, np.zeros((1, 6, 6)), 1.0, *(np.zeros((6, 6)),) * 6)
         >>> s.blocks(s.phi).shape
         (2, 3, 3, 2)
@@ -129,8 +130,8 @@ def sample_grid(height: int, width: int) -> tuple[np.ndarray, np.ndarray]:
 
     Examples
     --------
-    >>> [a.tolist() for a in sample_grid(8, 8)]
-    [[0, 1, 2], [1, 2, 5, 6]]
+    >>> [a.tolist() for a in sample_grid(8, 12)]
+    [[0, 1, 2], [1, 2, 9, 10]]
     """
     first = (ROW_STEP - 3) // 2
     top = np.arange(first if height - 2 > first else 0, height - 2, ROW_STEP)
@@ -146,13 +147,17 @@ def set_noise(prepared: Prepared, start: int, steps: int) -> float:
 
     N >= 4: the part of the difference between vertically adjacent pixels' frames that the
     N-step fit leaves (the fit is a projection: for N = 4 the alternating sum ``f0 - f1 +
-    f2 - f3`` over 2), on every fourth row pair and column, its median squared norm scaled
-    by the chi-square median of N - 3 degrees of freedom (:func:`residual_energy`; it
-    agrees with the fitted residual's to 1e-5 and better). N = 3: the frames' second
-    differences down the columns, ``median|d2| / (0.6745 * sqrt(6))``
+    f2 - f3`` over 2), on every fourth row pair and column (the reference's own sample),
+    its median squared norm scaled by the chi-square median of N - 3 degrees of freedom
+    (:func:`~bistair.core.sample_jit.residual_energy`; it agrees with the fitted
+    residual's to 1e-5 and better). N = 3: the frames' second differences down the
+    columns, ``median|d2| / (0.6745 * sqrt(6))``
     (:func:`bistair.core.measure.along_fringe_noise`), on the runs of three rows of the
-    sample grid. Pixels that a frame of the set clips or that read 0 are left out (all are
-    kept when fewer than 100 are left).
+    sample grid and every second column (a sixth of the reference's values, so about
+    ``1.2 / sqrt(values)`` apart from it, relatively, at one standard error where the
+    values are not whole levels of a camera's; on every 8-bit capture the same figure).
+    Pixels that a frame of the set clips or that read 0 are left out (all are kept when
+    fewer than 100 are left).
 
     Parameters
     ----------
@@ -179,17 +184,20 @@ def set_noise(prepared: Prepared, start: int, steps: int) -> float:
     raw, start, _ = kernel_view(prepared, start, steps, None)
     full = float(prepared.full_scale)
     if steps <= 3:
-        rows, cols = sample_grid(*raw.shape[1:])
+        rows = sample_grid(*raw.shape[1:])[0]
+        cols = np.arange(0, raw.shape[2], 2, dtype=np.int64)
         d2, ok = second_differences(raw, int(start), int(steps), float(prepared.scale), rows,
                                     cols, full)
-        sample = d2[:, ok] if ok.sum() >= 100 else d2
-        return float(np.median(sample) / (0.6745 * np.sqrt(6.0))) if sample.size else 0.0
+        if d2.size == 0:
+            return 0.0
+        median = masked_median(d2.ravel(), np.broadcast_to(ok, d2.shape).ravel(), 100 * steps)
+        return float(median / (0.6745 * np.sqrt(6.0)))
     d = shifts_of(steps)
     basis = np.linalg.qr(np.stack([np.ones(steps), np.cos(d), np.sin(d)]).T)[0].T
     energy, ok = residual_energy(raw, int(start), int(steps), float(prepared.scale),
                                  np.ascontiguousarray(basis), full)
-    sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
-    return float(np.sqrt(np.median(sample) / (2.0 * chi2_median(steps - 3))))
+    median = masked_median(energy.ravel(), ok.ravel(), 100)  # (float32: to 6e-8)
+    return float(np.sqrt(median / (2.0 * chi2_median(steps - 3))))
 
 
 def take_sample(prepared: Prepared, start: int, steps: int, pair: int | None,
@@ -224,16 +232,14 @@ def take_sample(prepared: Prepared, start: int, steps: int, pair: int | None,
     >>> stack = np.round(255 * phase_shift_patterns(x, 16, 4, amplitude=0.3)).astype(np.uint8)
     >>> s = take_sample(prepare(stack, 4, "demo"), 0, 4, None, 0.01, 0.02)
     >>> s.values.shape, s.phi.shape, bool(s.strong.all()), round(float(s.mod.mean()), 2)
-    ((4, 6, 32), (6, 32), True, 0.3)
+    ((4, 6, 16), (6, 16), True, 0.3)
     """
     raw, first, cos_frame = kernel_view(prepared, start, steps, pair)
     rows, cols = sample_grid(*raw.shape[1:])
-    shifts = shifts_of(steps, shift_sign)
-    hi, lo = offset_parts(phase_offset)
     values, phi, mod, avg, clipped, theta, stair_mod = sample_pixels(
         raw, first, int(steps), cos_frame, float(prepared.scale),
-        np.sin(shifts).astype(np.float32), np.cos(shifts).astype(np.float32), hi, lo,
-        np.float32(2.0 / steps), clip_level(prepared), rows, cols)
+        *shift_weights(steps, shift_sign), *offset_parts(phase_offset), clip_level(prepared),
+        rows, cols)
     if raw is not prepared.raw:  # (frames converted for the kernel: the captures' own)
         values = prepared.raw[:, rows][:, :, cols]
     white, black = ((None, None) if prepared.white is None or prepared.black is None else

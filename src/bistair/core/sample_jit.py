@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import kernel
-from .phase_jit import _angle, _hypot32, _phase
+from .phase_jit import _angle, _hypot32, _phase, _quarter_sums, _quarter_turns
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -34,7 +34,7 @@ def residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
     The N-step fit of a pixel is the projection of its frames onto that span (for shifts
     evenly spread over a turn), so this is the squared norm of the difference of the two
     pixels' fit residuals: what :func:`~bistair.core.measure_jit.fit_residual_energy`
-    computes through the fitted sinusoid (to float rounding), in float64, without a cosine.
+    computes through the fitted sinusoid (to float rounding), without a cosine.
 
     Parameters
     ----------
@@ -51,8 +51,8 @@ def residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
 
     Returns
     -------
-    energy : (rows, cols) float64 array
-        The squared norms, ``rows`` the pairs of rows ``(4i, 4i + 1)``.
+    energy : (rows, cols) float32 array
+        The squared norms (computed in float64), ``rows`` the pairs of rows ``(4i, 4i + 1)``.
     ok : (rows, cols) bool array
         Neither pixel clipped or black in any frame.
 
@@ -70,28 +70,38 @@ def residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
     rows = min(len(range(0, h - 1, 4)), len(range(1, h, 4)))
     cols = (w + 3) // 4
     s32 = np.float32(scale)
-    energy = np.empty((rows, cols), np.float64)
+    energy = np.empty((rows, cols), np.float32)
     ok = np.empty((rows, cols), np.bool_)
-    for r in prange(rows):
-        g = np.empty(steps, np.float64)
+    for r in prange(rows):  # a row pair at a time, the loops along it vectorised
+        g = np.empty((steps, cols), np.float64)
+        total = np.empty(cols, np.float64)
+        good = ok[r]
         for c in range(cols):
-            x = 4 * c
-            good = True
+            total[c] = 0.0
+            good[c] = True
+        for n in range(steps):
+            top = raw[start + n, 4 * r]
+            low = raw[start + n, 4 * r + 1]
+            gn = g[n]
+            for c in range(cols):
+                v0 = top[4 * c]
+                v1 = low[4 * c]
+                d = np.float64(np.float32(v1) * s32) - np.float64(np.float32(v0) * s32)
+                gn[c] = d
+                total[c] += d * d
+                good[c] = good[c] and v0 > 0 and v1 > 0 and v0 < full and v1 < full
+        for k in range(3):
+            p = np.zeros(cols, np.float64)
             for n in range(steps):
-                v0 = raw[start + n, 4 * r, x]
-                v1 = raw[start + n, 4 * r + 1, x]
-                g[n] = np.float64(np.float32(v1) * s32) - np.float64(np.float32(v0) * s32)
-                good = good and v0 > 0 and v1 > 0 and v0 < full and v1 < full
-            total = 0.0
-            for n in range(steps):
-                total += g[n] * g[n]
-            for k in range(3):
-                p = 0.0
-                for n in range(steps):
-                    p += basis[k, n] * g[n]
-                total -= p * p
-            energy[r, c] = max(total, 0.0)
-            ok[r, c] = good
+                b = basis[k, n]
+                gn = g[n]
+                for c in range(cols):
+                    p[c] += b * gn[c]
+            for c in range(cols):
+                total[c] -= p[c] * p[c]
+        out = energy[r]
+        for c in range(cols):
+            out[c] = np.float32(max(total[c], 0.0))
     return energy, ok
 
 
@@ -158,8 +168,8 @@ def second_differences(raw: np.ndarray, start: int, steps: int, scale: float,
 @kernel(parallel=True)
 def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
                   sin_w: np.ndarray, cos_w: np.ndarray, off_hi: np.float32,
-                  off_lo: np.float32, mod_scale: np.float32, full: float, rows: np.ndarray,
-                  cols: np.ndarray) -> tuple[np.ndarray, ...]:
+                  off_lo: np.float32, full: float, rows: np.ndarray, cols: np.ndarray
+                  ) -> tuple[np.ndarray, ...]:
     """The pixels ``rows x cols`` of a capture measured as
     :func:`bistair.core.measure_jit.front_end` measures every pixel, with the same
     operations in the same order (the same bits): wrapped phase, modulation, average, the
@@ -177,11 +187,10 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
     scale : float
         Factor that turns a raw value into a fraction of full scale.
     sin_w, cos_w : (N,) float32 arrays
-        Sine and cosine of each frame's phase shift.
+        Sine and cosine of each frame's phase shift
+        (:func:`~bistair.core.phase_jit.shift_weights`).
     off_hi, off_lo : float32
         The phase offset (:func:`~bistair.core.phase_jit.offset_parts`).
-    mod_scale : float32
-        ``2/N``.
     full : float
         The raw value at which a frame clips.
     rows, cols : int64 arrays
@@ -200,12 +209,11 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
 
     Examples
     --------
+    >>> from bistair.core.phase_jit import shift_weights
     >>> raw = np.zeros((4, 3, 3), np.uint8)
     >>> raw[0], raw[2] = 200, 100  # a phase of 0
-    >>> d = 2 * np.pi * np.arange(4) / 4
-    >>> out = sample_pixels(raw, 0, 4, -1, 1 / 255, np.sin(d).astype(np.float32),
-    ...                     np.cos(d).astype(np.float32), np.float32(0), np.float32(0),
-    ...                     np.float32(0.5), 255.0, np.arange(2), np.arange(1))
+    >>> out = sample_pixels(raw, 0, 4, -1, 1 / 255, *shift_weights(4), np.float32(0),
+    ...                     np.float32(0), 255.0, np.arange(2), np.arange(1))
     >>> out[0].shape, out[1].ravel().tolist(), round(float(out[2][0, 0]), 4)
     ((4, 2, 1), [0.0, 0.0], 0.1961)
     """
@@ -214,6 +222,9 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
     nc = cols.size
     s32 = np.float32(scale)
     n32 = np.float32(steps)
+    zero = np.float32(0.0)
+    full32 = np.float32(full)
+    quarter = _quarter_turns(sin_w, cos_w)
     values = np.empty((frames, nr, nc), raw.dtype)
     phi = np.empty((nr, nc), np.float32)
     mod = np.empty((nr, nc), np.float32)
@@ -221,35 +232,141 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
     clipped = np.empty((nr, nc), np.bool_)
     theta = np.zeros((nr, nc), np.float32)
     stair_mod = np.zeros((nr, nc), np.float32)
-    for i in prange(nr):
+    for i in prange(nr):  # a sampled row at a time, as the full pass works a row
         y = rows[i]
-        for j in range(nc):
-            x = cols[j]
-            for f in range(frames):
-                values[f, i, j] = raw[f, y, x]
-            s = np.float32(0.0)
-            c = np.float32(0.0)
-            a = np.float32(0.0)
-            top = raw[start, y, x]
+        for f in range(frames):
+            src = raw[f, y]
+            dst = values[f, i]
+            for j in range(nc):
+                dst[j] = src[cols[j]]
+        p = phi[i]
+        m = mod[i]
+        a = avg[i]
+        top = np.empty(nc, raw.dtype)
+        if quarter:
+            r0 = values[start, i]
+            r1 = values[start + 1, i]
+            r2 = values[start + 2, i]
+            r3 = values[start + 3, i]
+            for j in range(nc):
+                top[j] = max(max(r0[j], r1[j]), max(r2[j], r3[j]))
+                num, den, av = _quarter_sums(r0[j], r1[j], r2[j], r3[j], s32, sin_w, cos_w)
+                p[j] = _phase(num, den, off_hi, off_lo)
+                m[j] = _hypot32(num, den) * np.float32(0.5)
+                a[j] = av
+        else:
+            s = np.empty(nc, np.float32)
+            c = np.empty(nc, np.float32)
+            first = values[start, i]
+            for j in range(nc):
+                s[j] = zero
+                c[j] = zero
+                a[j] = zero
+                top[j] = first[j]
             for n in range(steps):  # the full pass's sums, in its order
-                v = raw[start + n, y, x]
-                top = max(top, v)
-                f32 = np.float32(v) * s32
-                s += sin_w[n] * f32
-                c += cos_w[n] * f32
-                a += f32
-            num = -s
-            av = a / n32
-            phi[i, j] = _phase(num, c, off_hi, off_lo)
-            mod[i, j] = _hypot32(num, c) * mod_scale
-            avg[i, j] = av
-            if pair >= 0:
-                pc = raw[pair, y, x]
-                ps = raw[pair + 1, y, x]
-                top = max(top, max(pc, ps))
-                cc = np.float32(pc) * s32 - av
-                ss = np.float32(ps) * s32 - av
-                theta[i, j] = _angle(ss, cc)
-                stair_mod[i, j] = _hypot32(cc, ss)
-            clipped[i, j] = np.float64(top) >= full
+                sw = sin_w[n]
+                cw = cos_w[n]
+                row = values[start + n, i]
+                for j in range(nc):
+                    v = row[j]
+                    top[j] = max(top[j], v)
+                    f32 = np.float32(v) * s32
+                    s[j] += sw * f32
+                    c[j] += cw * f32
+                    a[j] += f32
+            mod_scale = np.float32(2.0) / n32
+            for j in range(nc):
+                num = -s[j]
+                a[j] = a[j] / n32
+                p[j] = _phase(num, c[j], off_hi, off_lo)
+                m[j] = _hypot32(num, c[j]) * mod_scale
+        if pair >= 0:
+            cos_row = values[pair, i]
+            sin_row = values[pair + 1, i]
+            th = theta[i]
+            sm = stair_mod[i]
+            for j in range(nc):
+                top[j] = max(top[j], max(cos_row[j], sin_row[j]))
+                cc = np.float32(cos_row[j]) * s32 - a[j]
+                ss = np.float32(sin_row[j]) * s32 - a[j]
+                th[j] = _angle(ss, cc)
+                sm[j] = _hypot32(cc, ss)
+        cl = clipped[i]
+        for j in range(nc):
+            cl[j] = np.float32(top[j]) >= full32
     return values, phi, mod, avg, clipped, theta, stair_mod
+
+
+@kernel()
+def masked_median(values: np.ndarray, ok: np.ndarray, least: int) -> float:
+    """``np.median(values[ok])`` of float32 values, or of all ``values`` when fewer than
+    ``least`` are ``ok`` (NaN for none): the two middle values averaged for an even count,
+    as NumPy does, found by counting the values' bits (two passes of 16 bits, no sort).
+
+    Parameters
+    ----------
+    values : 1-D float32 array
+        Finite.
+    ok : 1-D bool array
+        Of ``values``' size.
+    least : int
+        The fewest ``ok`` values to take the median of those alone.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> masked_median(np.float32([5, 1, 4, 2, 9]), np.array([1, 1, 1, 1, 0], bool), 1)
+    3.0
+    >>> masked_median(np.float32([5, -1, 4]), np.array([1, 0, 0], bool), 2)
+    4.0
+    """
+    count = 0
+    for i in range(values.size):
+        count += ok[i]
+    every = count < least
+    n = values.size if every else count
+    if n == 0:
+        return np.nan
+    bits = values.view(np.uint32)
+    sign = np.uint32(1 << 31)
+    keys = np.empty(n, np.uint32)  # in the order of the values: the sign bit flipped
+    high = np.zeros(1 << 16, np.int32)
+    j = 0
+    for i in range(values.size):
+        if every or ok[i]:
+            b = bits[i]
+            key = ~b if b & sign else b | sign
+            keys[j] = key
+            high[key >> 16] += 1
+            j += 1
+    ranks = (n // 2 - 1 if n % 2 == 0 else n // 2, n // 2)
+    tops = np.empty(2, np.int64)
+    rests = np.empty(2, np.int64)
+    for r in range(2):
+        rank = ranks[r]
+        top = 0
+        while rank >= high[top]:  # the 16 high bits of the rank-th key
+            rank -= high[top]
+            top += 1
+        tops[r] = top
+        rests[r] = rank
+    found = np.empty(2, np.uint32)
+    low = np.zeros(1 << 16, np.int32)
+    for r in range(2):
+        if r == 0 or tops[1] != tops[0]:
+            low[:] = 0
+            for i in range(n):
+                if keys[i] >> 16 == tops[r]:
+                    low[keys[i] & 0xFFFF] += 1
+        rank = rests[r]
+        bottom = 0
+        while rank >= low[bottom]:
+            rank -= low[bottom]
+            bottom += 1
+        key = np.uint32((tops[r] << 16) | bottom)
+        found[r] = key & ~sign if key & sign else ~key
+    pair = found.view(np.float32)
+    return (np.float64(pair[0]) + np.float64(pair[1])) / 2.0
