@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import inspect
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any, Literal, get_args, get_origin
 
 import numpy as np
@@ -323,8 +323,11 @@ class Codec:
 
         code = self.code_columns(cols, spec, fs, min_modulation)
         del cols
+        fs = replace(fs, stair=None)  # (the code's maps hold the pair: let go with them)
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
+        # the phase noise and the sample let go before the result is made
+        fs = replace(fs, sigma=None, sample=None)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
