@@ -5,7 +5,7 @@ measures them.
 Examples
 --------
 >>> import numpy as np
->>> basis = np.linalg.qr(np.float64([[1, 1, 1, 1], [1, 0, -1, 0], [0, 1, 0, -1]]).T)[0].T
+>>> basis = np.linalg.qr(np.float64([[1, 1, 1, 1], [1, 0, -1, 0], [0, 1, 0, -1]]).T)[0].T.copy()
 >>> raw = np.full((4, 9, 8), 100, np.uint8)
 >>> raw[0, 1, 0] = 104  # the pixel below (0, 0) off its neighbour by 4 levels in frame 0
 >>> energy, ok = residual_energy(raw, 0, 4, 1.0, basis, 255.0)
@@ -59,7 +59,7 @@ def residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
     Examples
     --------
     >>> d = 2 * np.pi * np.arange(5) / 5
-    >>> q = np.linalg.qr(np.stack([np.ones(5), np.cos(d), np.sin(d)]).T)[0].T
+    >>> q = np.linalg.qr(np.stack([np.ones(5), np.cos(d), np.sin(d)]).T)[0].T.copy()
     >>> raw = np.full((5, 2, 4), 0.5, np.float32)
     >>> raw[:, 1, 0] += np.float32(0.01) * np.cos(2 * d)  # a second harmonic below (0, 0)
     >>> energy, ok = residual_energy(raw, 0, 5, 1.0, q, 1.0)
