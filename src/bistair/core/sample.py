@@ -20,6 +20,21 @@ maps are small images of the sampled rows and columns
 differences inside a run (down the columns: ``a[1::3] - a[0::3]``) or a pair (along the
 rows: ``a[:, 1::2] - a[:, 0::2]``) and never across them (:meth:`Sample.blocks`).
 
+**For the checks.** :func:`bistair.core.measure.measure` keeps the sample of the set whose
+captures it judges (``check=True``: the set every codec's stage 1 measures) in
+``FringeSet.sample``, column layout; ``Codec._decode`` lets it go once the orders are made.
+What each check of the whole capture would read (today they still find their own
+samples in the full maps):
+
+- shift order: ``values[frames_of_a_set][:, strong]`` (every set's frames are there,
+  those of sets measured with ``check=False`` too);
+- axis: ``wrap(phi[:, 1::2] - phi[:, 0::2])`` along the rows and ``wrap(phi[1::3] -
+  phi[0::3])`` down the columns, where both pixels are ``strong``;
+- stair misfit: ``theta[strong]``;
+- phase convention: the code of the column pairs (``quantize(theta, levels)``, or a code
+  map at ``np.ix_(rows, cols)``) and ``phi`` where the pair's code steps;
+- stair fit: the orders at ``np.ix_(rows, cols)`` against ``theta``.
+
 Examples
 --------
 >>> import numpy as np
