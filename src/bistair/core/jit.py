@@ -357,13 +357,7 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
     if os.environ.get(RECORD_ENV) and not _STATE.get("recording"):
         _STATE["recording"] = True
         atexit.register(_record, os.environ[RECORD_ENV])
-    module = fn.__globals__  # the kernel's own module (a *_jit.py)
-    if module.get("prange") is range:  # its first kernel: helpers compiled once
-        module["prange"] = numba.prange
-        for name, value in list(module.items()):
-            how = getattr(value, "_inline", None)
-            if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
-                module[name] = numba.njit(cache=True, inline=how)(value)
+    _compile_helpers(fn.__globals__, numba)  # the kernel's own module (a *_jit.py)
     # nogil: two threads may run kernels at once (:func:`side_by_side`)
     compiled = numba.njit(cache=False, parallel=parallel, fastmath=False,
                           error_model="numpy", nogil=True)(fn)
@@ -372,6 +366,21 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
     except (RuntimeError, OSError):  # numba finds no folder to keep compiled code in
         pass  # compiled in every process, as numba's cache=True would refuse to
     return compiled
+
+
+def _compile_helpers(module: dict[str, Any], numba: Any) -> None:
+    """On a module's first kernel: its ``prange`` made numba's and its helpers (marked with
+    :func:`_numba_inline` or :func:`_numba_called`) compiled, once; a helper imported from
+    another module is compiled after that module's own helpers, which it may call."""
+    if module.get("prange") is not range:
+        return
+    module["prange"] = numba.prange
+    for name, value in list(module.items()):
+        how = getattr(value, "_inline", None)
+        if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
+            if value.__globals__ is not module:
+                _compile_helpers(value.__globals__, numba)
+            module[name] = numba.njit(cache=True, inline=how)(value)
 
 
 def _record(path: str) -> None:

@@ -104,7 +104,8 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
         Float32 stair phase in radians (:func:`~bistair.core.phase_jit.arctan2_32` of the frames
         minus ``avg``).
     modulation : ndarray
-        Float32 length of that (cos, sin) vector, same shape.
+        Float32 length of that (cos, sin) vector (``sqrt(c*c + s*s)`` in float32), same
+        shape.
 
     Examples
     --------
@@ -113,9 +114,9 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     >>> theta.astype(float).round(4).tolist(), mod.astype(float).round(3).tolist()
     ([-2.3562, -0.7854, 0.7854, 2.3562], [0.5, 0.5, 0.5, 0.5])
     """
-    c = np.asarray(cos_frame, dtype=np.float32) - avg
-    s = np.asarray(sin_frame, dtype=np.float32) - avg
-    return arctan2_32(s, c), np.hypot(s, c).astype(np.float32)
+    c = np.asarray(cos_frame, dtype=np.float32) - np.asarray(avg, np.float32)
+    s = np.asarray(sin_frame, dtype=np.float32) - np.asarray(avg, np.float32)
+    return arctan2_32(s, c), np.sqrt(c * c + s * s)
 
 
 def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:

@@ -2,8 +2,10 @@
 share: the stair pair's phase and modulation in one pass, and its quantisation to levels.
 
 :func:`bistair.core.stair.stair_phase` and :func:`bistair.core.stair.quantize` are the
-NumPy references; these give the same (the arctangent correctly rounded, as
-:func:`bistair.core.phase_jit.arctan2_32`).
+NumPy references; these give the same, bit for bit (the arctangent is
+:func:`bistair.core.phase_jit.arctan2_32`'s). A decode reads the pair in the phase stage's
+own pass (:func:`bistair.core.measure_jit.front_end`, the same arithmetic):
+:func:`pair_phase` serves a set measured without it.
 
 Examples
 --------
@@ -19,7 +21,7 @@ import math
 import numpy as np
 
 from .jit import PI32, kernel, kernel_frames
-from .phase_jit import _atan2
+from .phase_jit import _angle, _hypot32
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -49,13 +51,16 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
     """
     h, w = theta.shape
     scale = np.float32(levels / (2.0 * math.pi))
+    cycle = np.float64(levels)
     out = np.empty((h, w), np.int32)
     for y in prange(h):
-        for x in range(w):
-            if valid[y, x]:
-                out[y, x] = np.int32(math.floor((theta[y, x] + PI32) * scale)) % levels
-            else:
-                out[y, x] = -1
+        t = theta[y]
+        ok = valid[y]
+        o = out[y]
+        for x in range(w):  # the modulo in float64 (exact): the loop vectorises
+            q = np.float64(math.floor((t[x] + PI32) * scale))
+            q = q - cycle * math.floor(q / cycle)
+            o[x] = np.int32(q) if ok[x] else np.int32(-1)
     return out
 
 
@@ -70,10 +75,8 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
         for x in range(w):
             a = np.float32(raw[first, y, x]) * s32 - avg[y, x]
             b = np.float32(raw[first + 1, y, x]) * s32 - avg[y, x]
-            theta[y, x] = _atan2(b, a)
-            da = np.float64(a)
-            db = np.float64(b)
-            mod[y, x] = np.float32(math.sqrt(da * da + db * db))
+            theta[y, x] = _angle(b, a)
+            mod[y, x] = _hypot32(a, b)
     return theta, mod
 
 
@@ -98,7 +101,8 @@ def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     Returns
     -------
     theta : (H, W) float32 array
-        The stair phase in radians, ``arctan2(sin - A, cos - A)`` (as :func:`arctan2_32`).
+        The stair phase in radians, ``arctan2(sin - A, cos - A)`` (as
+        :func:`~bistair.core.phase_jit.arctan2_32`), in ``[-pi, pi]``.
     modulation : (H, W) float32 array
         The length of that vector.
 

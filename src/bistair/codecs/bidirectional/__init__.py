@@ -221,7 +221,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the stair phases sit ...
     """
-    theta, stair_mod = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)
+    theta, stair_mod = fs.stair if fs.stair is not None else pair_phase(
+        prepared.raw, spec.steps, prepared.scale, fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
         refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
