@@ -73,6 +73,7 @@ from .profiles import (
     stair_row_profiles,
     stair_values,
 )
+from .response import linear_stair
 from .stairs import stair_edges, stair_fit
 from .stairs_jit import stair_agreement, stair_noise
 
@@ -293,7 +294,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
         if links and bad > 0.005 * links:
             info["warnings"] = [f"the paper decoder's orders do not step by one across "
                                 f"{100 * bad / links:.1f}% of the phase jumps"]
-    else:
+    else:  # read the levels where this capture's response puts them
+        theta, ks, exponent = linear_stair(fs, theta, code.maps["stair_modulation"], ks, spec)
+        if exponent != 1.0:
+            info["stair_response"] = round(exponent, 2)
         order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
     misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
     info["stair_misfit"] = round(misfit, 4)
