@@ -74,7 +74,6 @@ from .profiles import (
 )
 from .response import (
     LEVEL_DOUBT,
-    UNREADABLE,
     doubtful_orders,
     level_offsets,
     linear_stair,
@@ -288,8 +287,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     """
     if strategy not in ("region", "paper"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
-    theta, ks = code.maps["stair_phase"], code.code
+    theta, ks, stair_mod = code.maps["stair_phase"], code.code, code.maps["stair_modulation"]
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
+    readings = None
     if strategy == "paper":
         order = paper_orders(ks, theta, fs, spec).astype(np.int32)
         # the published decoder as published: its orders are judged by the same limit as
@@ -300,11 +300,12 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
             info["warnings"] = [f"the paper decoder's orders do not step by one across "
                                 f"{100 * bad / links:.1f}% of the phase jumps"]
     else:  # read the levels where this capture's response puts them
-        theta, ks, exponent = linear_stair(fs, theta, code.maps["stair_modulation"], ks, spec)
-        if exponent != 1.0:
-            info["stair_response"] = round(exponent, 2)
-        order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
-    misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
+        lin = linear_stair(fs, theta, stair_mod, ks, spec)
+        if lin.readings is not None:
+            info["stair_response"] = round(lin.exponent, 2)
+        order = _region_orders(fs, lin.theta, stair_mod, lin.ks, spec, info)
+        readings = lin.readings
+    misfit = stair_fit(fs, theta, stair_mod, order, spec, readings=readings)
     info["stair_misfit"] = round(misfit, 4)
     band = info.get("group_height", spec.group_rows) * (1 - spec.local_rows / spec.group_rows)
     if band < MIN_BAND_PX:
@@ -324,12 +325,6 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
             f"stair level whose band rows read at least {100 * LEVEL_DOUBT:.0f}% of the way "
             "to halfway to the next level (median): regions showing one take their order "
             "from their neighbours or stay undecided")]
-    if info.get("level_offset", 0.0) > UNREADABLE:
-        refuse(f"the band rows read {100 * info['level_offset']:.0f}% of the way to halfway "
-               "between two stair levels (median; 50% at random): the levels cannot be told "
-               f"apart (too much noise or blur for {spec.partitions} x {spec.stairs} levels, "
-               "or a projector response the decoder cannot undo: compensate its gamma, spec "
-               "field gamma, 'bistair gamma')")
     if misfit > 0.1:
         refuse(
             f"at {100 * misfit:.0f}% of the decoded pixels "

@@ -8,14 +8,16 @@ scene at 11 x 11, 20% of its pixels). :func:`linear_stair` fits the response exp
 sample of the capture's own stair phases (:func:`~bistair.core.stair.fit_level_response`)
 and, where it moves the readings, maps the stair phase so that each level reads where the
 patterns put it (:func:`~bistair.core.stair.relinearize`); the band rows are then read
-against the levels as before. :func:`level_offsets` says how well they can be: a level
-whose rows read far from it decides no region alone (:func:`doubtful_orders`), and the
-decode refuses where the rows as a whole read nearly as far from the levels as a coin toss.
+against the levels as before. :func:`level_offsets` says how well each level can be: one
+whose rows read far from it (where the response squeezes levels together its noise counts
+for more) decides no region alone (:func:`doubtful_orders`); its regions take their orders
+from their neighbours or stay undecided.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -42,10 +44,30 @@ MIN_SHIFT = 0.25  # readings moved less than this share of a half gap: read as t
 MAX_RATIO = 0.9  # the fit must bring the phases this much nearer the readings than the levels
 
 
+@dataclass(frozen=True)
+class LinearStair:
+    """The stair phase read where a capture's response puts the levels.
+
+    Attributes
+    ----------
+    theta : (H, W) float32 stair phase, mapped so that the levels read where the patterns
+        put them (the capture's own where not mapped).
+    ks : (H, W) int32 its local stair level per pixel, -1 where not valid.
+    exponent : the fitted response exponent, 1.0 where the phase was not mapped.
+    readings : (L,) where the union levels read in the capture's own stair phase (None
+        where not mapped).
+    """
+
+    theta: np.ndarray
+    ks: np.ndarray
+    exponent: float = 1.0
+    readings: np.ndarray | None = None
+
+
 def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np.ndarray,
-                 spec: BidirectionalSpec) -> tuple[np.ndarray, np.ndarray, float]:
+                 spec: BidirectionalSpec) -> LinearStair:
     """The stair phase and its local levels, mapped so that the levels read where the
-    patterns put them, and the response exponent that moved them (1.0: not mapped).
+    patterns put them, the response exponent that moved them and where they read.
 
     The exponent is fitted to about 5000 valid pixels away from the fringe edges whose stair
     phase noise is under 0.3 rad (at least 500). The phase is mapped only where that
@@ -69,12 +91,8 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
 
     Returns
     -------
-    theta : numpy.ndarray
-        The (mapped) stair phase, float32.
-    ks : numpy.ndarray
-        Its local stair level per pixel.
-    exponent : float
-        The fitted response exponent, 1.0 where the phase was not mapped.
+    LinearStair
+        The (mapped) stair phase, its local levels, the exponent and the readings.
 
     Examples
     --------
@@ -93,8 +111,8 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
     >>> theta, smod = code.maps["stair_phase"], code.maps["stair_modulation"]
     >>> code.code[0, 2:12:4].tolist()  # fringes 0, 1, 2: local levels 0, 1, 2
     [1, 1, 1]
-    >>> lin, ks, exponent = linear_stair(fs, theta, smod, code.code, spec)
-    >>> ks[0, 2:12:4].tolist(), round(exponent, 1)
+    >>> lin = linear_stair(fs, theta, smod, code.code, spec)
+    >>> lin.ks[0, 2:12:4].tolist(), round(lin.exponent, 1)
     ([0, 1, 2], 2.2)
     """
     levels = union_levels(spec.partitions, spec.stairs)
@@ -103,18 +121,18 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
     phi = fs.phi.ravel()[idx]
     keep = (sigma < 0.3) & (phi > 0.5) & (phi < TWO_PI - 0.5)
     if keep.sum() < 500 or levels.size < 3:
-        return theta, ks, 1.0
+        return LinearStair(theta, ks)
     exponent, ratio = fit_level_response(theta.ravel()[idx][keep], levels, spec.offset,
                                          spec.amplitude)
     read = level_readings(levels, exponent, spec.offset, spec.amplitude)
     shift = float(np.max(np.abs(wrap(read - levels)) / half_gaps(levels)))
     if ratio > MAX_RATIO or shift < MIN_SHIFT:
-        return theta, ks, 1.0
+        return LinearStair(theta, ks)
     try:
         mapped = relinearize(theta, read, levels)
     except ValueError:  # readings out of the levels' order: no power law explains them
-        return theta, ks, 1.0
-    return mapped, quantize32(mapped, spec.stairs, fs.valid), exponent
+        return LinearStair(theta, ks)
+    return LinearStair(mapped, quantize32(mapped, spec.stairs, fs.valid), exponent, read)
 
 
 def level_offsets(prof: RowProfiles, levels: np.ndarray) -> tuple[float, np.ndarray]:
@@ -214,4 +232,3 @@ def doubtful_orders(per_level: np.ndarray, levels: np.ndarray, stairs: int,
 
 
 LEVEL_DOUBT = 0.35  # a level whose rows read this far from it (median) decides no region alone
-UNREADABLE = 0.4  # band rows this far from their levels (median): refused
