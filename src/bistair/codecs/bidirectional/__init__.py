@@ -372,7 +372,8 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         prof = profiles(labels)
         if "level_offset" not in info:  # how far the band rows read from the levels
             offset, per_level = level_offsets(prof, levels)
-            info["level_offset"] = round(offset, 3)
+            info.update(level_offset=round(offset, 3),
+                        worst_level_offset=round(float(per_level.max()), 3))
             doubt[:] = doubtful_orders(per_level, levels, spec.stairs, spec.partitions)
             if doubt.any():
                 info["doubtful_orders"] = int(doubt.sum())
