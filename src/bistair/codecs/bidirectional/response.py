@@ -40,8 +40,8 @@ if TYPE_CHECKING:
     from . import BidirectionalSpec
 
 SAMPLES = 5000  # stair phases the response is fitted to
-MIN_SHIFT = 0.25  # readings moved less than this share of a half gap: read as they are
-MAX_RATIO = 0.9  # the fit must bring the phases this much nearer the readings than the levels
+MIN_SHIFT = 0.2  # readings moved less than this share of a half gap: read as they are
+MAX_RATIO = 0.95  # the fit must bring the phases this much nearer the readings than the levels
 
 
 @dataclass(frozen=True)
@@ -71,10 +71,13 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
 
     The exponent is fitted to about 5000 valid pixels away from the fringe edges whose stair
     phase noise is under 0.3 rad (at least 500). The phase is mapped only where that
-    exponent moves some level's reading by at least a quarter of the way to halfway
-    (``MIN_SHIFT`` of its half gap) and fits the phases better than the levels do (mean
-    clipped squared distance at most ``MAX_RATIO`` of theirs): a compensated projector
-    decodes exactly as before.
+    exponent moves some level's reading by at least ``MIN_SHIFT`` of the way to halfway and
+    fits the phases better than the levels do (mean clipped squared distance at most
+    ``MAX_RATIO`` of theirs): a compensated projector decodes exactly as before. On the
+    rendered scenes (every preset, 6 x 6 to 12 x 12 levels, 1% and 3% noise, 640 x 512)
+    the compensated captures fit exponents of 0.79-1.17 to their noise (moving a level up to
+    0.33 of the way) that fit no better than 0.988 of the levels; under a gamma of 2.2 left
+    uncompensated, 2.06-2.45, at least 0.66 of the way, at most 0.881.
 
     Parameters
     ----------
