@@ -260,7 +260,7 @@ def fit_level_response(theta: np.ndarray, levels: np.ndarray, offset: float = 0.
     Each phase (binned in 1024 steps of the circle) counts its squared distance to the
     nearest reading, clipped at a quarter of the smallest gap between two levels (phases
     between bands, blurred or noisy, weigh no more than that); exponents 0.4 to 4 in steps
-    of 10%, then of 1% around the best.
+    of 10%, then of 2% around the best.
 
     Parameters
     ----------
@@ -312,32 +312,31 @@ def fit_level_response(theta: np.ndarray, levels: np.ndarray, offset: float = 0.
     base = cost(1.0)
     coarse = np.exp(np.linspace(math.log(0.4), math.log(4.0), 25))  # steps of 10%
     best = float(coarse[int(np.argmin([cost(e) for e in coarse]))])
-    fine = [1.0, *(best * np.exp(np.linspace(-0.1, 0.1, 21)))]
+    fine = [1.0, *(best * np.exp(np.linspace(-0.1, 0.1, 11)))]
     costs = [cost(e) for e in fine]
     i = int(np.argmin(costs))  # ties keep 1.0 (listed first)
     return float(fine[i]), costs[i] / base if base > 0 else 0.0
 
 
-def relinearize(theta: np.ndarray, readings: np.ndarray, levels: np.ndarray,
-                bins: int = 8192) -> np.ndarray:
-    """The stair phase mapped so that each level's reading lands on the level: piecewise
-    linear on the circle between the readings, through a table of ``bins`` steps.
+def level_table(readings: np.ndarray, levels: np.ndarray, bins: int = 8192) -> np.ndarray:
+    """The map that puts each level's reading on the level, piecewise linear on the circle
+    between the readings, as a table: entry ``i`` is where the phases from ``-pi + 2*pi*i /
+    bins`` on go (its step's centre mapped; the error at most half a step times the map's
+    slope).
 
     Parameters
     ----------
-    theta : ndarray
-        Stair phases in radians in [-pi, pi], any shape.
     readings : (L,) float array
         Where the levels read (:func:`level_readings`), in the levels' circular order.
     levels : (L,) float array
         The levels' phases, radians.
     bins : int
-        Table steps over the circle (the map's error at most half a step times its slope).
+        Table steps over the circle.
 
     Returns
     -------
-    float32 ndarray
-        The mapped phases in [-pi, pi), ``theta``'s shape.
+    (bins,) float32 array
+        The mapped phases, in [-pi, pi).
 
     Raises
     ------
@@ -347,9 +346,13 @@ def relinearize(theta: np.ndarray, readings: np.ndarray, levels: np.ndarray,
     Examples
     --------
     >>> levels = stair_level_phase(np.arange(6), 6)
-    >>> readings = level_readings(levels, 2.2)
-    >>> bool(np.allclose(relinearize(readings, readings, levels), levels, atol=1e-3))
-    True
+    >>> table = level_table(level_readings(levels, 2.2), levels)
+    >>> table.shape, table.dtype
+    ((8192,), dtype('float32'))
+    >>> level_table(levels[::-1] + 0.0, levels)
+    Traceback (most recent call last):
+    ...
+    ValueError: the readings do not keep the levels' circular order
     """
     readings = np.asarray(readings, dtype=np.float64)
     levels = np.asarray(levels, dtype=np.float64)
@@ -362,7 +365,33 @@ def relinearize(theta: np.ndarray, readings: np.ndarray, levels: np.ndarray,
     x = np.r_[x - TWO_PI, x, x + TWO_PI]
     y = np.r_[y - TWO_PI, y, y + TWO_PI]
     grid = -np.pi + (np.arange(bins) + 0.5) * (TWO_PI / bins)
-    table = wrap(np.interp(grid, x, y)).astype(np.float32)
-    step = np.float32(bins / TWO_PI)
+    return wrap(np.interp(grid, x, y)).astype(np.float32)
+
+
+def relinearize(theta: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """NumPy reference of :func:`~bistair.core.stair_jit.relinearize32`, which a decode runs:
+    stair phases through a :func:`level_table` (float32 arithmetic, as the kernel's).
+
+    Parameters
+    ----------
+    theta : ndarray
+        Stair phases in radians in [-pi, pi], any shape.
+    table : (bins,) float32 array
+        From :func:`level_table`.
+
+    Returns
+    -------
+    float32 ndarray
+        The mapped phases, ``theta``'s shape.
+
+    Examples
+    --------
+    >>> levels = stair_level_phase(np.arange(6), 6)
+    >>> readings = level_readings(levels, 2.2)
+    >>> mapped = relinearize(readings.astype(np.float32), level_table(readings, levels))
+    >>> bool(np.allclose(mapped, levels, atol=1e-3))
+    True
+    """
+    step = np.float32(table.size / TWO_PI)
     index = ((np.asarray(theta, dtype=np.float32) + np.float32(np.pi)) * step).astype(np.int64)
-    return table[np.clip(index, 0, bins - 1)]
+    return table[np.clip(index, 0, table.size - 1)]

@@ -7,7 +7,7 @@ nearer its neighbour than itself and whole partitions took their neighbour's ord
 scene at 11 x 11, 20% of its pixels). :func:`linear_stair` fits the response exponent to a
 sample of the capture's own stair phases (:func:`~bistair.core.stair.fit_level_response`)
 and, where it moves the readings, maps the stair phase so that each level reads where the
-patterns put it (:func:`~bistair.core.stair.relinearize`); the band rows are then read
+patterns put it (:func:`~bistair.core.stair.level_table`); the band rows are then read
 against the levels as before. :func:`level_offsets` says how well each level can be: one
 whose rows read far from it (where the response squeezes levels together its noise counts
 for more) decides no region alone (:func:`doubtful_orders`); its regions take their orders
@@ -28,18 +28,17 @@ from ...core.stair import (
     fit_level_response,
     half_gaps,
     level_readings,
-    relinearize,
+    level_table,
     stair_level_phase,
 )
-from ...core.stair_jit import quantize32
+from ...core.stair_jit import relinearize32
 from .bands import nearest_level, union_levels
 from .profiles import RowProfiles
-from .stairs_jit import decoded_sample
 
 if TYPE_CHECKING:
     from . import BidirectionalSpec
 
-SAMPLES = 5000  # stair phases the response is fitted to
+SAMPLES = 5000  # a quarter of the grid of pixels the response is fitted to
 MIN_SHIFT = 0.2  # readings moved less than this share of a half gap: read as they are
 MAX_RATIO = 0.95  # the fit must bring the phases this much nearer the readings than the levels
 
@@ -69,8 +68,9 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
     """The stair phase and its local levels, mapped so that the levels read where the
     patterns put them, the response exponent that moved them and where they read.
 
-    The exponent is fitted to about 5000 valid pixels away from the fringe edges whose stair
-    phase noise is under 0.3 rad (at least 500). The phase is mapped only where that
+    The exponent is fitted to the valid pixels of a grid of about 20000 (every few pixels of
+    every few rows) away from the fringe edges whose stair phase noise is under 0.3 rad (at
+    least 500). The phase is mapped only where that
     exponent moves some level's reading by at least ``MIN_SHIFT`` of the way to halfway and
     fits the phases better than the levels do (mean clipped squared distance at most
     ``MAX_RATIO`` of theirs): a compensated projector decodes exactly as before. On the
@@ -119,23 +119,27 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
     ([0, 1, 2], 2.2)
     """
     levels = union_levels(spec.partitions, spec.stairs)
-    idx = decoded_sample(fs.valid, ks, SAMPLES)
-    sigma = fs.noise * math.sqrt(2.0) / np.maximum(stair_mod.ravel()[idx], 1e-6)
-    phi = fs.phi.ravel()[idx]
-    keep = (sigma < 0.3) & (phi > 0.5) & (phi < TWO_PI - 0.5)
+    # every step-th pixel of every step-th row: about 4 * SAMPLES pixels, without a pass
+    # over the image
+    step = max(1, math.isqrt(theta.size // (4 * SAMPLES)))
+    grid = (slice(None, None, step), slice(None, None, step))
+    sigma = fs.noise * math.sqrt(2.0) / np.maximum(stair_mod[grid], 1e-6)
+    phi = fs.phi[grid]
+    keep = fs.valid[grid] & (sigma < 0.3) & (phi > 0.5) & (phi < TWO_PI - 0.5)
     if keep.sum() < 500 or levels.size < 3:
         return LinearStair(theta, ks)
-    exponent, ratio = fit_level_response(theta.ravel()[idx][keep], levels, spec.offset,
+    exponent, ratio = fit_level_response(theta[grid][keep], levels, spec.offset,
                                          spec.amplitude)
     read = level_readings(levels, exponent, spec.offset, spec.amplitude)
     shift = float(np.max(np.abs(wrap(read - levels)) / half_gaps(levels)))
     if ratio > MAX_RATIO or shift < MIN_SHIFT:
         return LinearStair(theta, ks)
     try:
-        mapped = relinearize(theta, read, levels)
+        table = level_table(read, levels)
     except ValueError:  # readings out of the levels' order: no power law explains them
         return LinearStair(theta, ks)
-    return LinearStair(mapped, quantize32(mapped, spec.stairs, fs.valid), exponent, read)
+    mapped, local = relinearize32(theta, table, spec.stairs, fs.valid)
+    return LinearStair(mapped, local, exponent, read)
 
 
 def level_offsets(prof: RowProfiles, levels: np.ndarray) -> tuple[float, np.ndarray]:
@@ -188,16 +192,17 @@ def level_offsets(prof: RowProfiles, levels: np.ndarray) -> tuple[float, np.ndar
     order = np.argsort(share)
     cum = np.cumsum(weight[order])
     offset = float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
-    # per level: the rows sorted by level, then share; each level's weighted median
-    order = np.lexsort((share, nearest))
-    level, cum = nearest[order], np.cumsum(weight[order])
-    first = np.searchsorted(level, np.arange(levels.size))
-    last = np.searchsorted(level, np.arange(levels.size), side="right")
+    # per level: the rows grouped by level, each group's shares ascending; a group's
+    # weighted median is where the running weight passes half of the group's
+    grouped = order[np.argsort(nearest[order], kind="stable")]
+    cum = np.cumsum(weight[grouped])
+    first, last = (np.searchsorted(nearest[grouped], np.arange(levels.size), side=side)
+                   for side in ("left", "right"))
     before = np.where(first > 0, cum[np.maximum(first - 1, 0)], 0.0)
     total = np.where(last > first, cum[np.maximum(last - 1, 0)], 0.0) - before
-    for j in np.flatnonzero(total > 0):
-        at = np.searchsorted(cum[first[j]:last[j]], before[j] + 0.5 * total[j])
-        per_level[j] = share[order][first[j] + min(int(at), last[j] - first[j] - 1)]
+    seen = total > 0
+    at = np.minimum(np.searchsorted(cum, before + 0.5 * total), last - 1)
+    per_level[seen] = share[grouped][at[seen]]
     return offset, per_level
 
 
