@@ -4,11 +4,11 @@ preset scene, codeword count, optics and seed, scored against the rendered truth
 For each case the table gives the response exponent the decoder fitted to the stair levels
 (``-``: read as they are), how far the band rows read from their levels (``level_offset``,
 the median share of half a gap) and from the worst level (``worst_level_offset``, against
-the limit ``LEVEL_DOUBT`` = 0.35), the orders read with doubt (those with a level past that
-limit), the stair check's share of contradicting pixels (``stair_misfit``, refused over
-0.1), the share of the decoded pixels more than half a period off the truth, the share of
-the truth's pixels decoded, and what a check refused (each case is decoded with
-``force=True``). A case is *silently wrong* when over 1% of its
+the limit ``LEVEL_DOUBT`` = 0.35), the levels past that limit (a region reading one is
+faint: its neighbours decide), the stair check's share of contradicting pixels
+(``stair_misfit``, refused over 0.1), the share of the decoded pixels more than half a
+period off the truth, the share of the truth's pixels decoded, and what a check refused
+(each case is decoded with ``force=True``). A case is *silently wrong* when over 1% of its
 decoded pixels are wrong and no check refused it, a *false refusal* when a check refused a
 decode at most 1% wrong.
 
@@ -92,7 +92,7 @@ def score(stack: np.ndarray, spec, coord: np.ndarray, mask: np.ndarray) -> dict:
     return dict(wrong=wrong, coverage=float(both.sum() / max(int(mask.sum()), 1)),
                 response=info.get("stair_response"), offset=info.get("level_offset", 0.0),
                 worst=info.get("worst_level_offset", 0.0), misfit=info.get("stair_misfit", 0.0),
-                doubtful=info.get("doubtful_orders", 0), forced=info.get("forced", []),
+                doubtful=info.get("doubtful_levels", 0), forced=info.get("forced", []),
                 seconds=time.perf_counter() - start)
 
 

@@ -1,14 +1,13 @@
-"""Stair levels that cannot be read where the patterns put them (issue 31, item 2).
-
-A projector gamma the patterns do not compensate moves each stair level's reading by its own
+"""Stair levels that cannot be read where the patterns put them (issue 31, item 2). A
+projector gamma the patterns do not compensate moves each stair level's reading by its own
 amount; with 11 x 11 levels some read nearer a neighbour than themselves, and whole
-partitions of the paper scene took their neighbour's order with exit 0 (12-24% of its valid
-pixels under the hard optics at 640 x 512). The default decoder now fits the response to the
-capture's own stair phases and reads the levels where it puts them; a level whose band rows
-still read far from it (where the response squeezes levels together its noise counts for
-more) decides no region alone. The rendered scenes: 640 x 512, paper-sim's projector of
-1080 columns, the hard optics of the robustness issue (3% noise, 1.2 px camera and 1 px
-projector blur, 15% ambient, gamma 2.2).
+partitions of the paper scene took their neighbour's order with exit 0 (12-24% of its decoded
+pixels under the hard optics at 640 x 512). The default decoder now fits the response to
+the capture's own stair phases and reads the levels where it puts them; a region that reads
+a level whose band rows still read far from it (where the response squeezes levels together
+its noise counts for more) decides nothing alone. The rendered scenes: 640 x 512, the hard
+optics of the robustness issue (3% noise, 1.2 px camera and 1 px projector blur, 15%
+ambient, gamma 2.2).
 """
 
 from __future__ import annotations
@@ -26,6 +25,12 @@ DEFAULT = dict(gamma=2.2, read_noise=0.01, camera_blur=1.0, ambient=0.05)
 @pytest.fixture(scope="module")
 def paper_hard():
     rig, geometry = preset("paper-sim", camera_size=(640, 512))
+    return rig, trace(rig, geometry, Imaging(**HARD))
+
+
+@pytest.fixture(scope="module")
+def sculptures_hard():
+    rig, geometry = preset("two-sculptures", camera_size=(640, 512))
     return rig, trace(rig, geometry, Imaging(**HARD))
 
 
@@ -53,36 +58,37 @@ def _decode(scene, optics: dict, seed: int, levels: int, period: int, compensate
 
 
 def test_levels_are_read_where_an_uncompensated_response_puts_them(paper_hard):
-    """The issue's case: 11 x 11 at T = 16, gamma not compensated (13.9% of the valid pixels
-    a partition off before, exit 0; now 0.32% wrong, 85.6% of the truth decoded)."""
+    """The issue's case: 11 x 11 at T = 16, gamma not compensated (13.9% of the decoded
+    pixels a partition off before, exit 0; now none, 89.9% of the truth decoded)."""
     result, wrong, coverage = _decode(paper_hard, HARD, 1, 11, 16, compensated=False)
     assert not isinstance(result, str), result
     assert abs(result.info["stair_response"] - 2.2) < 0.15
     assert wrong <= 0.005 and coverage >= 0.8, (wrong, coverage)
 
 
-def test_a_level_read_with_doubt_decides_no_region_alone(paper_hard):
-    """Seed 0 of the same: levels 0-2, squeezed together by the response, read 0.37-0.44 of
-    half a gap from their places; one region read a single band of level 1 as the merged
-    order 12 (local and partition level 1) and its neighbours followed it: 1.77% of the
-    pixels two orders off with their orders taken at face value, 0.08% now."""
-    result, wrong, coverage = _decode(paper_hard, HARD, 0, 11, 16, compensated=False)
+def test_a_region_reading_a_doubtful_level_decides_nothing_alone(sculptures_hard):
+    """Two sculptures at 8 x 8, the same optics, seed 1: the response squeezes levels 0 and 1
+    together and their rows read up to 0.32 of the way to halfway; a fringe of the bust
+    read its local level 0 and partition level 3 the other way round (order 3 for 24) and its
+    neighbours followed: 5.15% of the pixels 21 orders off with the regions' readings taken
+    at face value, none now (97.5% of the truth decoded)."""
+    result, wrong, coverage = _decode(sculptures_hard, HARD, 1, 8, 30, compensated=False)
     assert not isinstance(result, str), result
-    assert result.info["doubtful_orders"] == 57  # three of the 11 levels, in either stair
-    assert wrong <= 0.005 and coverage >= 0.8, (wrong, coverage)
+    assert result.info["doubtful_levels"] >= 1
+    assert wrong <= 0.005 and coverage >= 0.9, (wrong, coverage)
 
 
 def test_the_same_optics_at_8x8_are_accepted_and_right(paper_hard):
     result, wrong, coverage = _decode(paper_hard, HARD, 2, 8, 30, compensated=False)
     assert not isinstance(result, str), result
     assert "forced" not in result.info
-    assert wrong <= 0.005 and coverage >= 0.95, (wrong, coverage)  # measured 0, 97.7%
+    assert wrong <= 0.005 and coverage >= 0.95, (wrong, coverage)  # measured 0, 97.1%
 
 
 def test_a_compensated_capture_is_read_as_it_is(paper_hard):
     result, wrong, coverage = _decode(paper_hard, HARD, 1, 11, 16, compensated=True)
     assert not isinstance(result, str), result
-    assert "stair_response" not in result.info and "doubtful_orders" not in result.info
+    assert "stair_response" not in result.info and "doubtful_levels" not in result.info
     assert wrong <= 0.005 and coverage >= 0.9, (wrong, coverage)
 
 

@@ -74,7 +74,7 @@ from .profiles import (
 )
 from .response import (
     LEVEL_DOUBT,
-    doubtful_orders,
+    doubtful_regions,
     level_offsets,
     linear_stair,
 )
@@ -319,11 +319,11 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
             f"{info['stair_response']:g} puts them and were read there: is the projector's "
             "gamma compensated (spec field gamma, 'bistair gamma')? It also ripples the "
             "fringes' phase")]
-    if "doubtful_orders" in info:
+    if "doubtful_levels" in info:
         info["warnings"] = [*info.get("warnings", []), (
-            f"{info['doubtful_orders']} of the {spec.stairs * spec.partitions} orders have a "
-            f"stair level whose band rows read at least {100 * LEVEL_DOUBT:.0f}% of the way "
-            "to halfway to the next level (median): regions showing one take their order "
+            f"{info['doubtful_levels']} of the {len(union_levels(spec.partitions, spec.stairs))} "
+            f"stair levels read at least {100 * LEVEL_DOUBT:.0f}% of the way to halfway to the "
+            "next (median of their band rows): the regions that read one take their orders "
             "from their neighbours or stay undecided")]
     if misfit > 0.1:
         refuse(
@@ -366,7 +366,7 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
                               sign=direction)[0]
 
     levels = union_levels(spec.partitions, spec.stairs)
-    doubt = np.zeros(spec.stairs * spec.partitions, bool)  # orders whose levels read too far
+    doubt = np.zeros(levels.size, bool)  # the levels whose rows read too far from them
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         prof = profiles(labels)
@@ -374,9 +374,9 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
             offset, per_level = level_offsets(prof, levels)
             info.update(level_offset=round(offset, 3),
                         worst_level_offset=round(float(per_level.max()), 3))
-            doubt[:] = doubtful_orders(per_level, levels, spec.stairs, spec.partitions)
+            doubt[:] = per_level >= LEVEL_DOUBT
             if doubt.any():
-                info["doubtful_orders"] = int(doubt.sum())
+                info["doubtful_levels"] = int(doubt.sum())
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = edge_rows(runs, band_splits(runs, heights, spec.local_rows / spec.group_rows))
@@ -391,7 +391,8 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         info.update(region_splits=info.get("region_splits", 0) + len(splits),
                     group_height=default)
         evidence = thin_band_doubt(region_evidence(runs, n, heights, layout), default, spec)
-        evidence[:, doubt] *= THIN_DOUBT  # levels read too far to decide a region alone
+        if doubt.any():  # regions that read a level too far from its place: faint
+            evidence[doubtful_regions(runs, n, doubt)] *= THIN_DOUBT
         return labels, n, evidence
 
     def agrees(k: np.ndarray) -> np.ndarray:

@@ -10,8 +10,8 @@ and, where it moves the readings, maps the stair phase so that each level reads 
 patterns put it (:func:`~bistair.core.stair.level_table`); the band rows are then read
 against the levels as before. :func:`level_offsets` says how well each level can be: one
 whose rows read far from it (where the response squeezes levels together its noise counts
-for more) decides no region alone (:func:`doubtful_orders`); its regions take their orders
-from their neighbours or stay undecided.
+for more) decides no region alone (:func:`doubtful_regions`): the regions that read it take
+their orders from their neighbours or stay undecided.
 """
 
 from __future__ import annotations
@@ -29,10 +29,9 @@ from ...core.stair import (
     half_gaps,
     level_readings,
     level_table,
-    stair_level_phase,
 )
 from ...core.stair_jit import relinearize32
-from .bands import nearest_level, union_levels
+from .bands import Runs, nearest_level, union_levels
 from .profiles import RowProfiles
 
 if TYPE_CHECKING:
@@ -206,37 +205,43 @@ def level_offsets(prof: RowProfiles, levels: np.ndarray) -> tuple[float, np.ndar
     return offset, per_level
 
 
-def doubtful_orders(per_level: np.ndarray, levels: np.ndarray, stairs: int,
-                    partitions: int) -> np.ndarray:
-    """The orders whose local or partition level reads too far from its place to decide a
-    region alone (its rows' median at least ``LEVEL_DOUBT`` of half a gap from it,
-    :func:`level_offsets`).
+def doubtful_regions(runs: Runs, n_regions: int, doubtful: np.ndarray) -> np.ndarray:
+    """The regions whose band runs read a doubtful level (:func:`level_offsets` at least
+    ``LEVEL_DOUBT``) in at least ``DOUBT_SHARE`` of their weight: their own reading cannot
+    tell that level from its neighbours, so their evidence is to be faint, whichever order
+    it favours (doubting the orders of a doubtful level instead favours the orders of the
+    levels beside it, which a region misreading that level reads as: a whole fringe of the
+    paper scene at 12 x 12 went two partitions off so).
 
     Parameters
     ----------
-    per_level : numpy.ndarray
-        (L,) each level's median share (:func:`level_offsets`).
-    levels : numpy.ndarray
-        (L,) the union levels' phases (:func:`~.bands.union_levels`).
-    stairs, partitions : int
-        ``S`` and ``P``.
+    runs : Runs
+        The band runs (:func:`~.bands.row_runs`).
+    n_regions : int
+        The highest region label.
+    doubtful : numpy.ndarray
+        (L,) bool, the doubtful levels (indexing ``runs.uid``).
 
     Returns
     -------
     numpy.ndarray
-        (S*P,) bool, True for the orders read with doubt.
+        (n_regions + 1,) bool.
 
     Examples
     --------
-    >>> levels = union_levels(3, 3)
-    >>> doubtful_orders(np.array([0.1, 0.45, 0.2]), levels, 3, 3).astype(int).tolist()
-    [0, 1, 0, 1, 1, 1, 0, 1, 0]
+    >>> from bistair.codecs.bidirectional.bands import Runs
+    >>> one = np.ones(4)
+    >>> runs = Runs(region=np.array([1, 1, 2, 2]), y0=one, y1=one, length=one, theta=one,
+    ...             weight=np.array([10.0, 5.0, 10.0, 1.0]), uid=np.array([0, 2, 0, 2]),
+    ...             top_ok=one > 0, bottom_ok=one > 0, misfit=one)
+    >>> doubtful_regions(runs, 2, np.array([False, False, True])).tolist()
+    [False, True, False]
     """
-    local = nearest_level(stair_level_phase(np.arange(stairs), stairs), levels)
-    part = nearest_level(stair_level_phase(np.arange(partitions), partitions), levels)
-    k = np.arange(stairs * partitions)
-    doubt = np.asarray(per_level) >= LEVEL_DOUBT
-    return doubt[local[k % stairs]] | doubt[part[k // stairs]]
+    weight = np.asarray(runs.weight, np.float64)
+    total = np.bincount(runs.region, weight, n_regions + 1)
+    doubted = np.bincount(runs.region, weight * np.asarray(doubtful)[runs.uid], n_regions + 1)
+    return doubted > DOUBT_SHARE * total
 
 
-LEVEL_DOUBT = 0.35  # a level whose rows read this far from it (median) decides no region alone
+LEVEL_DOUBT = 0.3  # a level whose rows read this far from it (median) decides no region alone
+DOUBT_SHARE = 0.2  # the share of a region's band weight on doubtful levels that makes it faint
