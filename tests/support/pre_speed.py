@@ -12,8 +12,8 @@ of agreeing links ties to a region that decides itself, undecided): only mugs-on
 changed, 3,171 fewer pixels decoded, its wrong orders 901 -> 817; and again when the stair
 levels were read where a projector response the patterns do not compensate puts them (issue
 31: both scenes leave the gamma of 2.2 uncompensated): paper-sim 228 more pixels decoded,
-none wrong; mugs-on-wall 3,823 more decoded and 81 another order, its pixels more than half
-a period off the truth 319 -> 427 (of 310,571 decoded). Any speed-up must give the same
+none wrong; mugs-on-wall 3,432 more decoded, 68 fewer and 79 another order, its pixels
+more than half a period off the truth 319 -> 422 (of 310,112 decoded). Any speed-up must give the same
 orders
 (tests/test_speed.py); a decode that refuses its captures is not recorded."""
 
