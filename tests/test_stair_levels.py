@@ -12,10 +12,14 @@ ambient, gamma 2.2).
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
+from click.testing import CliRunner
 
 import bistair
+from bistair.app.cli import cli
 from bistair.sim import Imaging, expose, preset, trace
 
 HARD = dict(gamma=2.2, read_noise=0.03, camera_blur=1.2, projector_blur=1.0, ambient=0.15)
@@ -124,3 +128,33 @@ def test_a_linear_response_is_not_fitted():
     result = bistair.decode(bistair.encode(spec), spec)
     assert "stair_response" not in result.info
     assert (result.order == np.arange(1728) // 12).all()
+
+
+def test_band_rows_that_read_at_random_are_refused_and_force_decodes(plane_default,
+                                                                      tmp_path):
+    """A linear projector whose sine frame came out 30% brighter than the cosine frame (the
+    lamp or the exposure changed between them): no response read off the levels undoes it,
+    the band rows read 58% of the way to halfway between two levels (50% at random); the
+    decode is refused, and forced, 29% of its pixels are wrong."""
+    rig, traced = plane_default
+    imaging = Imaging(**{**DEFAULT, "gamma": 1.0}, seed=0)
+    spec = bistair.make_spec("bidirectional", width=1920, height=1080, period=16,
+                             partitions=11, stairs=11)
+    stack = expose(traced, bistair.encode(spec), imaging).astype(np.float32)
+    stack[-1] *= 1.3  # stair-sin
+    np.save(tmp_path / "caps.npy", np.clip(stack, 0, 255).astype(np.uint8))
+    (tmp_path / "spec.json").write_text(spec.to_json())
+    args = ["decode", str(tmp_path / "caps.npy"), "--spec", str(tmp_path / "spec.json")]
+    refused = CliRunner().invoke(cli, [*args, "--out", str(tmp_path / "a")])
+    assert refused.exit_code == 2 and not (tmp_path / "a").exists()
+    assert "the band rows read 58% of the way to halfway between two stair levels" in \
+        refused.output, refused.output
+    forced = CliRunner().invoke(cli, [*args, "--out", str(tmp_path / "b"), "--force"])
+    assert forced.exit_code == 0, forced.output
+    assert "forced past a check: the band rows read 58%" in forced.output
+    info = json.loads((tmp_path / "b" / "info.json").read_text())
+    assert any(f.startswith("the band rows read 58%") for f in info["forced"])
+    order, known = np.load(tmp_path / "b" / "order.npy"), traced.truth.mask
+    both = (order >= 0) & known
+    truth = np.floor(traced.truth.coord_x / 16)
+    assert np.mean(order[both] != truth[both]) > 0.1  # the refusal is right

@@ -13,9 +13,9 @@ changed, 3,171 fewer pixels decoded, its wrong orders 901 -> 817; and again when
 levels were read where a projector response the patterns do not compensate puts them (issue
 31: both scenes leave the gamma of 2.2 uncompensated): paper-sim 228 more pixels decoded,
 none wrong; mugs-on-wall 3,432 more decoded, 68 fewer and 79 another order, its pixels
-more than half a period off the truth 319 -> 422 (of 310,112 decoded). Any speed-up must give the same
-orders
-(tests/test_speed.py); a decode that refuses its captures is not recorded."""
+more than half a period off the truth 319 -> 422 (of 310,112 decoded). Any speed-up must
+give the same orders (tests/test_speed.py); a decode that refuses its captures is not
+recorded."""
 
 from __future__ import annotations
 

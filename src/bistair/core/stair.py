@@ -312,7 +312,7 @@ def fit_level_response(theta: np.ndarray, levels: np.ndarray, offset: float = 0.
     base = cost(1.0)
     coarse = np.exp(np.linspace(math.log(0.4), math.log(4.0), 25))  # steps of 10%
     best = float(coarse[int(np.argmin([cost(e) for e in coarse]))])
-    fine = [1.0, *(best * np.exp(np.linspace(-0.1, 0.1, 11)))]
+    fine = [1.0, *np.clip(best * np.exp(np.linspace(-0.1, 0.1, 11)), 0.4, 4.0)]
     costs = [cost(e) for e in fine]
     i = int(np.argmin(costs))  # ties keep 1.0 (listed first)
     return float(fine[i]), costs[i] / base if base > 0 else 0.0

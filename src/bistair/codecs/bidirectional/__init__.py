@@ -74,6 +74,7 @@ from .profiles import (
 )
 from .response import (
     LEVEL_DOUBT,
+    UNREADABLE,
     doubtful_regions,
     level_offsets,
     linear_stair,
@@ -238,7 +239,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
                   strategy: Literal["region", "paper"] = "region") -> Orders:
     """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy.
 
-    The orders are then checked against the stair phase (:func:`stair_fit`).
+    The region strategy reads the stair levels where this capture's response puts them
+    (:func:`~.response.linear_stair`). The orders are then checked against the stair phase
+    (:func:`stair_fit`).
 
     Parameters
     ----------
@@ -257,13 +260,19 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     Orders
         (H, W) int32 fringe order per pixel (-1 where invalid) and ``info``: the strategy,
         the camera noise, the well-modulated pixels, the phase jumps across which the
-        orders do not step by one, ``stair_misfit`` and any ``warnings``.
+        orders do not step by one, ``stair_misfit``, for the region strategy how far the
+        band rows read from their levels (``level_offset``, ``worst_level_offset``), the
+        levels too far to decide a region (``doubtful_levels``) and the response exponent
+        the levels were read through (``stair_response``, :mod:`.response`), and any
+        ``warnings``.
 
     Raises
     ------
     BistairError
-        ``strategy`` is neither ``"region"`` nor ``"paper"``, or over 10% of the decoded
-        pixels' stair phases contradict their orders (the spec does not fit).
+        ``strategy`` is neither ``"region"`` nor ``"paper"``, over 10% of the decoded
+        pixels' stair phases contradict their orders (the spec does not fit), or the band
+        rows read as far from the levels as at random (``level_offset`` at least
+        ``UNREADABLE``).
 
     Examples
     --------
@@ -325,6 +334,12 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
             f"stair levels read at least {100 * LEVEL_DOUBT:.0f}% of the way to halfway to the "
             "next (median of their band rows): the regions that read one take their orders "
             "from their neighbours or stay undecided")]
+    if info.get("level_offset", 0.0) >= UNREADABLE:
+        refuse(f"the band rows read {100 * info['level_offset']:.0f}% of the way to halfway "
+               "between two stair levels (median; 50% at random): the levels cannot be told "
+               f"apart (too much noise or blur for {spec.partitions} x {spec.stairs} levels, "
+               "or a projector response the decoder cannot undo: compensate its gamma, spec "
+               "field gamma, 'bistair gamma')")
     if misfit > 0.1:
         refuse(
             f"at {100 * misfit:.0f}% of the decoded pixels "

@@ -70,9 +70,11 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
     The exponent is fitted to the valid pixels of a grid of about 20000 (every few pixels of
     every few rows) away from the fringe edges whose stair phase noise is under 0.3 rad (at
     least 500). The phase is mapped only where that
-    exponent moves some level's reading by at least ``MIN_SHIFT`` of the way to halfway and
+    exponent moves some level's reading by at least ``MIN_SHIFT`` of the way to halfway,
     fits the phases better than the levels do (mean clipped squared distance at most
-    ``MAX_RATIO`` of theirs): a compensated projector decodes exactly as before. On the
+    ``MAX_RATIO`` of theirs) and is not at an end of the range searched (0.4 to 4: there no
+    power law fits the capture, say a sine frame brighter than the cosine frame): a
+    compensated projector decodes exactly as before. On the
     rendered scenes (every preset, 6 x 6 to 12 x 12 levels, 1% and 3% noise, 640 x 512)
     the compensated captures fit exponents of 0.79-1.17 to their noise (moving a level up to
     0.33 of the way) that fit no better than 0.988 of the levels; under a gamma of 2.2 left
@@ -131,8 +133,8 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
                                          spec.amplitude)
     read = level_readings(levels, exponent, spec.offset, spec.amplitude)
     shift = float(np.max(np.abs(wrap(read - levels)) / half_gaps(levels)))
-    if ratio > MAX_RATIO or shift < MIN_SHIFT:
-        return LinearStair(theta, ks)
+    if ratio > MAX_RATIO or shift < MIN_SHIFT or not 0.42 < exponent < 3.8:
+        return LinearStair(theta, ks)  # no better, too little, or no power law (its range's end)
     try:
         table = level_table(read, levels)
     except ValueError:  # readings out of the levels' order: no power law explains them
@@ -245,3 +247,4 @@ def doubtful_regions(runs: Runs, n_regions: int, doubtful: np.ndarray) -> np.nda
 
 LEVEL_DOUBT = 0.3  # a level whose rows read this far from it (median) decides no region alone
 DOUBT_SHARE = 0.2  # the share of a region's band weight on doubtful levels that makes it faint
+UNREADABLE = 0.4  # band rows this far from their levels (median; 0.5 at random): refused
