@@ -130,14 +130,15 @@ def test_a_linear_response_is_not_fitted():
     assert (result.order == np.arange(1728) // 12).all()
 
 
-def test_band_rows_that_read_at_random_are_refused_and_force_decodes(plane_default,
-                                                                      tmp_path):
+def test_band_rows_that_read_at_random_are_refused_and_force_decodes(tmp_path):
     """A linear projector whose sine frame came out 30% brighter than the cosine frame (the
-    lamp or the exposure changed between them): no response read off the levels undoes it,
-    the band rows read 58% of the way to halfway between two levels (50% at random); the
-    decode is refused, and forced, 29% of its pixels are wrong."""
-    rig, traced = plane_default
-    imaging = Imaging(**{**DEFAULT, "gamma": 1.0}, seed=0)
+    lamp or the exposure changed between them), the hard optics: no response read off the
+    levels undoes it, the band rows read 59% of the way to halfway between two levels (50%
+    at random), and under 3% noise the stair check sees too few sharp pixels to judge. The
+    decode is refused; forced, 45% of its pixels are wrong (with exit 0 before)."""
+    rig, geometry = preset("plane", camera_size=(640, 512))
+    imaging = Imaging(**{**HARD, "gamma": 1.0}, seed=0)
+    traced = trace(rig, geometry, imaging)
     spec = bistair.make_spec("bidirectional", width=1920, height=1080, period=16,
                              partitions=11, stairs=11)
     stack = expose(traced, bistair.encode(spec), imaging).astype(np.float32)
@@ -146,15 +147,15 @@ def test_band_rows_that_read_at_random_are_refused_and_force_decodes(plane_defau
     (tmp_path / "spec.json").write_text(spec.to_json())
     args = ["decode", str(tmp_path / "caps.npy"), "--spec", str(tmp_path / "spec.json")]
     refused = CliRunner().invoke(cli, [*args, "--out", str(tmp_path / "a")])
-    assert refused.exit_code == 2 and not (tmp_path / "a").exists()
-    assert "the band rows read 58% of the way to halfway between two stair levels" in \
+    assert refused.exit_code == 2 and not (tmp_path / "a").exists(), refused.output
+    assert "the band rows read 59% of the way to halfway between two stair levels" in \
         refused.output, refused.output
     forced = CliRunner().invoke(cli, [*args, "--out", str(tmp_path / "b"), "--force"])
     assert forced.exit_code == 0, forced.output
-    assert "forced past a check: the band rows read 58%" in forced.output
+    assert "forced past a check: the band rows read 59%" in forced.output
     info = json.loads((tmp_path / "b" / "info.json").read_text())
-    assert any(f.startswith("the band rows read 58%") for f in info["forced"])
+    assert [f[:25] for f in info["forced"]] == ["the band rows read 59% of"]  # nothing else
     order, known = np.load(tmp_path / "b" / "order.npy"), traced.truth.mask
     both = (order >= 0) & known
     truth = np.floor(traced.truth.coord_x / 16)
-    assert np.mean(order[both] != truth[both]) > 0.1  # the refusal is right
+    assert np.mean(order[both] != truth[both]) > 0.3  # the refusal is right
