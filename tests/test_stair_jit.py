@@ -9,8 +9,15 @@ import pytest
 from support.arrays import angle_np, same
 
 from bistair.core.captures import ScaledStack
-from bistair.core.stair import quantize, stair_phase
-from bistair.core.stair_jit import pair_phase, quantize32
+from bistair.core.stair import (
+    level_readings,
+    level_table,
+    quantize,
+    relinearize,
+    stair_level_phase,
+    stair_phase,
+)
+from bistair.core.stair_jit import pair_phase, quantize32, relinearize32
 
 RNG = np.random.default_rng(7)
 
@@ -37,3 +44,16 @@ def test_quantize32_is_quantize(levels):
     valid = RNG.random(theta.shape) < 0.9
     assert same(quantize32(theta, levels, valid),
                 np.where(valid, quantize(theta, levels), -1).astype(np.int32))
+
+
+def test_relinearize32_is_relinearize_and_quantize():
+    """The compiled map through a level table gives the NumPy reference's phases bit for bit
+    and quantize32's levels of them (including phases at the ends of the circle)."""
+    levels = stair_level_phase(np.arange(11), 11)
+    table = level_table(level_readings(levels, 2.2), levels)
+    theta = RNG.uniform(-np.pi, np.pi, (64, 80)).astype(np.float32)
+    theta[0, :4] = [-np.pi, np.pi, np.nextafter(np.float32(np.pi), 0), 0.0]
+    valid = RNG.uniform(0, 1, theta.shape) < 0.9
+    mapped, level = relinearize32(theta, table, 11, valid)
+    assert same(mapped, relinearize(theta, table))
+    assert np.array_equal(level, quantize32(mapped, 11, valid))

@@ -65,6 +65,56 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
 
 
 @kernel(parallel=True)
+def relinearize32(theta: np.ndarray, table: np.ndarray, levels: int, valid: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The stair phase through a level table (:func:`bistair.core.stair.relinearize`, bit for
+    bit) and its :func:`quantize32` levels, in one pass.
+
+    Parameters
+    ----------
+    theta : (H, W) float32 array
+        Stair phase in radians.
+    table : (bins,) float32 array
+        From :func:`bistair.core.stair.level_table`.
+    levels : int
+        Number of steps of the stair the levels are read for.
+    valid : (H, W) bool array
+        Pixels to quantise.
+
+    Returns
+    -------
+    mapped : (H, W) float32 array
+        The phase through the table.
+    level : (H, W) int32 array
+        Its level, -1 where not valid.
+
+    Examples
+    --------
+    >>> table = np.float32([-3.0, -1.0, 1.0, 3.0])  # four steps of the circle
+    >>> mapped, level = relinearize32(np.float32([[-3.1, 0.1, 2.0]]), table, 4,
+    ...                               np.array([[True, True, False]]))
+    >>> mapped.tolist(), level.tolist()
+    ([[-3.0, 1.0, 3.0]], [[0, 2, -1]])
+    """
+    h, w = theta.shape
+    n = table.size
+    step = np.float32(n / (2.0 * math.pi))
+    scale = np.float32(levels / (2.0 * math.pi))
+    mapped = np.empty((h, w), np.float32)
+    out = np.empty((h, w), np.int32)
+    for y in prange(h):
+        for x in range(w):
+            i = int((theta[y, x] + PI32) * step)
+            m = table[min(max(i, 0), n - 1)]
+            mapped[y, x] = m
+            if valid[y, x]:
+                out[y, x] = np.int32(math.floor((m + PI32) * scale)) % levels
+            else:
+                out[y, x] = -1
+    return mapped, out
+
+
+@kernel(parallel=True)
 def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
                 ) -> tuple[np.ndarray, np.ndarray]:
     _, h, w = raw.shape
