@@ -78,7 +78,18 @@ from .base import (
     shift_patterns,
 )
 from .graycode_alone import code_alone, measure_alone
-from .graycode_jit import code_bits, gray_orders
+from .graycode_jit import code_bits, read_orders
+
+# The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
+# in docs/guide/checks.md): a bit clears the noise of its margin by CLEAR_NOISE sigmas (a
+# bit read on the wrong side does so with probability under 0.14%) and reads at least
+# CLEAR_SHARE of the pixel's code contrast, unless the phase puts its edge within
+# EDGE_REACH fringes (a blur that leaves the fringes 5% of the code's contrast still leaves
+# a bit half a fringe from its edge 0.8 of it); the phase clears its own noise by
+# CLEAR_NOISE sigmas where the code's edge sits on it.
+CLEAR_NOISE = 3.0
+CLEAR_SHARE = 0.5
+EDGE_REACH = 0.5
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -293,8 +304,6 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     n = spec.steps
     start = n * (2 if spec.second_period else 1)
     n_bits = spec.code_bits + spec.complementary
-    # each bit: the code frame brighter than the average (or its inverse), in one pass
-    gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     valid = fs.valid
     if spec.inverse and fs.threshold is not None:
         code = prepared.frames[start:start + n_bits]
@@ -302,10 +311,16 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
         del code, ref
     maps: dict[str, np.ndarray] = {}
-    if not spec.second_period:  # per pixel in one pass
+    if not spec.second_period:  # per pixel in one pass, with the evidence of each order
         mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
-        code, maps["edges"], beyond = gray_orders(gray, fs.phi, valid, mode, spec.fringes)
+        noise_d = fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n)
+        code, maps["edges"], maps["carried"], beyond = read_orders(
+            prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse), fs.phi,
+            fs.mod, valid, mode, spec.fringes, noise_d, fs.noise / math.sqrt(n / 2),
+            CLEAR_NOISE, CLEAR_SHARE, EDGE_REACH)
         return CodeMap(code, maps, edge_phase=np.pi if mode == 2 else 0.0, beyond=beyond)
+    # each bit: the code frame brighter than the average (or its inverse), in one pass
+    gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     if spec.complementary:
         k1 = gray_to_binary(gray >> 1)
         k2 = (gray_to_binary(gray) + 1) // 2
@@ -401,24 +416,37 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
                            "decodes per pixel")
     info = {"strategy": strategy, "noise": fs.noise,
             "bits": spec.code_bits + spec.complementary}
-    k = code.code
+    read = code.code
+    # the orders the pixels' own evidence carries (all read ones where it is not judged)
+    carried = code.maps.get("carried")
+    k = read if carried is None else np.where(carried, read, -1)
+    if carried is not None:
+        info["left_out"] = int(np.count_nonzero(read >= 0)) - int(np.count_nonzero(k >= 0))
     if strategy == "pixel":
         if spec.steps == 0:  # no phase to check the cells against: their direction
             against, steps = cell_steps(k)
             info.update(cell_steps=steps, cell_steps_against=against)
             refuse(direction_problem(against, steps))
         return Orders(k, info)
-    labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
+    # the regions join every pixel read; only those whose evidence carries its order vote
+    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        return labels, n, code_evidence(labels, n, k, spec.fringes, weight)
+        evidence = code_evidence(labels, n, k, spec.fringes, weight)
+        if carried is not None:  # a region whose pixels mostly abstain decides little
+            flat = labels.ravel()
+            every = np.bincount(flat, weights=weight.ravel(), minlength=n + 1)
+            voting = np.bincount(flat, weights=np.where(k >= 0, weight, 0).ravel(),
+                                 minlength=n + 1)
+            evidence *= (voting / np.maximum(every, 1e-12))[:, None]
+        return labels, n, evidence
 
     def agrees(order: np.ndarray) -> np.ndarray:
         return (k == order) | (k < 0)
 
-    order = orders_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
-                                   info)
+    order = orders_from_regions(fs.phi, fs.valid & (read >= 0), labels, evidence_of, agrees,
+                                info)
     return Orders(order, info)
 
 
