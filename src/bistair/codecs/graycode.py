@@ -78,15 +78,15 @@ from .base import (
     shift_patterns,
 )
 from .graycode_alone import code_alone, measure_alone
-from .graycode_jit import code_bits, read_orders
+from .graycode_jit import code_bits, orders_fit, read_orders
 
 # The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
 # in docs/guide/checks.md): a bit clears the noise of its margin by CLEAR_NOISE sigmas (a
-# bit read on the wrong side does so with probability under 0.14%) and reads at least
-# CLEAR_SHARE of the pixel's code contrast, unless the phase puts its edge within
-# EDGE_REACH fringes (a blur that leaves the fringes 5% of the code's contrast still leaves
-# a bit half a fringe from its edge 0.8 of it); the phase clears its own noise by
-# CLEAR_NOISE sigmas where the code's edge sits on it.
+# bit read on the wrong side does so with probability under 0.14%) and reads over
+# CLEAR_SHARE of the pixel's code contrast (its strongest bit), unless the phase puts its
+# edge within EDGE_REACH fringes (a blur that leaves the fringes 5% of the code's contrast
+# still leaves a bit half a fringe from its edge 0.8 of it); the phase clears its own noise
+# by CLEAR_NOISE sigmas where the code's edge sits on it.
 CLEAR_NOISE = 3.0
 CLEAR_SHARE = 0.5
 EDGE_REACH = 0.5
@@ -311,13 +311,15 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
         del code, ref
     maps: dict[str, np.ndarray] = {}
+    mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
+    # the noise of a bit's margin (frame minus inverse, or minus the average of n frames),
+    # and of the phase times the modulation
+    evidence = (fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n),
+                fs.noise / math.sqrt(n / 2), CLEAR_NOISE, CLEAR_SHARE, EDGE_REACH)
     if not spec.second_period:  # per pixel in one pass, with the evidence of each order
-        mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
-        noise_d = fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n)
         code, maps["edges"], maps["carried"], beyond = read_orders(
             prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse), fs.phi,
-            fs.mod, valid, mode, spec.fringes, noise_d, fs.noise / math.sqrt(n / 2),
-            CLEAR_NOISE, CLEAR_SHARE, EDGE_REACH)
+            fs.mod, valid, mode, spec.fringes, *evidence)
         return CodeMap(code, maps, edge_phase=np.pi if mode == 2 else 0.0, beyond=beyond)
     # each bit: the code frame brighter than the average (or its inverse), in one pass
     gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
@@ -333,26 +335,31 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     else:
         k = edges = gray_to_binary(gray)
         edge_phase = 0.0
-    if spec.second_period:
-        second = measure(prepared, n, n, min_modulation, check=False,
-                         shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
-        k, agree = _second_period_check(k, fs.phi, second.phi, spec)
-        valid = valid & second.valid & agree
-        maps["second_phase"] = second.phi
+    second = measure(prepared, n, n, min_modulation, check=False,
+                     shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
+    k, agree = _second_period_check(k, fs, second, spec)
+    valid = valid & second.valid & agree
+    maps["second_phase"] = second.phi
     ok = valid & (k >= 0) & (k < spec.fringes)
     maps["edges"] = np.where(valid, edges, -1).astype(np.int32)
     beyond = int(np.count_nonzero(valid & (k >= spec.fringes)))
-    return CodeMap(np.where(ok, k, -1).astype(np.int32), maps, edge_phase=edge_phase,
-                   beyond=beyond)
+    code = np.where(ok, k, -1).astype(np.int32)
+    # where the order the second phase chose fits the code's own evidence
+    maps["carried"] = orders_fit(prepared.raw, start, n_bits, prepared.scale, fs.avg,
+                                 bool(spec.inverse), fs.phi, fs.mod, code, mode, spec.fringes,
+                                 *evidence)
+    return CodeMap(code, maps, edge_phase=edge_phase, beyond=beyond)
 
 
-def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
+def _second_period_check(k: np.ndarray, fs: FringeSet, second: FringeSet,
                          spec: GrayCodeSpec) -> tuple[np.ndarray, np.ndarray]:
     """The order (the code's, or its neighbour on the phase's side) that predicts the second
-    phase best, and where that prediction is within half the candidates' separation."""
+    phase best, and where that prediction is within half the candidates' separation and
+    the two phases' noise (``CLEAR_NOISE`` sigmas of the prediction's) is under half of
+    it: where the second phase tells the two apart."""
     ratio = spec.period / spec.second_period
+    phi, phi2 = fs.phi, second.phi
     side = np.where(phi < np.pi, 1, -1)
-    best, best_err = k, None
     errs = []
     for cand in (k, k + side):
         pred = (cand + phi / TWO_PI) * (TWO_PI * ratio)
@@ -360,7 +367,8 @@ def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
     best = np.where(errs[1] < errs[0], k + side, k)
     best_err = np.minimum(errs[0], errs[1])
     separation = abs(wrap(np.array(TWO_PI * ratio)))
-    return best, best_err < 0.5 * separation
+    sigma = np.hypot(ratio * fs.phase_noise, second.phase_noise)
+    return best, (best_err < 0.5 * separation) & (CLEAR_NOISE * sigma < 0.5 * separation)
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,

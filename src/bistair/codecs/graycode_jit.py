@@ -1,14 +1,17 @@
 """Compiled passes of the Gray code (:mod:`bistair.codecs.graycode`): the code bits read
-against their inverses or the mid-level, and the orders from the Gray code words (bit for
-bit the NumPy they replace).
+against their inverses or the mid-level (bit for bit the NumPy they replace), the orders
+from them with the evidence of each pixel's order (:func:`read_orders`), and the Gray code
+without phase shifts.
 
 Examples
 --------
 >>> import numpy as np
->>> code, edges, beyond = gray_orders(np.int32([[0, 1, 3, 2]]), np.zeros((1, 4), np.float32),
-...                                   np.ones((1, 4), bool), 0, 4)
->>> code.tolist()
-[[0, 1, 2, 3]]
+>>> raw = np.float32([[[0.1, 0.1, 0.9, 0.9]], [[0.1, 0.9, 0.9, 0.1]]])  # cells 0, 1, 2, 3
+>>> code, edges, carried, beyond = read_orders(
+...     raw, 0, 2, 1.0, np.full((1, 4), 0.5, np.float32), False, np.full((1, 4), 3.0, np.float32),
+...     np.full((1, 4), 0.4, np.float32), np.ones((1, 4), bool), 0, 4, 0.01, 0.01, 3.0, 0.5, 0.5)
+>>> code.tolist(), carried.tolist()
+([[0, 1, 2, 3]], [[True, True, True, True]])
 """
 
 from __future__ import annotations
@@ -81,42 +84,6 @@ def code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndar
 
 
 
-@kernel()
-def _gray_orders(gray: np.ndarray, phi: np.ndarray, valid: np.ndarray, mode: int,
-                 fringes: int) -> tuple[np.ndarray, np.ndarray, int]:
-    h, w = gray.shape
-    code = np.empty((h, w), np.int32)
-    edges = np.empty((h, w), np.int32)
-    beyond = np.zeros(h, np.int64)
-    quarter = np.float32(0.5 * math.pi)
-    half = np.float32(math.pi)
-    three = np.float32(1.5 * math.pi)
-    for y in range(h):
-        out = 0
-        for x in range(w):
-            g = np.int32(gray[y, x])
-            if mode == 1:  # complementary: the three-zone rule
-                k1 = _binary(g >> 1)
-                k2 = (_binary(g) + 1) // 2
-                p = phi[y, x]
-                k = k2 if p < quarter else (k2 - 1 if p >= three else k1)
-                e = k1
-            elif mode == 2:  # the code shifted by half a fringe
-                e = _binary(g)
-                k = e if phi[y, x] < half else e - 1
-            else:
-                e = _binary(g)
-                k = e
-            ok = valid[y, x]
-            code[y, x] = k if ok and k >= 0 and k < fringes else -1
-            edges[y, x] = e if ok else -1
-            if ok and k >= fringes:
-                out += 1
-        beyond[y] = out
-    return code, edges, beyond.sum()
-
-
-
 @_numba_inline
 def _binary(g: np.int32) -> np.int32:
     """Gray code to binary: the XOR of all the right shifts of ``g``."""
@@ -126,47 +93,6 @@ def _binary(g: np.int32) -> np.int32:
         shift <<= 1
     return g
 
-
-
-def gray_orders(gray: np.ndarray, phi: np.ndarray, valid: np.ndarray, mode: int,
-                fringes: int) -> tuple[np.ndarray, np.ndarray, int]:
-    """Fringe orders from Gray code words, per pixel in one pass: the plain code
-    (``mode`` 0), the complementary three-zone rule (1: the words carry one more bit) or
-    the code shifted by half a fringe (2), as :func:`~bistair.codecs.graycode.code_columns`
-    reads them.
-
-    Parameters
-    ----------
-    gray : (H, W) int32 array
-        The code words (non-negative).
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    valid : (H, W) bool array
-        Pixels to decode.
-    mode : int
-        0 plain, 1 complementary, 2 shifted by half a fringe.
-    fringes : int
-        Fringes across the projector (orders from 0 to ``fringes - 1``).
-
-    Returns
-    -------
-    code : (H, W) int32 array
-        The order, -1 where not valid or outside ``[0, fringes)``.
-    edges : (H, W) int32 array
-        The code whose steps mark the edges, -1 where not valid.
-    beyond : int
-        Valid pixels whose order is ``fringes`` or more.
-
-    Examples
-    --------
-    >>> gray = np.int32([[0, 1, 3, 2]])
-    >>> code, edges, beyond = gray_orders(gray, np.zeros((1, 4), np.float32),
-    ...                                   np.ones((1, 4), bool), 0, 3)
-    >>> code.tolist(), edges.tolist(), beyond
-    ([[0, 1, 2, -1]], [[0, 1, 2, 3]], 1)
-    """
-    return _gray_orders(gray, np.asarray(phi, np.float32), np.asarray(valid, bool), int(mode),
-                        int(fringes))
 
 
 @kernel(parallel=True)
@@ -321,53 +247,29 @@ def _order_of(g: np.int64, p: np.float32, mode: int) -> tuple[np.int64, np.int64
 
 
 @_numba_called
-def _median(values: np.ndarray, n: int) -> float:
-    """The median of ``values[:n]`` (sorted in place), as NumPy's: the mean of the middle
-    two for an even count; NaN for none."""
-    if n == 0:
-        return np.nan
-    for i in range(1, n):
-        v = values[i]
-        j = i - 1
-        while j >= 0 and values[j] > v:
-            values[j + 1] = values[j]
-            j -= 1
-        values[j + 1] = v
-    if n % 2:
-        return values[n // 2]
-    return 0.5 * (values[n // 2 - 1] + values[n // 2])
-
-
-@_numba_called
-def _carried(d: np.ndarray, buf: np.ndarray, g: np.int64, p: np.float32, mod: float,
-             mode: int, fringes: int, inverse: bool, noise_d: float, phase_noise: float,
-             z: float, share: float, reach: float) -> bool:
-    """Whether the pixel's own evidence carries the order its code word ``g`` gives at
-    wrapped phase ``p``: see :func:`read_orders`."""
+def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, fringes: int,
+          inverse: bool, noise_d: float, phase_noise: float, z: float, share: float,
+          reach: float, target: np.int64, alone: bool) -> bool:
+    """Whether order ``target`` fits the evidence of a pixel whose code reads ``g`` (bit
+    margins ``d``) at wrapped phase ``p`` and, with ``alone``, is the only order that does
+    and has the phase at the end of its code cell the edge bits say (see
+    :func:`read_orders`)."""
     bits = d.shape[0]
-    # the pixel's code contrast: the median bit margin (of each sign without inverses,
+    # the pixel's code contrast: its strongest bit's margin (of each sign without inverses,
     # whose threshold, the fringes' average, need not sit midway between dark and bright)
+    c_pos = 0.0
+    c_neg = 0.0
+    for b in range(bits):
+        if d[b] > 0:
+            c_pos = max(c_pos, np.float64(d[b]))
+        else:
+            c_neg = max(c_neg, -np.float64(d[b]))
     if inverse:
-        for b in range(bits):
-            buf[b] = abs(d[b])
-        c_pos = c_neg = _median(buf, bits)
-    else:
-        n = 0
-        for b in range(bits):
-            if d[b] > 0:
-                buf[n] = d[b]
-                n += 1
-        c_pos = _median(buf, n)
-        m = 0
-        for b in range(bits):
-            if not d[b] > 0:
-                buf[m] = -d[b]
-                m += 1
-        c_neg = _median(buf, m)
-        if n == 0:
-            c_pos = c_neg
-        if m == 0:
-            c_neg = c_pos
+        c_pos = c_neg = max(c_pos, c_neg)
+    elif c_pos == 0:
+        c_pos = c_neg
+    elif c_neg == 0:
+        c_neg = c_pos
     # the unclear bits (LSB = bit 0): those that do not clear their noise or that read
     # under `share` of the pixel's contrast (`faint`); a bit read on the wrong side away
     # from its edge is `possible` only where noise could have made up its contrast and more
@@ -394,7 +296,6 @@ def _carried(d: np.ndarray, buf: np.ndarray, g: np.int64, p: np.float32, mod: fl
     slack = z * sigma / (2.0 * math.pi)  # in fringes
     limit = (reach + slack) * unit
     frac = np.float64(p) / (2.0 * math.pi)
-    read, _ = _order_of(g, p, mode)
     found = False
     flips = unclear
     while True:  # every reading of the unclear bits: the order it gives, if it fits
@@ -416,15 +317,16 @@ def _carried(d: np.ndarray, buf: np.ndarray, g: np.int64, p: np.float32, mod: fl
                     fits = False
                     break
             if fits:
-                if k != read:
+                if k == target:
+                    found = True
+                elif alone:
                     return False  # two orders fit the evidence
-                found = True
         if flips == 0:
             break
         flips = (flips - 1) & unclear
     if not found:
         return False
-    if mode == 1:
+    if mode == 1 or not alone:
         return True
     # beside a code edge at the phase's wrap: the weaker edge bit must be on the phase's side
     cell = frac if mode == 0 else (frac + 0.5) % 1.0
@@ -471,7 +373,6 @@ def _read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.n
     s32 = np.float32(scale)
     for y in prange(h):
         d = np.empty(bits, np.float32)
-        buf = np.empty(bits, np.float32)
         out = 0
         for x in range(w):
             g = np.int64(0)
@@ -488,9 +389,8 @@ def _read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.n
             edges[y, x] = e if ok else -1
             if ok and k >= fringes:
                 out += 1
-            carried[y, x] = inside and _carried(d, buf, g, p, mod[y, x], mode, fringes,
-                                                inverse, noise_d, phase_noise, z, share,
-                                                reach)
+            carried[y, x] = inside and _fits(d, g, p, mod[y, x], mode, fringes, inverse,
+                                             noise_d, phase_noise, z, share, reach, k, True)
         beyond[y] = out
     return code, edges, carried, beyond.sum()
 
@@ -502,11 +402,12 @@ def read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.nd
     """The Gray code read per pixel in one pass: the code word of ``bits`` frames from
     ``start`` (a bit is set where its frame is brighter than its inverse, the ``bits``
     frames after them, or without ``inverse`` than ``avg``), its order by the rule of
-    ``mode`` (as :func:`gray_orders`), and whether the pixel's own evidence carries that
-    order.
+    ``mode`` (plain, complementary or shifted, as
+    :func:`~bistair.codecs.graycode.code_columns` reads them), and whether the pixel's own
+    evidence carries that order.
 
     The evidence of a pixel: each bit's margin ``d`` (frame minus inverse, or minus
-    ``avg``), the pixel's code contrast ``c`` (the median ``|d|`` over the bits; without
+    ``avg``), the pixel's code contrast ``c`` (the largest ``|d|`` of its bits; without
     inverses, of the bits of each sign apart, since the fringes' average need not sit
     midway between a code frame's dark and bright) and its wrapped phase ``phi`` with noise
     ``sigma = phase_noise / mod``. A bit is unclear where ``|d|`` is at most
@@ -593,3 +494,68 @@ def read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.nd
                         np.asarray(phi, np.float32), np.asarray(mod, np.float32),
                         np.asarray(valid, bool), int(mode), int(fringes), float(noise_d),
                         float(phase_noise), float(z), float(share), float(reach))
+
+
+@kernel(parallel=True)
+def _orders_fit(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndarray,
+                inverse: bool, phi: np.ndarray, mod: np.ndarray, order: np.ndarray,
+                mode: int, fringes: int, noise_d: float, phase_noise: float, z: float,
+                share: float, reach: float) -> np.ndarray:
+    _, h, w = raw.shape
+    out = np.zeros((h, w), np.bool_)
+    s32 = np.float32(scale)
+    for y in prange(h):
+        d = np.empty(bits, np.float32)
+        for x in range(w):
+            if order[y, x] < 0:
+                continue
+            g = np.int64(0)
+            for b in range(bits):
+                v = np.float32(raw[start + b, y, x]) * s32
+                ref = np.float32(raw[start + bits + b, y, x]) * s32 if inverse else avg[y, x]
+                d[b] = v - ref
+                g = (g << 1) | (1 if v > ref else 0)
+            out[y, x] = _fits(d, g, phi[y, x], mod[y, x], mode, fringes, inverse, noise_d,
+                              phase_noise, z, share, reach, np.int64(order[y, x]), False)
+    return out
+
+
+def orders_fit(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndarray,
+               inverse: bool, phi: np.ndarray, mod: np.ndarray, order: np.ndarray, mode: int,
+               fringes: int, noise_d: float, phase_noise: float, z: float, share: float,
+               reach: float) -> np.ndarray:
+    """Where a given order fits the evidence of the Gray code read from ``bits`` frames
+    from ``start`` (the reading of :func:`read_orders`, whose arguments these are): some
+    reading of the unclear bits gives it, every unclear bit's edge within ``reach``
+    fringes, each faint one's only so. Other orders may fit as well (another measurement,
+    such as a second period's phase, chose among them).
+
+    Parameters
+    ----------
+    raw, start, bits, scale, avg, inverse, phi, mod, mode, fringes, noise_d, phase_noise, \
+z, share, reach
+        As for :func:`read_orders`.
+    order : (H, W) int array
+        The order to judge per pixel; -1 where none.
+
+    Returns
+    -------
+    (H, W) bool array
+        Where ``order`` is 0 or more and fits.
+
+    Examples
+    --------
+    >>> raw = np.float32([[[0.9, 0.9]], [[0.9, 0.52]], [[0.1, 0.1]], [[0.1, 0.48]]])
+    >>> phi = np.float32([[5.5, 0.5]])  # cell 2 (Gray 11); the second's last bit is faint,
+    >>> # and its edge is cell 2's upper end, which the phase puts the pixel far from
+    >>> orders_fit(raw, 0, 2, 1.0, phi, True, phi, np.full((1, 2), 0.3, np.float32),
+    ...            np.int32([[2, 2]]), 0, 4, 0.01, 0.01, 3.0, 0.5, 0.5).tolist()
+    [[True, False]]
+    """
+    raw, start = kernel_frames(raw, start, 2 * bits if inverse else bits)
+    return _orders_fit(raw, start, int(bits), float(np.float32(scale)),
+                       np.asarray(avg, np.float32), bool(inverse),
+                       np.asarray(phi, np.float32), np.asarray(mod, np.float32),
+                       np.ascontiguousarray(order, np.int32), int(mode), int(fringes),
+                       float(noise_d), float(phase_noise), float(z), float(share),
+                       float(reach))
