@@ -61,7 +61,9 @@ def test_a_spec_with_the_wrong_convention_is_refused(method, params, offset, sig
 def test_multifrequency_with_the_wrong_convention(periods):
     """Offsets break the agreement of the periods (refused); a sign flip of every set is a
     mirrored projector to the captures: warned about where the mirrored coordinates land on
-    the projector, else refused (42, 45 and 48 px: a few pixels' land there, all wrong)."""
+    the projector, else refused or left empty (42, 45 and 48 px: the 21 pixels whose periods
+    agree by chance are dim, their misses' noise 0.4-1.1 fringe, and are left out; the
+    command line refuses an empty decode)."""
     _, images, _ = _render("multifreq", dict(periods=periods), phase_offset=np.pi)
     plain = bistair.make_spec("multifreq", width=1080, height=1080, periods=periods)
     with pytest.raises(BistairError, match="periods agree on"):
@@ -72,7 +74,8 @@ def test_multifrequency_with_the_wrong_convention(periods):
     except BistairError as exc:
         assert "read on only" in str(exc) or "outside the 1080-px projector" in str(exc)
     else:
-        assert result.mask.sum() > 1000 and "shift_sign -1" in result.info["warnings"][0]
+        assert result.mask.sum() == 0 or (
+            result.mask.sum() > 1000 and "shift_sign -1" in result.info["warnings"][0])
 
 
 def test_frames_in_another_order_with_black_and_ignored_frames():

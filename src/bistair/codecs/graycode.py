@@ -435,7 +435,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
             against, steps = cell_steps(k)
             info.update(cell_steps=steps, cell_steps_against=against)
             refuse(direction_problem(against, steps))
-        return Orders(k, info)
+        return Orders(k, info, read=None if carried is None else read)
     # the regions join every pixel read; only those whose evidence carries its order vote
     labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))

@@ -344,7 +344,8 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
     """Stage 2: the shortest period's order from the longer periods (or their beats).
 
-    ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step and
+    ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step,
+    ``maps["spread"]`` the largest noise of a step's miss (:func:`unwrap_spread`) and
     ``maps["valid"]`` where every period is well modulated.
 
     Parameters
@@ -363,10 +364,11 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     -------
     CodeMap
         ``code``: (H, W) int32 order of the shortest period, -1 where some period is not
-        valid; ``maps``: ``worst`` (fringes), ``valid`` (bool) and ``residual`` (the last
-        step's signed miss, fringes), all (H, W). The hierarchical rule unwraps in float64
-        and stores float32 (``worst`` rounded toward zero: below 0.25 exactly where the
-        float64 miss is); the heterodyne rule keeps float64.
+        valid; ``maps``: ``worst`` (fringes), ``spread`` (float32 fringes), ``valid`` (bool)
+        and ``residual`` (the last step's signed miss, fringes), all (H, W). The
+        hierarchical rule unwraps in float64 and stores float32 (``worst`` rounded toward
+        zero: below 0.25 exactly where the float64 miss is); the heterodyne rule keeps
+        float64.
 
     Examples
     --------
@@ -377,7 +379,7 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     >>> fs = measure_columns(cols, spec)
     >>> code = code_columns(cols, spec, fs)
     >>> code.code[0, ::42].tolist(), sorted(code.maps), bool(code.maps["worst"].max() < 0.01)
-    ([0, 1, 2, 3, 4, 5, 6, 7], ['residual', 'valid', 'worst'], True)
+    ([0, 1, 2, 3, 4, 5, 6, 7], ['residual', 'spread', 'valid', 'worst'], True)
     """
     n = spec.steps
     shortest = float(spec.period)
@@ -449,8 +451,8 @@ def unwrap_spread(noise: dict[float, np.ndarray], spec: MultiFreqSpec) -> np.nda
     >>> from bistair.codecs import make_spec
     >>> spec = make_spec("multifreq", width=300, height=40, periods=(42, 45, 48), steps=4)
     >>> sigma = {t: np.full((1, 1), 0.01, np.float32) for t in (42.0, 45.0, 48.0)}
-    >>> round(float(unwrap_spread(sigma, spec)[0, 0]), 4)  # 630 -> 42: 15 x 0.014 rad / 2 pi
-    0.0338
+    >>> round(float(unwrap_spread(sigma, spec)[0, 0]), 4)  # 720 -> 45: 16 x 0.014 rad / 2 pi
+    0.036
     """
     two_pi = np.float32(TWO_PI)
     spread = np.zeros(next(iter(noise.values())).shape, np.float32)
@@ -477,7 +479,10 @@ def unwrap_spread(noise: dict[float, np.ndarray], spec: MultiFreqSpec) -> np.nda
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
-    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe.
+    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe
+    and whose phases carry their order: the next order fits the worst step's miss ``m``
+    worse by ``CLEAR_NOISE**2`` of that miss's variance (``1 - 2|m| >= (3 sigma)**2``,
+    ``sigma`` from :func:`unwrap_spread`); the others are left out (``info["left_out"]``).
 
     Captures where the periods agree on under half of the well-modulated pixels do not fit
     the spec (periods, frame order or phase convention) and are refused; a coordinate that
@@ -497,9 +502,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
     -------
     Orders
         (H, W) int32 order of the shortest period per pixel (-1 where invalid) and
-        ``info``: the unwrap rule, the camera noise, the well-modulated pixels
-        (``valid_modulation``), the share where every step agrees (``period_agreement``)
-        and any ``warnings``.
+        ``info``: the unwrap rule, the camera noise, the pixels left out (``left_out``), the
+        well-modulated pixels (``valid_modulation``), the share where every step agrees
+        (``period_agreement``) and any ``warnings``.
 
     Raises
     ------
