@@ -16,12 +16,12 @@ from bistair.io.atomic import write_image
 from bistair.io.read import read_with_spec
 
 PARTS = list(parts())
-# kamino's rows axis as a plain 3-step + Gray code decoded by fringe regions was refused,
-# rightly, while every pixel voted (47% of its pixels one order off the rig's full decode:
-# the regions merge fringes across gamma-distorted wraps, and the dim side wall's misread
-# codes outvoted the rest); with votes only from the pixels whose own evidence carries
-# their order it is 0.1% off the full two-period decode, its wrap links at 9.9% (the limit
-# is 10%).
+# the one part a check refuses, rightly: kamino's rows axis as a plain 3-step + Gray code
+# decoded by fringe regions is 47% of its pixels one order off the rig's full decode (the
+# regions merge fringes across gamma-distorted wraps): its orders do not step by one across
+# 29% of the phase jumps. Its pixel decode is accepted (its orders as read step wrong across
+# 7% of the jumps, a warning; those pixels are left out).
+WRONG = {"kamino/T100+gray region (rows)"}
 
 
 @pytest.mark.skipif(not PARTS, reason="no real captures under ../shared/data")
@@ -29,6 +29,10 @@ PARTS = list(parts())
                          ids=[p[0] for p in PARTS])
 def test_real_captures_are_not_refused(name, folder, spec, options):
     stack, spec = read_with_spec(folder, spec)
+    if name in WRONG:
+        with pytest.raises(bistair.BistairError, match="do not step by one"):
+            bistair.decode(stack, spec, **options)
+        return
     result = bistair.decode(stack, spec, **options)
     results = [result.x, result.y] if hasattr(result, "x") else [result]
     for res in results:
