@@ -145,7 +145,9 @@ def multifreq() -> None:
         _, cols = codec._columns(images, spec)
         fs = codec.measure_columns(cols, spec)
         code = codec.code_columns(cols, spec, fs)
-        agreed = code.maps["valid"] & (code.code >= 0) & (code.maps["worst"] < 0.25)
+        coord = (fs.phi / (2 * np.pi) + code.code) * spec.period
+        agreed = (code.maps["valid"] & (code.code >= 0) & (code.maps["worst"] < 0.25)
+                  & (coord >= 0) & (coord < spec.coded_length))
         true_phase = 2 * np.pi * truth.coord(spec) / spec.period
         for oid, name in ((2, "dim (albedo 0.1)"), (1, "bright (albedo 0.8)")):
             on = truth.mask & (truth.object_id == oid)
