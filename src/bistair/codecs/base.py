@@ -100,10 +100,15 @@ class CodeMap:
 @dataclass
 class Orders:
     """Stage 3 of a decode: the fringe order per pixel (int, -1 where invalid) and figures
-    about it."""
+    about it; ``read``, where a per-pixel decoder left out pixels whose own evidence cannot
+    carry their order, the orders as its code read them, which the checks of the whole
+    decode judge (without those pixels the orders can step by one across every wrap of a
+    code read wrong: the pixels at the wraps, where code and phase disagree, are the ones
+    left out)."""
 
     order: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
+    read: np.ndarray | None = None
 
 
 MeasureFn = Callable[[Prepared, Any, float | None], FringeSet]
@@ -331,15 +336,20 @@ class Codec:
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
-            bad, big, links = wrap_steps(fs.phi, orders.order, fs.valid)
+            judged = orders.order if orders.read is None else orders.read
+            bad, big, links = wrap_steps(fs.phi, judged, fs.valid)
+            del judged
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
             judge(jump_problem(bad, links, big=big, big_limit=0.02))
             if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
+                where = ("the code reads pixels beside its edges one order off" if
+                         orders.read is None else "the code reads pixels beside its edges "
+                         "one order off (left out where their own evidence shows it)")
                 orders.info["warnings"] = [*orders.info.get("warnings", []), (
-                    f"the orders do not step by one across {100 * bad / links:.1f}% of the "
-                    "phase jumps: pixels beside the code's edges read one order off (a code "
-                    "whose edges sit on the phase jumps; a complementary or shifted code, a "
-                    "second period or --strategy region avoid it)")]
+                    f"the orders as read do not step by one across {100 * bad / links:.1f}% "
+                    f"of the phase jumps: {where} (a code whose edges sit on the phase "
+                    "jumps; a complementary or shifted code, a second period or --strategy "
+                    "region avoid it)")]
         judge(jump_problem(orders.info.get("jump_violations", 0),
                            orders.info.get("jump_links", 0)))
         modulated = int(np.count_nonzero(fs.valid))
