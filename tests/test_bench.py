@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from conftest import cli_run
 from bistair.evaluation.speed import CASES, opencv_floor, speed_captures, speed_cases
 
 NUMBER = r"\s+(-?[\d.]+)"
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def _rows(out: str) -> dict[str, list[float]]:
@@ -98,3 +100,44 @@ def test_the_floor_is_the_four_step_phase_and_modulation():
     diff = np.abs(phase - want)
     assert np.minimum(diff, 2 * np.pi - diff).max() < 1e-3  # cv2.phase: 0.3 degree accuracy
     assert np.allclose(magnitude, np.hypot(f[3] - f[1], f[0] - f[2]), rtol=1e-5)
+
+
+def test_where_the_time_goes_counts_every_stage_and_puts_the_code_back(monkeypatch):
+    """benchmarks/stage_times.py (the speed page's five rows): the default decode's time
+    split into five stages that add up to the instrumented decode, each stage holding some
+    of it, every function named by a pattern; the decode's answer unchanged by the timers,
+    and every module's functions put back afterwards."""
+    import sys
+
+    import bistair.codecs
+
+    monkeypatch.syspath_prepend(str(ROOT / "benchmarks"))  # as `python benchmarks/...` runs
+    from stage_times import STAGES, instrumented, stage_times
+
+    case = CASES[0]
+    spec = case.spec()
+    frames = speed_captures(spec, (192, 256))
+    plain = bistair.codecs.decode(frames, spec)
+    before = {name: {k: v for k, v in vars(m).items() if callable(v)}
+              for name, m in sys.modules.items() if name.startswith("bistair")}
+
+    def timers() -> int:
+        return sum(hasattr(v, "stage") for name, m in list(sys.modules.items())
+                   if name.startswith("bistair") for v in list(vars(m).values()))
+
+    with instrumented() as clock:
+        timed = bistair.codecs.decode(frames, spec)
+        assert timers() > 50
+    assert timers() == 0
+    assert np.array_equal(timed.order, plain.order)
+    assert np.array_equal(timed.phase, plain.phase, equal_nan=True)
+    assert list(clock.seconds) == list(STAGES) and len(STAGES) == 5
+    for stage, seconds in clock.seconds.items():
+        assert seconds > 0, f"nothing counted in {stage}"
+    assert sum(clock.seconds.values()) == pytest.approx(clock.total)
+    assert clock.unassigned(share=0.0) == []
+    for name, attrs in before.items():
+        module = vars(sys.modules[name])
+        assert all(module[k] is v for k, v in attrs.items() if k in module), name
+    seconds, total, unassigned = stage_times(bistair.codecs.decode, frames, spec, {}, runs=1)
+    assert sum(seconds.values()) == pytest.approx(total) and unassigned == []
