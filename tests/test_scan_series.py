@@ -27,7 +27,7 @@ from bistair.errors import BistairError
 from bistair.io.read import read_captures
 from bistair.sim import Imaging, preset, render
 
-SPEC = make_spec("graycode", width=1920, height=1080, period=120, complementary=1)  # 12 frames
+SPEC = make_spec("graycode", width=1920, height=1080, period=120, complementary=1)  # 9 frames
 SIZE = (128, 96)
 CAMERA = f"sim:sphere-on-plane:{SIZE[0]}x{SIZE[1]}"
 ARRAYS = ("coord.npy", "info.json", "mask.npy", "order.npy", "phase.npy")
