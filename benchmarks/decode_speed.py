@@ -31,7 +31,8 @@ with the default settings. ``--markdown docs/results/speed.md`` writes the page 
 documentation's results: both tables, then what the script printed.
 
     python benchmarks/decode_speed.py [--runs 5] [--sizes 1.3,12] [--threads N] [--no-memory]
-                                      [--codecs 0,2] [--markdown docs/results/speed.md]
+                                      [--no-compile] [--codecs 0,2]
+                                      [--markdown docs/results/speed.md]
 """
 
 from __future__ import annotations
@@ -226,6 +227,8 @@ def main() -> None:
     parser.add_argument("--sizes", default="1.3,12")
     parser.add_argument("--threads", type=int, default=None)
     parser.add_argument("--no-memory", action="store_true", help="skip the fresh processes")
+    parser.add_argument("--no-compile", action="store_true",
+                        help="skip the fresh processes that compile every kernel (minutes)")
     parser.add_argument("--codecs", default=None,
                         help="comma-separated indices of the codecs to time (default: all)")
     parser.add_argument("--markdown", type=Path, default=None,
@@ -275,9 +278,10 @@ def run(args: argparse.Namespace, found: dict[str, dict]) -> None:
                     cold = fresh_process(frames, spec, case.options, cache)
                 mem = f"{1024 * cold['peak_kb'] / (size[0] * size[1]):5.1f}"
                 first = f"{cold['first']:6.2f}s" if have else "-"
-                with tempfile.TemporaryDirectory() as cache:
-                    jit = fresh_process(frames, spec, case.options, cache, prebuilt=False)
-                compile_s = f"{jit['first'] - jit['warm']:6.1f}s"
+                if not args.no_compile:
+                    with tempfile.TemporaryDirectory() as cache:
+                        jit = fresh_process(frames, spec, case.options, cache, prebuilt=False)
+                    compile_s = f"{jit['first'] - jit['warm']:6.1f}s"
                 entry["memory"][case.label] = f"{mem.strip()} B/px"
                 entry["first"][case.label] = first.strip() if have else None
             against = f"{t.ratio / default:8.2f}" if default else f"{'':8s}"
