@@ -72,6 +72,8 @@ MAX_BACKLOG = 100
 MAX_SCANS = 1_000_000
 # why a scan has no decode
 BEHIND, STOPPED = "the decode fell behind", "stopped before its decode"
+NOT_ASKED = "no --decode"
+_NOT_FAILED = (None, BEHIND, STOPPED, NOT_ASKED)
 
 
 @dataclass
@@ -94,7 +96,7 @@ class SeriesReport:
         if what in reasons:
             return sum(r["not_decoded"] in reasons[what] for r in self.records)
         if what == "failed":
-            return sum(r["not_decoded"] not in (None, BEHIND, STOPPED) for r in self.records)
+            return sum(r["not_decoded"] not in _NOT_FAILED for r in self.records)
         raise ValueError(what)
 
     def to_dict(self) -> dict[str, Any]:
@@ -203,7 +205,7 @@ class _Pipeline:
         record = {"index": index, "folder": f"scan-{index:0{self.digits}d}",
                   "started": round(now - grabbed.info["seconds"], 4),
                   "grabbed": round(now, 4), "decoded": False, "decode_seconds": None,
-                  "valid": None, "not_decoded": None if self.decoding else "not asked"}
+                  "valid": None, "not_decoded": None if self.decoding else NOT_ASKED}
         job = (record, grabbed, threading.Event())  # the event: its captures are written
         with _signals_held():
             t0 = time.monotonic()
@@ -327,7 +329,7 @@ def summary_lines(report: SeriesReport) -> tuple[list[str], list[str]]:
             warnings.append(f"{behind} of {n} scans not decoded: the decode ({each.rstrip('; ')}"
                             f") fell behind the scans ({rate or 0:.1f} scans/s); their captures "
                             f"are in {out} ('bistair batch {out} --out RESULT' decodes them)")
-        failed = [r for r in report.records if r["not_decoded"] not in (None, BEHIND, STOPPED)]
+        failed = [r for r in report.records if r["not_decoded"] not in _NOT_FAILED]
         if failed:
             warnings.append(f"{len(failed)} scans not decoded ({failed[0]['folder']}: "
                             f"{failed[0]['not_decoded']}; see {out}/{SERIES_FILE})")
