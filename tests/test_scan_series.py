@@ -198,6 +198,62 @@ def test_a_series_replaces_an_earlier_one_whole(tmp_path):
         scan_series(SPEC, "none", "sim:plane:48x32@500", other, 2)
 
 
+class _StopAt:
+    """A queue's put that raises KeyboardInterrupt (a Ctrl-C) at its ``at``-th call, before
+    or after the item is queued."""
+
+    def __init__(self, put, at: int, after: bool) -> None:
+        self.put, self.at, self.after, self.calls = put, at, after, 0
+
+    def __call__(self, queue, item, *args, **kwargs):
+        if item is None or item[0] is None:  # the end of the series, the decoder's warm-up
+            return self.put(queue, item, *args, **kwargs)
+        self.calls += 1
+        if self.calls == self.at and not self.after:
+            raise KeyboardInterrupt
+        self.put(queue, item, *args, **kwargs)
+        if self.calls == self.at:
+            raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize(("where", "after", "listed"), [
+    ("writes", False, 2),  # scan 3 never reached the writer: left out
+    ("writes", True, 3),  # written, never handed to the decoder: stopped before its decode
+    ("decodes", False, 3),
+])
+def test_a_stop_between_handing_a_scan_on_leaves_the_records_whole(tmp_path, monkeypatch,
+                                                                    where, after, listed):
+    """Ctrl-C may come between any two steps of handing a scan on (to the writer, then the
+    decoder): series.json lists exactly the scan folders written, each decoded or stopped
+    before its decode (the decodes still waiting when it came are not begun)."""
+    import queue
+
+    pipeline = series._Pipeline.__init__
+
+    def init(pipe, *args, **kwargs):
+        pipeline(pipe, *args, **kwargs)
+        target = getattr(pipe, where)
+        stop = _StopAt(queue.Queue.put, 3, after)
+        target.put = lambda item, *a, **k: stop(target, item, *a, **k)
+
+    monkeypatch.setattr(series._Pipeline, "__init__", init)
+    out = tmp_path / "series"
+    with pytest.raises(KeyboardInterrupt):
+        scan_series(SPEC, "none", "sim:sphere-on-plane:128x96@500", out, 5, decode=True,
+                    backlog=5, previews=False)
+    data = json.loads((out / "series.json").read_text())
+    assert data["stopped"] == "KeyboardInterrupt" and data["grabbed"] == listed
+    assert all(r["decoded"] or r["not_decoded"] == "stopped before its decode"
+               for r in data["scans"])
+    if listed == 3:  # the scan the stop came at was written, not decoded
+        assert not data["scans"][2]["decoded"]
+    assert data["decoded"] + data["stopped_before_decode"] == listed
+    assert sorted(p.name for p in out.iterdir() if p.is_dir()) == [
+        r["folder"] for r in data["scans"]]
+    for record in data["scans"]:
+        _check_scan_folder(out / record["folder"], decoded=record["decoded"])
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
 def test_a_signal_mid_series_keeps_the_scans_grabbed_whole(tmp_path, sig):

@@ -41,10 +41,9 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
-import signal
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -170,7 +169,8 @@ class _Pipeline:
         self.tmp, self.spec, self.decoding, self.backlog = tmp, spec, decode, backlog
         self.previews, self.start = previews, start
         self.digits = max(4, len(str(count - 1)))
-        self.records: list[dict[str, Any]] = []
+        self.entries: list[tuple[dict[str, Any], threading.Event]] = []  # handed on or not
+        self.records: list[dict[str, Any]] = []  # those written (made by finish)
         self.writes: queue.Queue = queue.Queue(maxsize=WRITE_BACKLOG)
         self.decodes: queue.Queue = queue.Queue()
         self.lock = threading.Lock()
@@ -183,9 +183,8 @@ class _Pipeline:
         if decode:
             self.threads.append(threading.Thread(target=self._decoder, args=(thread_count(),),
                                                  daemon=True))
-        with _signals_held():  # Ctrl-C and SIGTERM go to the caller's thread alone
-            for thread in self.threads:
-                thread.start()
+        for thread in self.threads:
+            thread.start()
 
     def warm_up(self) -> None:
         """Decode (a corner of) the spec's own patterns on the decoder thread and wait:
@@ -195,10 +194,9 @@ class _Pipeline:
         done.wait()
 
     def add(self, grabbed: Scan) -> None:
-        """A scan is grabbed: hand it to the writer and, if there is room, the decoder (with
-        Ctrl-C and SIGTERM held back meanwhile, so that a scan is in the records exactly
-        when it is handed on)."""
-        index = len(self.records)
+        """A scan is grabbed: hand it to the writer and, if there is room, the decoder. A
+        stop (Ctrl-C) between any two steps leaves what :meth:`finish` sorts out."""
+        index = len(self.entries)
         if index == 0:
             self.warnings = list(grabbed.info.get("warnings", []))
         now = time.monotonic() - self.start
@@ -206,29 +204,34 @@ class _Pipeline:
                   "started": round(now - grabbed.info["seconds"], 4),
                   "grabbed": round(now, 4), "decoded": False, "decode_seconds": None,
                   "valid": None, "not_decoded": None if self.decoding else NOT_ASKED}
-        job = (record, grabbed, threading.Event())  # the event: its captures are written
-        with _signals_held():
-            t0 = time.monotonic()
-            self.writes.put(job)  # waits only when WRITE_BACKLOG scans wait
-            self.waited += time.monotonic() - t0
-            self.records.append(record)
-            if self.decoding:
-                with self.lock:
-                    if self.waiting < self.backlog:
-                        self.waiting += 1
-                        self.most_waiting = max(self.most_waiting, self.waiting)
-                        self.decodes.put(job)
-                    else:
-                        record["not_decoded"] = BEHIND
+        written = threading.Event()  # set by the writer once the captures are written
+        self.entries.append((record, written))
+        t0 = time.monotonic()
+        self.writes.put((record, grabbed, written))  # waits only when WRITE_BACKLOG wait
+        self.waited += time.monotonic() - t0
+        if self.decoding:
+            with self.lock:
+                if self.waiting < self.backlog:
+                    self.waiting += 1
+                    self.most_waiting = max(self.most_waiting, self.waiting)
+                    self.decodes.put((record, grabbed, written))
+                else:
+                    record["not_decoded"] = BEHIND
 
     def finish(self, stop: bool) -> None:
-        """Write every scan grabbed; with ``stop``, decode none that has not begun."""
+        """Write every scan handed on; with ``stop``, decode none that has not begun. Then
+        the records: a scan stopped before it reached the writer is left out, one stopped
+        before it reached the decoder is listed as stopped."""
         if stop:
             self.stop.set()
         self.writes.put(None)
         self.decodes.put(None)
         for thread in self.threads:
             thread.join()
+        self.records = [record for record, written in self.entries if written.is_set()]
+        for record in self.records:
+            if not record["decoded"] and record["not_decoded"] is None:
+                record["not_decoded"] = STOPPED
 
     def figures(self) -> dict[str, Any]:
         """The series' rates and waits, for ``series.json`` and the summary."""
@@ -340,21 +343,6 @@ def summary_lines(report: SeriesReport) -> tuple[list[str], list[str]]:
                         "captures to be written (the disk or the CPU is slower than the "
                         "camera)")
     return lines, warnings
-
-
-@contextlib.contextmanager
-def _signals_held() -> Iterator[None]:
-    """Hold SIGINT and SIGTERM back (POSIX; they arrive when the block ends)."""
-    held = {signal.SIGINT, signal.SIGTERM}
-    if not hasattr(signal, "pthread_sigmask") or \
-            threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, held)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _warnings(result: Any) -> list[str]:
