@@ -25,7 +25,7 @@ from .cli_options import (
               "or none (the projector holds the patterns and triggers the camera)")
 @click.option("--camera", required=True, metavar="CAMERA",
               help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
-              "sim[:SCENE[:WxH]]")
+              "sim[:SCENE[:WxH]][@FPS]")
 @click.option("--out", "-o", type=click.Path(path_type=Path), default=None,
               help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
 @click.option("--settle-ms", type=float, default=None,
