@@ -283,7 +283,7 @@ def run(args: argparse.Namespace, found: dict[str, dict]) -> None:
                         jit = fresh_process(frames, spec, case.options, cache, prebuilt=False)
                     compile_s = f"{jit['first'] - jit['warm']:6.1f}s"
                 entry["memory"][case.label] = f"{mem.strip()} B/px"
-                entry["first"][case.label] = first.strip() if have else None
+                entry["first"][case.label] = _ms(cold["first"]) if have else None
             against = f"{t.ratio / default:8.2f}" if default else f"{'':8s}"
             print(f"{case.label:<28} {1e3 * t.decode_s:6.0f}ms {1e3 * t.floor_s:5.1f}ms "
                   f"{t.ratio:6.1f} {f'{min(t.ratios):.0f}-{max(t.ratios):.0f}':>8} "
