@@ -543,6 +543,44 @@ def set_threads(count: int | None) -> int:
     return numba.get_num_threads()
 
 
+def thread_count() -> int:
+    """The threads the kernels called from this thread use (numba keeps the count per
+    thread: a new thread starts with every core, whatever :func:`set_threads` said in the
+    thread that started it; give it the count with :func:`set_threads`).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> set_threads(1), thread_count()
+    (1, 1)
+    >>> set_threads(None) == thread_count()
+    True
+    """
+    return int(_numba().get_num_threads())
+
+
+def threading_layer() -> str:
+    """numba's threading layer (``omp``, ``tbb`` or ``workqueue``), or ``not started`` before
+    the first parallel kernel of the process has run.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> threading_layer() in ("omp", "tbb", "workqueue", "not started")
+    True
+    """
+    try:
+        return str(_numba().threading_layer())
+    except ValueError:  # no parallel kernel has run yet
+        return "not started"
+
+
 def side_by_side(first: Callable[[], Any], second: Callable[[], Any]) -> tuple[Any, Any]:
     """``(first(), second())``, run at once on two threads that share this thread's kernel
     threads (half each) where numba's threading layer allows kernels from two threads at
