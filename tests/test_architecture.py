@@ -13,7 +13,8 @@ LAYERS = {"errors": 0, "spec": 0, "hooks": 0, "core": 1, "codecs": 2, "io": 3, "
           "sim": 5, "evaluation": 6, "acquire": 6.5, "app": 7}
 # Commands import their jobs when they run (a fast --help and --version).
 LAZY_OK = {"bistair.app.cli", "bistair.app.cli_options", "bistair.app.cli_simulate",
-           "bistair.app.cli_stereo", "bistair.app.cli_scan", "bistair.app.cli_batch"}
+           "bistair.app.cli_stereo", "bistair.app.cli_scan", "bistair.app.cli_batch",
+           "bistair.app.cli_bench"}
 
 
 def _modules() -> dict[str, Path]:

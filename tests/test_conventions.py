@@ -39,9 +39,7 @@ def _right(result, truth, spec, tolerance=0.001):
 @pytest.mark.parametrize(("method", "params"), CODECS, ids=IDS)
 def test_a_spec_that_names_the_convention_decodes_it(method, params, offset, sign):
     spec, images, truth = _render(method, params, phase_offset=offset, shift_sign=sign)
-    tolerance = 0.03 if (method == "graycode" and not params.get("complementary")
-                         ) else 0.001  # plain and shifted: misreads beside the code's edges
-    _right(bistair.decode(images, spec), truth, spec, tolerance)
+    _right(bistair.decode(images, spec), truth, spec)
 
 
 @pytest.mark.parametrize(("offset", "sign", "hint"), [
@@ -63,7 +61,9 @@ def test_a_spec_with_the_wrong_convention_is_refused(method, params, offset, sig
 def test_multifrequency_with_the_wrong_convention(periods):
     """Offsets break the agreement of the periods (refused); a sign flip of every set is a
     mirrored projector to the captures: warned about where the mirrored coordinates land on
-    the projector, else refused (42, 45 and 48 px: a few pixels' land there, all wrong)."""
+    the projector, else refused or left empty (42, 45 and 48 px: the 21 pixels whose periods
+    agree by chance are dim, their misses' noise 0.4-1.1 fringe, and are left out; the
+    command line refuses an empty decode)."""
     _, images, _ = _render("multifreq", dict(periods=periods), phase_offset=np.pi)
     plain = bistair.make_spec("multifreq", width=1080, height=1080, periods=periods)
     with pytest.raises(BistairError, match="periods agree on"):
@@ -74,7 +74,8 @@ def test_multifrequency_with_the_wrong_convention(periods):
     except BistairError as exc:
         assert "read on only" in str(exc) or "outside the 1080-px projector" in str(exc)
     else:
-        assert result.mask.sum() > 1000 and "shift_sign -1" in result.info["warnings"][0]
+        assert result.mask.sum() == 0 or (
+            result.mask.sum() > 1000 and "shift_sign -1" in result.info["warnings"][0])
 
 
 def test_frames_in_another_order_with_black_and_ignored_frames():
@@ -127,24 +128,38 @@ def test_fractional_periods(method, params):
     assert bistair.spec_from_dict(spec.to_dict()) == spec
 
 
+def _read_errors(result, truth, spec) -> float:
+    """The share of the pixels read whose order, as the code reads it, is off."""
+    read = truth.mask & (result.code >= 0)
+    phase = result.wrapped + 2 * np.pi * result.code
+    return float((read & (np.abs(phase - 2 * np.pi * truth.coord(spec) / spec.period)
+                          > np.pi)).sum() / read.sum())
+
+
 @pytest.mark.parametrize("offset", [0.0, 0.5])
 def test_gray_code_misreads_beside_its_edges_are_outvoted(offset):
     """Plain and shifted codes misread beside their edges (at the phase jumps, or mid-fringe
-    for the shifted one); voting per fringe region removes those errors."""
+    for the shifted one): 1.6% of the pixels as read. Per pixel the evidence test leaves
+    them out (no order error, 1.6% fewer pixels); voting per fringe region gives them their
+    orders."""
     scene = warped_scene(1, noise=0.02, blur=1.5)
     spec = bistair.make_spec("graycode", width=1080, height=1080, period=30,
                              gray_offset=offset)
     images, truth = render_warp(spec, scene)
-    found = {strategy: score(bistair.decode(images, spec, strategy=strategy),
-                             truth.coord(spec), truth.mask) for strategy in ("pixel", "region")}
-    assert found["pixel"]["order_error_rate"] > 0.005
+    results = {s: bistair.decode(images, spec, strategy=s) for s in ("pixel", "region")}
+    found = {s: score(r, truth.coord(spec), truth.mask) for s, r in results.items()}
+    assert _read_errors(results["pixel"], truth, spec) > 0.005
+    assert found["pixel"]["order_error_rate"] < 0.0005 and found["pixel"]["coverage"] > 0.97
     assert found["region"]["order_error_rate"] < 0.0005 and found["region"]["coverage"] > 0.99
+    assert found["pixel"]["coverage"] < found["region"]["coverage"]
     assert bistair.make_spec("graycode", width=1080, height=1080, period=30,
                              gray_offset=0.5).code_bits == 6  # 37 levels
 
 
 def test_gray_code_checked_by_a_second_period():
-    """The kamino layout: 3-step sets at 100 and 200/3 px, Gray cells of 100 px, inverses."""
+    """The kamino layout: 3-step sets at 100 and 200/3 px, Gray cells of 100 px, inverses.
+    Without the second period 1.1% of the pixels read one order off; the evidence test
+    leaves them out, the second period reads them right."""
     spec = bistair.make_spec("graycode", width=1920, height=1080, period=100, steps=3,
                              second_period=200 / 3, inverse=1)
     plain = spec.replace(second_period=0.0, frame_order=())
@@ -152,9 +167,12 @@ def test_gray_code_checked_by_a_second_period():
     images, truth = render_warp(spec, scene)
     checked = score(bistair.decode(images, spec), truth.coord(spec), truth.mask)
     keep = [spec.frames.index(n) for n in plain.frames]
-    alone = score(bistair.decode(images[keep], plain), truth.coord(spec), truth.mask)
-    assert alone["order_error_rate"] > 0.005
+    result = bistair.decode(images[keep], plain)
+    alone = score(result, truth.coord(spec), truth.mask)
+    assert _read_errors(result, truth, plain) > 0.005
+    assert alone["order_error_rate"] < 0.0005 and alone["coverage"] > 0.97
     assert checked["order_error_rate"] < 0.0005 and checked["coverage"] > 0.97
+    assert alone["coverage"] < checked["coverage"]
     with pytest.raises(BistairError, match="whole number"):
         spec.replace(second_period=50.0)
 

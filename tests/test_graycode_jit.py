@@ -1,7 +1,8 @@
-"""The Gray code's compiled passes (bistair.codecs.graycode_jit: code bits, orders, and the
+"""The Gray code's compiled passes (bistair.codecs.graycode_jit: code bits, orders, the
 Gray code alone's levels and cells) give, bit for bit, what NumPy gives (written out here:
 the first bit the most significant, as OpenCV's GrayCodePattern), on random data and on the
-values where roundings and thresholds bite."""
+values where roundings and thresholds bite; and the evidence each order needs, pixel by
+pixel."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import numpy as np
 from support.arrays import same
 
 from bistair.codecs.graycode import gray_to_binary
-from bistair.codecs.graycode_jit import alone_cells, alone_levels, code_bits, gray_orders
+from bistair.codecs.graycode_jit import alone_cells, alone_levels, code_bits, read_orders
 from bistair.core.captures import ScaledStack
 from bistair.core.phase import TWO_PI
 
@@ -30,11 +31,22 @@ def test_code_bits_are_numpys():
         assert same(code_bits(raw, 2, 3, np.float32(1 / 255), avg, inverse), gray)
 
 
-def test_gray_orders_are_numpys():
+
+def _frames(gray: np.ndarray, bits: int, contrast=0.4) -> np.ndarray:
+    """Code frames and their inverses (float32, fractions of full scale) of ``gray``."""
+    bright = np.stack([(gray >> b) & 1 for b in range(bits - 1, -1, -1)])
+    code = 0.5 + contrast * (2 * bright - 1)
+    return np.concatenate([code, 1 - code]).astype(np.float32)
+
+
+def test_read_orders_are_numpys():
+    """The orders and edges as read are the NumPy expressions of the three rules."""
     gray = RNG.integers(0, 2**8, (30, 40)).astype(np.int32)
     phi = RNG.uniform(0, TWO_PI, gray.shape).astype(np.float32)
     phi.flat[:4] = [np.nan, np.float32(np.pi / 2), np.float32(1.5 * np.pi), np.float32(np.pi)]
     valid = RNG.random(gray.shape) < 0.9
+    raw = _frames(gray, 8)
+    mod = np.full(gray.shape, 0.3, np.float32)
     for mode, fringes in ((0, 200), (1, 100), (2, 200)):
         if mode == 1:
             k1 = gray_to_binary(gray >> 1)
@@ -47,10 +59,60 @@ def test_gray_orders_are_numpys():
         else:
             k = edges = gray_to_binary(gray)
         ok = valid & (k >= 0) & (k < fringes)
-        code, got_edges, beyond = gray_orders(gray, phi, valid, mode, fringes)
+        code, got_edges, carried, beyond = read_orders(
+            raw, 0, 8, 1.0, mod, True, phi, mod, valid, mode, fringes, 0.01, 0.01, 3.0, 0.5,
+            0.5)
         assert same(code, np.where(ok, k, -1).astype(np.int32))
         assert same(got_edges, np.where(valid, edges, -1).astype(np.int32))
         assert beyond == int(np.count_nonzero(valid & (k >= fringes)))
+        assert not (carried & ~ok).any()
+
+
+def _carried(d, phi, mode=0, inverse=True, noise_d=0.01, mod=0.3):
+    """Whether the evidence carries the order of one pixel whose bit margins (MSB first)
+    are ``d``."""
+    d = np.asarray(d, np.float32)
+    bits = len(d)
+    if inverse:
+        raw = np.concatenate([0.5 + d / 2, 0.5 - d / 2])[:, None, None]
+    else:
+        raw = (0.5 + d)[:, None, None]
+    one = np.ones((1, 1), np.float32)
+    out = read_orders(raw.astype(np.float32), 0, bits, 1.0, 0.5 * one, inverse,
+                      np.float32(phi) * one, np.float32(mod) * one, one > 0, mode, 2**bits,
+                      noise_d, 0.01, 3.0, 0.5, 0.5)
+    assert out[0][0, 0] >= 0
+    return bool(out[2][0, 0])
+
+
+def test_the_evidence_of_one_pixel():
+    """Cell 5 (Gray 111) of a 3-bit plain code: its lower edge is its last bit's (to cell
+    4, Gray 110), its upper edge its middle bit's (to cell 6, Gray 101)."""
+    at = TWO_PI  # the phase, as a share of the fringe
+    assert _carried([0.8, 0.8, 0.8], 0.5 * at)  # every bit clear
+    # the last bit unclear: carried where the phase puts the pixel beside that bit's edge,
+    # at the start of cell 5 (and beyond the phase's noise), not at its end
+    assert _carried([0.8, 0.8, 0.02], 0.2 * at)
+    assert not _carried([0.8, 0.8, 0.02], 0.8 * at)
+    assert not _carried([0.8, 0.8, 0.2], 0.8 * at)  # a faint bit away from its edge
+    assert _carried([0.8, 0.8, 0.5], 0.8 * at)  # over half the contrast
+    # within three sigma of the phase's wrap (sigma = 0.01 / 0.3 rad): the weaker edge bit
+    # must be at the phase's end of the cell
+    assert _carried([0.8, 0.7, 0.8], 0.995 * at)  # the upper edge's bit is the weaker
+    assert not _carried([0.8, 0.8, 0.7], 0.995 * at)
+    assert _carried([0.8, 0.8, 0.7], 0.005 * at)
+    assert not _carried([0.8, 0.7, 0.8], 0.005 * at)
+    # four unclear bits are more than the evidence can sort out when they are faint
+    assert not _carried([0.8, 0.01, 0.01, 0.01, 0.01], 0.5 * at)
+    # without inverses the dark bits read against the fringes' average may be weaker than
+    # the bright ones: each sign is judged against its own kind
+    assert _carried([0.4, 0.4, -0.15], 0.5 * at, inverse=False)
+    assert not _carried([0.4, 0.4, -0.15, -0.02], 0.5 * at, inverse=False)
+    # the first bit of cell 10 of 32 (Gray 01111; its edge 6 cells away) under three sigma:
+    # where the pixel's contrast and the bit together clear them, noise could not have
+    # flipped it; where they do not, it could have
+    assert _carried([-0.03, 0.05, 0.05, 0.05, 0.05], 0.5 * at, noise_d=0.012)
+    assert not _carried([-0.01, 0.02, 0.02, 0.02, 0.02], 0.5 * at, noise_d=0.012)
 
 
 def alone_levels_numpy(raw: np.ndarray, bits: int, inverse: bool, scale: float,

@@ -67,6 +67,19 @@ def test_a_decode_needs_only_listed_kernels(method, params, options, dtype):
             assert tuple(type_name(t) for t in sig) in listed.get(key, []), (key, sig)
 
 
+def test_a_decode_reading_moved_stair_levels_needs_only_listed_kernels():
+    """A projector gamma the patterns do not compensate: the stair phase is mapped where the
+    levels read (core.stair_jit.relinearize32), as no capture above needs."""
+    spec = bistair.make_spec("bidirectional", width=240, height=96, period=20, partitions=3,
+                             stairs=4, group_rows=16, local_rows=10)
+    images = np.round(bistair.encode(spec) ** 2.2 * 255).astype(np.uint8)
+    assert "stair_response" in bistair.decode(images, spec).info
+    listed = read_signatures()
+    for key, sigs in compiled_kernels().items():
+        for sig in sigs:
+            assert tuple(type_name(t) for t in sig) in listed.get(key, []), (key, sig)
+
+
 def _python(code: str, env: dict[str, str], cwd: Path) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-c", code], env=env, cwd=cwd, text=True,
                           capture_output=True, timeout=900)

@@ -7,10 +7,12 @@
   :mod:`bistair.acquire.genicam`.
 - :class:`ScreenCamera` (``screen[:MONITOR]``): screenshots of a monitor (mss), a camera
   that looks at the screen itself, for tests and demonstrations.
-- :class:`SimCamera` (``sim[:SCENE[:WxH]]``): the virtual rig (:mod:`bistair.sim`)
+- :class:`SimCamera` (``sim[:SCENE[:WxH]][@FPS]``): the virtual rig (:mod:`bistair.sim`)
   renders what its camera sees of the pattern the display shows, with the imaging of
   ``bistair simulate``'s defaults, frame ``k`` with the noise of frame ``k`` of
-  ``bistair simulate``; a preset scene or a calibration board in one of eight poses.
+  ``bistair simulate``; a preset scene or a calibration board in one of eight poses. At a
+  frame rate (``@FPS``) it delivers a frame every ``1/FPS`` s, as a camera does, rendering
+  each pattern once (:meth:`Camera.prepare`).
 
 A camera is a context manager: leaving the ``with`` block (also by Ctrl-C or an error)
 releases the device. :meth:`Camera.grab` returns one :class:`Frame`, 2-D grey in the
@@ -31,6 +33,7 @@ Examples
 from __future__ import annotations
 
 import time
+import zlib
 from typing import Any, NamedTuple
 
 import cv2
@@ -48,6 +51,7 @@ PIXEL_FORMATS = ("Mono8", "Mono12", "Mono16")
 SIM_IMAGING = dict(read_noise=0.01, camera_blur=1.0, gamma=2.2, ambient=0.05, bits=8, seed=0)
 FETCH_TIMEOUT = 5.0  # seconds a camera may take to deliver a frame
 SIM_BOARD = Board("checkerboard", 9, 6, 20.0)  # the board of the sim:board-N scenes
+MAX_FPS = 1000.0  # the sim camera's highest frame rate
 
 
 class Frame(NamedTuple):
@@ -105,6 +109,10 @@ class Camera:
     def check(self, width: int, height: int) -> None:
         """Refuse patterns of ``width x height`` the camera cannot see whole (before it
         opens)."""
+
+    def prepare(self, patterns: np.ndarray) -> None:
+        """The patterns the display will show, before the first (a camera that renders
+        them, the simulated one at a frame rate, renders them here)."""
 
     def grab(self) -> Frame:
         """The next frame."""
@@ -286,23 +294,37 @@ class ScreenCamera(Camera):
 
 
 class SimCamera(Camera):
-    """``sim[:SCENE[:WxH]]``: the virtual rig of a preset scene (``paper-sim`` by default;
-    camera size ``WxH``, by default the preset's) renders the pattern the display shows,
-    placed at the top-left of its projector as a screen shows it. ``board-N`` (N from 0 to
-    7) is the 9 x 6 checkerboard of 20 mm of ``bistair simulate --scene calibration`` in its
-    pose N, on the default rig (1920 x 1080 projector). Exposure: the response to full
-    white, above 0 and at most 1 (0.8 by default, :class:`~bistair.sim.Imaging`)."""
+    """``sim[:SCENE[:WxH]][@FPS]``: the virtual rig of a preset scene (``paper-sim`` by
+    default; camera size ``WxH``, by default the preset's) renders the pattern the display
+    shows, placed at the top-left of its projector as a screen shows it. ``board-N`` (N from
+    0 to 7) is the 9 x 6 checkerboard of 20 mm of ``bistair simulate --scene calibration``
+    in its pose N, on the default rig (1920 x 1080 projector). Exposure: the response to
+    full white, above 0 and at most 1 (0.8 by default, :class:`~bistair.sim.Imaging`).
+
+    ``fps``: a camera that delivers a frame every ``1/fps`` seconds from its first grab
+    (a grab waits for the next frame; one asked for late is delivered at once, as from a
+    camera's buffer). So that rendering costs no time between frames, it renders each
+    pattern once, in :meth:`prepare` (pattern ``k`` with the noise of frame ``k``, as
+    without a rate) or when first shown, and delivers that image whenever the pattern is
+    shown again: a still scene scanned again and again gives the same images."""
 
     kind = "sim"
     settings = ("exposure",)
     settle_ms = 0.0  # it sees the pattern the moment it is shown
 
     def __init__(self, scene: str = "paper-sim", size: tuple[int, int] | None = None,
-                 **settings: Any) -> None:
+                 fps: float | None = None, **settings: Any) -> None:
         super().__init__(**settings)
         if self.exposure is not None and not 0 < self.exposure <= 1:  # (NaN too)
             raise BistairError(f"the sim camera's exposure is its response to white, above 0 "
                                f"and at most 1, got {self.exposure:g}")
+        if fps is not None and (isinstance(fps, bool) or not isinstance(fps, int | float)
+                                or not 0 < fps <= MAX_FPS):
+            raise BistairError(f"the frame rate of the sim camera must be above 0 and at most "
+                               f"{MAX_FPS:g} frames a second, got {fps!r}")
+        self.fps = None if fps is None else float(fps)
+        self._rendered: dict[int, list[tuple[np.ndarray, np.ndarray]]] = {}
+        self._next: float | None = None  # when the next frame is due (at a frame rate)
         boards = [f"board-{i}" for i in range(len(POSES))]
         if scene not in (*scene_names(), *boards):
             raise BistairError(f"unknown sim scene {scene!r} (known: "
@@ -322,13 +344,24 @@ class SimCamera(Camera):
 
     @property
     def name(self) -> str:
-        return f"sim:{self.scene}" + (f":{self.size[0]}x{self.size[1]}" if self.size else "")
+        return f"sim:{self.scene}" + (f":{self.size[0]}x{self.size[1]}" if self.size else "") \
+            + (f"@{self.fps:g}" if self.fps is not None else "")
 
     def open(self) -> None:
         self._trace = trace(self._rig, self._geometry, self.imaging)
+        self._rendered, self._next = {}, None
 
     def close(self) -> None:
         self._trace = None
+        self._rendered = {}
+
+    def prepare(self, patterns: np.ndarray) -> None:
+        if self.fps is None:
+            return
+        top = 65535.0 if patterns.dtype == np.uint16 else 255.0
+        for k, codes in enumerate(patterns):
+            if self._cached(codes) is None:  # as a display holds it: fractions of full scale
+                self._keep(codes, self._render(codes.astype(np.float32) / np.float32(top), k))
 
     def attach(self, display: Display) -> None:
         self._display = display
@@ -341,21 +374,50 @@ class SimCamera(Camera):
                                f"{self.name}")
 
     def grab(self) -> Frame:
-        shown = None if self._display is None else self._display.current
-        if shown is None:
+        codes = None if self._display is None else self._display.codes
+        if codes is None:
             raise BistairError(f"camera {self.name} sees no pattern: nothing was shown")
-        projector = self._trace.rig.projector
-        self.check(shown.shape[1], shown.shape[0])
-        screen = np.zeros((projector.height, projector.width), np.float32)
-        screen[:shown.shape[0], :shown.shape[1]] = shown
-        image = expose(self._trace, screen[None], self.imaging, first_frame=self.grabs)[0]
+        self.check(codes.shape[1], codes.shape[0])
+        if self.fps is None:
+            image = self._render(self._display.current, self.grabs)
+        else:
+            image = self._cached(codes)
+            if image is None:
+                image = self._keep(codes, self._render(self._display.current, self.grabs))
+            now = time.monotonic()
+            due = now if self._next is None else self._next
+            if due > now:
+                time.sleep(due - now)
+            self._next = due + 1.0 / self.fps
         self.grabs += 1
         return Frame(image, time.monotonic())
+
+    def _render(self, shown: np.ndarray, frame: int) -> np.ndarray:
+        """The camera image of ``shown`` (fractions of full scale) with the noise of
+        ``frame``."""
+        projector = self._trace.rig.projector
+        screen = np.zeros((projector.height, projector.width), np.float32)
+        screen[:shown.shape[0], :shown.shape[1]] = shown
+        return expose(self._trace, screen[None], self.imaging, first_frame=frame)[0]
+
+    def _cached(self, codes: np.ndarray) -> np.ndarray | None:
+        """The image rendered of a pattern of the same codes, if any."""
+        codes = np.ascontiguousarray(codes)
+        for pattern, image in self._rendered.get(zlib.crc32(codes), ()):
+            if pattern.dtype == codes.dtype and np.array_equal(pattern, codes):
+                return image
+        return None
+
+    def _keep(self, codes: np.ndarray, image: np.ndarray) -> np.ndarray:
+        codes = np.ascontiguousarray(codes)
+        image.setflags(write=False)  # handed out again and again
+        self._rendered.setdefault(zlib.crc32(codes), []).append((codes.copy(), image))
+        return image
 
     def describe(self) -> dict[str, Any]:
         camera = self._rig.camera
         return {**super().describe(), "scene": self.scene, "size": [camera.width, camera.height],
-                "imaging": {**SIM_IMAGING, "exposure": self.imaging.exposure}}
+                "fps": self.fps, "imaging": {**SIM_IMAGING, "exposure": self.imaging.exposure}}
 
 
 def one_line(exc: BaseException) -> str:

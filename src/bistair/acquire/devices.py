@@ -2,7 +2,8 @@
 
 Displays: ``window[:SCREEN]`` (default screen 0), ``none``. Cameras:
 ``opencv:INDEX|URL``, ``genicam:PRODUCER.cti[:SERIAL]``, ``screen[:MONITOR]`` (default 0),
-``sim[:SCENE[:WxH]]`` (default ``paper-sim`` at the preset's camera size). A string that
+``sim[:SCENE[:WxH]][@FPS]`` (default ``paper-sim`` at the preset's camera size, frames as
+fast as it renders them; ``@FPS``: a frame every ``1/FPS`` s). A string that
 names no known kind, a bad number or a producer file that is not there is refused with one
 line, before anything is opened.
 
@@ -12,6 +13,8 @@ Examples
 ('window:1', 'none')
 >>> parse_camera("opencv:0").name, parse_camera("sim:plane:64x48").name
 ('opencv:0', 'sim:plane:64x48')
+>>> parse_camera("sim:plane:64x48@60").fps, parse_camera("sim@7.5").name
+(60.0, 'sim:paper-sim@7.5')
 >>> parse_camera("webcam")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
@@ -30,7 +33,7 @@ from .genicam import GenicamCamera
 
 DISPLAYS = "window[:SCREEN], none"
 CAMERAS = ("opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR], "
-           "sim[:SCENE[:WxH]]")
+           "sim[:SCENE[:WxH]][@FPS]")
 
 
 def parse_display(text: str) -> Display:
@@ -79,7 +82,7 @@ def parse_camera(text: str, exposure: float | None = None, gain: float | None = 
         ``opencv:INDEX`` (a device number) or ``opencv:URL`` (a stream, video file or
         image sequence such as ``caps/f%03d.png``), ``genicam:PRODUCER.cti`` or
         ``genicam:PRODUCER.cti:SERIAL``, ``screen`` or ``screen:MONITOR``, ``sim``,
-        ``sim:SCENE`` or ``sim:SCENE:WxH``.
+        ``sim:SCENE`` or ``sim:SCENE:WxH``, each with ``@FPS`` (a frame rate) or without.
     exposure, gain : float, optional
         In the camera's own units (genicam: ``ExposureTime`` in microseconds; opencv: the
         backend's; sim: the response to full white).
@@ -123,9 +126,10 @@ def parse_camera(text: str, exposure: float | None = None, gain: float | None = 
         return GenicamCamera(producer, serial, **settings)
     if kind == "screen":
         return ScreenCamera(_index(rest, 0, f"the monitor of camera {text!r}"), **settings)
-    if kind == "sim":
+    if kind.partition("@")[0] == "sim":
+        rest, fps = _rate(text.partition(":")[2] if ":" in text else "", text)
         scene, _, size = rest.partition(":")
-        return SimCamera(scene or "paper-sim", _size(size, text) if size else None,
+        return SimCamera(scene or "paper-sim", _size(size, text) if size else None, fps,
                          **settings)
     raise BistairError(f"unknown camera {text!r} (known: {CAMERAS})")
 
@@ -151,6 +155,23 @@ def _producer(rest: str, text: str) -> tuple[Path, str | None]:
     if not Path(path).is_file():
         raise BistairError(f"GenTL producer file {path} not found")
     return Path(path), serial or None
+
+
+def _rate(rest: str, device: str) -> tuple[str, float | None]:
+    """``REST@FPS`` as ``(REST, FPS)`` (``None`` without ``@``); the whole device string
+    ``sim@FPS`` too."""
+    if "@" not in device:
+        return rest, None
+    rest = rest.rpartition("@")[0] if "@" in rest else ""
+    value = device.rpartition("@")[2]
+    try:
+        fps = float(value)
+    except ValueError:
+        fps = None
+    if fps is None or not fps > 0:
+        raise BistairError(f"the frame rate of camera {device!r} must be a number of frames "
+                           f"a second above 0, e.g. @60, got {value!r}")
+    return rest, fps
 
 
 def _size(text: str, device: str) -> tuple[int, int]:

@@ -10,7 +10,8 @@
   a simulated camera can render it.
 
 A display is a context manager: leaving the ``with`` block (also by Ctrl-C or an error)
-closes the window. ``current`` is the pattern last shown, as fractions of full scale.
+closes the window. ``current`` is the pattern last shown, as fractions of full scale
+(made when first asked for), ``codes`` the same as it was given (8- or 16-bit codes).
 
 Examples
 --------
@@ -49,7 +50,8 @@ class Display:
     drives = True  # shows each pattern when told (``none``: the projector runs the sequence)
 
     def __init__(self) -> None:
-        self.current: np.ndarray | None = None
+        self.codes: np.ndarray | None = None  # the pattern last shown, as given
+        self._current: np.ndarray | None = None
         self.size: tuple[int, int] | None = None  # the screen's (width, height) when open
         self.shown = 0
 
@@ -83,12 +85,18 @@ class Display:
     def show(self, image: np.ndarray) -> float:
         """Show ``image`` (2-D 8- or 16-bit codes); returns the ``time.monotonic()`` at which
         it is up (for a window: drawn and handed to the window system)."""
-        image = np.asarray(image)
-        top = 65535.0 if image.dtype == np.uint16 else 255.0
-        self.current = image.astype(np.float32) / np.float32(top)
+        self.codes, self._current = np.asarray(image), None
         self.shown += 1
         self._draw(image)
         return time.monotonic()
+
+    @property
+    def current(self) -> np.ndarray | None:
+        """The pattern last shown as fractions of full scale (float32), or None."""
+        if self._current is None and self.codes is not None:
+            top = 65535.0 if self.codes.dtype == np.uint16 else 255.0
+            self._current = self.codes.astype(np.float32) / np.float32(top)
+        return self._current
 
     def _draw(self, image: np.ndarray) -> None:
         """Put the image on the screen."""
@@ -185,6 +193,14 @@ class WindowDisplay(Display):
         if self._surface is not None:
             self._surface = None
             pygame.display.quit()
+
+    @property
+    def current(self) -> np.ndarray | None:
+        """The pattern last shown as fractions of full scale (float32), or None."""
+        if self._current is None and self.codes is not None:
+            top = 65535.0 if self.codes.dtype == np.uint16 else 255.0
+            self._current = self.codes.astype(np.float32) / np.float32(top)
+        return self._current
 
     def _draw(self, image: np.ndarray) -> None:
         if self._surface is None:

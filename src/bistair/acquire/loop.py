@@ -22,9 +22,11 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
+import itertools
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -112,6 +114,34 @@ def scan(spec: BaseSpec | str | Path, display: Display | str, camera: Camera | s
     not fit the screen, a camera that delivers no frame or frames of changing size; the
     devices are closed on every way out, Ctrl-C included.
     """
+    with contextlib.closing(scans(spec, display, camera, 1, settle_ms=settle_ms,
+                                  average=average, drop=drop, exposure=exposure, gain=gain,
+                                  pixel_format=pixel_format, latency_file=latency_file,
+                                  progress=progress)) as each:
+        return next(each)
+
+
+def scans(spec: BaseSpec | str | Path, display: Display | str, camera: Camera | str,
+          count: int | None = 1, *, settle_ms: float | None = None, average: int = 1,
+          drop: int | None = None, exposure: float | None = None, gain: float | None = None,
+          pixel_format: str | None = None, latency_file: str | Path | None = None,
+          progress: Callable[[str], None] | None = None) -> Iterator[Scan]:
+    """Scan the pattern set ``count`` times in a row (``None``: until the caller stops),
+    the devices open throughout: each :class:`Scan` is yielded as soon as its last frame is
+    grabbed, and the next begins when the caller asks for it.
+
+    The arguments are those of :func:`scan`; everything is checked before the devices
+    open, and they are closed when the iterator ends or is closed (``contextlib.closing``),
+    Ctrl-C included. The camera is told the patterns first (:meth:`Camera.prepare`).
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=1920, height=1080, period=30)
+    >>> each = scans(spec, "none", "sim:plane:48x32@1000", 3)
+    >>> [s.frames.shape for s in each]
+    [(10, 32, 48), (10, 32, 48), (10, 32, 48)]
+    """
     if not isinstance(spec, BaseSpec):
         spec = load_spec(spec)
     if isinstance(average, bool) or not isinstance(average, int) or \
@@ -133,7 +163,16 @@ def scan(spec: BaseSpec | str | Path, display: Display | str, camera: Camera | s
         display.check(spec.width, spec.height)  # its size is known once it is open
         with camera:
             camera.attach(display)
-            return _run(spec, display, camera, patterns, settle, source, drop, average, say)
+            camera.prepare(patterns)
+            for n in itertools.count() if count is None else range(count):
+                if count != 1:  # a stage a scan, not a pattern
+                    say(f"scan {n + 1}" + ("" if count is None else f" of {count}"))
+                yield _run(spec, display, camera, patterns, settle, source, drop, average,
+                           say if count == 1 else _quiet)
+
+
+def _quiet(text: str) -> None:
+    """The progress of each pattern of a scan among many: not told."""
 
 
 def _run(spec: BaseSpec, display: Display, camera: Camera, patterns: np.ndarray,

@@ -21,6 +21,7 @@ from ..core.jit import interrupt
 from ..core.memory import keep_freed_memory
 from ..spec import BaseSpec, coerce_field, field_kind
 from .cli_batch import batch
+from .cli_bench import bench
 from .cli_options import (
     CliError,
     Input,
@@ -396,7 +397,7 @@ def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
         click.echo(f"height of {int(np.isfinite(h).sum())} pixels; wrote {out}/height.npy")
 
 
-for _command in (simulate, batch, stereo, calibrate_stereo, scan):
+for _command in (simulate, batch, stereo, calibrate_stereo, scan, bench):
     cli.add_command(_command)
 
 

@@ -27,7 +27,7 @@ from .cli_options import (
               "or none (the projector holds the patterns and triggers the camera)")
 @click.option("--camera", required=True, metavar="CAMERA",
               help="opencv:INDEX|URL, genicam:PRODUCER.cti[:SERIAL], screen[:MONITOR] or "
-              "sim[:SCENE[:WxH]]")
+              "sim[:SCENE[:WxH]][@FPS]")
 @click.option("--out", "-o", type=Output(), default=None,
               help="output folder: NN.png, spec.json, scan.json (replaced as a whole)")
 @click.option("--settle-ms", type=float, default=None,
@@ -54,17 +54,27 @@ from .cli_options import (
 @click.option("--latency-file", type=click.Path(path_type=Path), default=None,
               help="where measured settle times are kept [default: "
               "~/.config/bistair/latency.json or $BISTAIR_LATENCY_FILE]")
+@click.option("--scans", type=int, default=1, show_default=True,
+              help="scan the pattern set this many times in a row into OUT/scan-NNNN/ (with "
+              "--decode each decoded while the next is grabbed) and OUT/series.json")
+@click.option("--backlog", type=int, default=2, show_default=True,
+              help="with --scans and --decode: scans that may wait for the decoder; a scan "
+              "grabbed when this many wait is not decoded (counted and said)")
+@click.option("--no-previews", is_flag=True,
+              help="skip the decode's PNG previews (they take about as long as the decode)")
 @_quiet
 @reports_errors
 def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
          settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
          gain: float | None, pixel_format: str | None, decode_it: bool,
          calibration: Path | None, depth_range: str | None, measure_latency: bool,
-         latency_file: Path | None, quiet: bool) -> None:
+         latency_file: Path | None, scans: int, backlog: int, no_previews: bool,
+         quiet: bool) -> None:
     """Project a pattern set with DISPLAY, grab it with CAMERA, write a capture folder.
 
     Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
-    grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly."""
+    grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly
+    (with --scans, keeping the scans grabbed)."""
     from .progress import Progress
 
     settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
@@ -86,6 +96,14 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
             raise CliError(f"{name} is needed for a scan (or give --measure-latency)")
     if depth_range is not None and calibration is None:
         raise CliError("--depth-range applies to the reconstruction: give --calibration too")
+    given = click.get_current_context().get_parameter_source("backlog")
+    if given is not click.core.ParameterSource.DEFAULT and (scans == 1 or not decode_it):
+        raise CliError("--backlog applies to --scans N with --decode")
+    if scans != 1:
+        _series(spec_path, display, camera, out, scans, decode_it, backlog, no_previews,
+                calibration, quiet, settle_ms=settle_ms, average=average, drop=drop,
+                latency_file=latency_file, **settings)
+        return
     from .jobs import parse_depth_range
     from .scan import scan_folder
 
@@ -94,7 +112,7 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
         report = scan_folder(spec_path, display, camera, out, decode=decode_it,
                              calibration=calibration, depth_range=(low, high), progress=say,
                              settle_ms=settle_ms, average=average, drop=drop,
-                             latency_file=latency_file, **settings)
+                             latency_file=latency_file, previews=not no_previews, **settings)
     info = report.scan.info
     for message in info["warnings"]:
         click.echo(f"Warning: {message}", err=True)
@@ -115,3 +133,24 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     if report.reconstruction is not None:
         click.echo(f"{int(report.reconstruction.mask.sum())} points; wrote "
                    f"{out}/decode/cloud.ply and depth.npy")
+
+
+def _series(spec_path: Path, display: str, camera: str, out: Path, scans: int, decode: bool,
+            backlog: int, no_previews: bool, calibration: Path | None, quiet: bool,
+            **options: object) -> None:
+    """``bistair scan --scans N``: :func:`bistair.app.series.scan_series` and its summary."""
+    from .progress import Progress
+    from .series import scan_series, summary_lines
+
+    if calibration is not None:
+        raise CliError("--calibration applies to one scan: reconstruct a series afterwards "
+                       "with 'bistair batch OUT --calibration FILE --out RESULT'")
+    with Progress(quiet) as say:
+        report = scan_series(spec_path, display, camera, out, scans, decode=decode,
+                             backlog=backlog, previews=not no_previews, progress=say,
+                             **options)
+    lines, warnings = summary_lines(report)
+    for message in warnings:
+        click.echo(f"Warning: {message}", err=True)
+    if not quiet:
+        click.echo("\n".join(lines))

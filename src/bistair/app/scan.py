@@ -66,13 +66,13 @@ class ScanReport:
 def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str | Path, *,
                 decode: bool = False, calibration: Calibration | str | Path | None = None,
                 depth_range: tuple[float, float] = (0.0, np.inf),
-                progress: Callable[[str], None] | None = None,
+                progress: Callable[[str], None] | None = None, previews: bool = True,
                 **options: Any) -> ScanReport:
     """Scan ``spec`` with ``display`` and ``camera`` into the folder ``out`` (see the
     module's description); ``options`` go to :func:`bistair.acquire.scan` (``settle_ms``,
     ``average``, ``drop``, ``exposure``, ``gain``, ``pixel_format``, ``latency_file``).
-    ``decode`` writes ``OUT/decode/``; a ``calibration`` also reconstructs there
-    (``depth_range``: ``(min, max)`` depth in mm)."""
+    ``decode`` writes ``OUT/decode/`` (``previews``: with its PNG previews); a
+    ``calibration`` also reconstructs there (``depth_range``: ``(min, max)`` depth in mm)."""
     say = progress or (lambda text: None)
     out = check_output(out)
     _check_out(out)
@@ -107,7 +107,7 @@ def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str
         return report
     where = out / DECODE_FOLDER
     try:
-        report.decoded = decode_folder(out, where, progress=say)
+        report.decoded = decode_folder(out, where, previews=previews, progress=say)
         if cal is not None:
             report.reconstruction = reconstruct_folder(
                 out, None, cal, where / "cloud.ply", depth_dir=where, min_depth=depth_range[0],
@@ -120,12 +120,12 @@ def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str
 
 def _check_out(out: Path) -> None:
     """Refuse an output that is a file, or a folder that holds anything but an earlier
-    scan (it is replaced as a whole)."""
+    scan or series of scans (it is replaced as a whole)."""
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")
     if out.is_dir():
         items = [p for p in out.iterdir() if not p.name.startswith(TEMP_PREFIX)]
-        if items and not (out / "scan.json").is_file():
+        if items and not any((out / name).is_file() for name in ("scan.json", "series.json")):
             raise BistairError(f"output folder {out} holds files and is not an earlier scan "
                                "(a scan replaces its folder as a whole): choose a new or "
                                "empty folder")

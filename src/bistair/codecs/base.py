@@ -100,10 +100,15 @@ class CodeMap:
 @dataclass
 class Orders:
     """Stage 3 of a decode: the fringe order per pixel (int, -1 where invalid) and figures
-    about it."""
+    about it; ``read``, where a per-pixel decoder left out pixels whose own evidence cannot
+    carry their order, the orders as its code read them, which the checks of the whole
+    decode judge (without those pixels the orders can step by one across every wrap of a
+    code read wrong: the pixels at the wraps, where code and phase disagree, are the ones
+    left out)."""
 
     order: np.ndarray
     info: dict[str, Any] = field(default_factory=dict)
+    read: np.ndarray | None = None
 
 
 MeasureFn = Callable[[Prepared, Any, float | None], FringeSet]
@@ -131,7 +136,9 @@ def measure_shifts(prepared: Prepared, spec: PeriodSpec,
     -------
     FringeSet
         (H, W) float32 wrapped phase in [0, 2*pi) (radians), average and modulation
-        (fractions of full scale), the validity mask and the camera noise.
+        (fractions of full scale), the validity mask and the camera noise; for a method
+        with a cos/sin code pair right after the set (:func:`pair_frame`), its phase and
+        modulation (``stair``), read in the same pass.
 
     Examples
     --------
@@ -146,7 +153,36 @@ def measure_shifts(prepared: Prepared, spec: PeriodSpec,
     [7.0, 14.0, 21.0, 28.0]
     """
     return measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
-                   phase_offset=spec.phase_offset)
+                   phase_offset=spec.phase_offset, pair=pair_frame(spec))
+
+
+def pair_frame(spec: BaseSpec) -> int | None:
+    """The index of a cos/sin pair of code frames right after the N-step set (frames named
+    ``...-cos`` and ``...-sin``: the stair or code pair of bidirectional, lv and
+    phase-coding), which the phase stage reads in its own pass; ``None`` without one.
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec of one coded axis.
+
+    Returns
+    -------
+    int or None
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> pair_frame(make_spec("lv", width=240, height=32, period=20))
+    4
+    >>> pair_frame(make_spec("graycode", width=240, height=32, period=30)) is None
+    True
+    """
+    names = spec.method_frames()
+    n = getattr(spec, "steps", 0)
+    if len(names) >= n + 2 and names[n].endswith("-cos") and names[n + 1].endswith("-sin"):
+        return n
+    return None
 
 
 @dataclass(frozen=True)
@@ -291,24 +327,29 @@ class Codec:
             refuse(problem if problem is None or turned is None else f"{problem}; {turned}")
 
         code = self.code_columns(cols, spec, fs, min_modulation)
-        # every set is measured: saturation is in the validity, the clipped masks (one byte
-        # a pixel, twice for the rows orientation) need not stay in memory
-        prepared = replace(prepared, clipped=np.broadcast_to(False, prepared.clipped.shape))
         del cols
+        fs = replace(fs, stair=None)  # (the code's maps hold the pair: let go with them)
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
+        # the phase noise and the sample let go before the result is made
+        fs = replace(fs, sigma=None, sample=None)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
-            bad, big, links = wrap_steps(fs.phi, orders.order, fs.valid)
+            judged = orders.order if orders.read is None else orders.read
+            bad, big, links = wrap_steps(fs.phi, judged, fs.valid)
+            del judged
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
             judge(jump_problem(bad, links, big=big, big_limit=0.02))
             if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
+                where = ("the code reads pixels beside its edges one order off" if
+                         orders.read is None else "the code reads pixels beside its edges "
+                         "one order off (left out where their own evidence shows it)")
                 orders.info["warnings"] = [*orders.info.get("warnings", []), (
-                    f"the orders do not step by one across {100 * bad / links:.1f}% of the "
-                    "phase jumps: pixels beside the code's edges read one order off (a code "
-                    "whose edges sit on the phase jumps; a complementary or shifted code, a "
-                    "second period or --strategy region avoid it)")]
+                    f"the orders as read do not step by one across {100 * bad / links:.1f}% "
+                    f"of the phase jumps: {where} (a code whose edges sit on the phase "
+                    "jumps; a complementary or shifted code, a second period or --strategy "
+                    "region avoid it)")]
         judge(jump_problem(orders.info.get("jump_violations", 0),
                            orders.info.get("jump_links", 0)))
         modulated = int(np.count_nonzero(fs.valid))

@@ -9,7 +9,8 @@ inverse ``gray-i-inv`` after them (``frames`` may put them in any order, e.g. Op
 bit is 1; the Gray code of level ``j`` is ``j ^ (j >> 1)``.
 
 Plain: the code gives ``k = floor(x/T)`` directly; its edges sit exactly on the phase wraps,
-so blur and noise put pixels beside every edge one order off (the method's known limit).
+so blur and noise read pixels beside every edge one order off (the method's known limit);
+per pixel those are left out (see below).
 
 Shifted (``gray_offset = 0.5``; Wu Z. et al., Opt. Express 27(16), 2019): the code's edges
 sit half a period off the phase jumps, ``g = floor(x/T + 1/2)`` over ``fringes + 1``
@@ -33,7 +34,11 @@ rule picks the code whose edges are far from the pixel: ``k2`` where ``phi < pi/
 Stage 3 takes each pixel's order from the code (``strategy="pixel"``, the classic decode) or
 votes it over each fringe region, the pixels far from the code's edges counting most
 (``strategy="region"``), which removes the misreads beside the edges of a plain or shifted
-code.
+code. Per pixel, an order the pixel's own evidence cannot carry is left out, not guessed
+(:func:`~bistair.codecs.graycode_jit.read_orders`: bits that do not clear their noise, or
+read under half the pixel's code contrast, away from their edges; a phase within three
+sigmas of a code edge whose edge bits say the cell's other end); by regions, only the
+pixels whose evidence carries their order vote.
 
 Bits are binarised against the fringes' average intensity, or against the inverse patterns
 when the spec has them (robust to albedo and ambient light); with inverses, a pixel whose
@@ -78,7 +83,18 @@ from .base import (
     shift_patterns,
 )
 from .graycode_alone import code_alone, measure_alone
-from .graycode_jit import code_bits, gray_orders
+from .graycode_jit import code_bits, orders_fit, read_orders
+
+# The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
+# in docs/guide/checks.md): a bit clears the noise of its margin by CLEAR_NOISE sigmas (a
+# bit read on the wrong side does so with probability under 0.14%) and reads over
+# CLEAR_SHARE of the pixel's code contrast (its strongest bit), unless the phase puts its
+# edge within EDGE_REACH fringes (a blur that leaves the fringes 5% of the code's contrast
+# still leaves a bit half a fringe from its edge 0.8 of it); the phase clears its own noise
+# by CLEAR_NOISE sigmas where the code's edge sits on it.
+CLEAR_NOISE = 3.0
+CLEAR_SHARE = 0.5
+EDGE_REACH = 0.5
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -271,8 +287,10 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     Returns
     -------
     CodeMap
-        ``code``: (H, W) int32 fringe order, -1 where not decoded; ``maps["edges"]`` the
-        order as read (-1 where invalid), ``maps["second_phase"]`` with a second period;
+        ``code``: (H, W) int32 fringe order as read (checked by the second phase where
+        there is one), -1 where not decoded; ``maps["carried"]`` where the pixel's own
+        evidence carries it; ``maps["edges"]`` the code whose steps are the code's edges
+        (-1 where invalid), ``maps["second_phase"]`` with a second period;
         ``edge_phase`` 0 (pi for the shifted code); ``beyond``, the valid pixels whose code
         names a fringe past the projector's last.
 
@@ -293,8 +311,6 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     n = spec.steps
     start = n * (2 if spec.second_period else 1)
     n_bits = spec.code_bits + spec.complementary
-    # each bit: the code frame brighter than the average (or its inverse), in one pass
-    gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     valid = fs.valid
     if spec.inverse and fs.threshold is not None:
         code = prepared.frames[start:start + n_bits]
@@ -302,10 +318,18 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
         del code, ref
     maps: dict[str, np.ndarray] = {}
-    if not spec.second_period:  # per pixel in one pass
-        mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
-        code, maps["edges"], beyond = gray_orders(gray, fs.phi, valid, mode, spec.fringes)
+    mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
+    # the noise of a bit's margin (frame minus inverse, or minus the average of n frames),
+    # and of the phase times the modulation
+    evidence = (fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n),
+                fs.noise / math.sqrt(n / 2), CLEAR_NOISE, CLEAR_SHARE, EDGE_REACH)
+    if not spec.second_period:  # per pixel in one pass, with the evidence of each order
+        code, maps["edges"], maps["carried"], beyond = read_orders(
+            prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse), fs.phi,
+            fs.mod, valid, mode, spec.fringes, *evidence)
         return CodeMap(code, maps, edge_phase=np.pi if mode == 2 else 0.0, beyond=beyond)
+    # each bit: the code frame brighter than the average (or its inverse), in one pass
+    gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     if spec.complementary:
         k1 = gray_to_binary(gray >> 1)
         k2 = (gray_to_binary(gray) + 1) // 2
@@ -318,26 +342,31 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     else:
         k = edges = gray_to_binary(gray)
         edge_phase = 0.0
-    if spec.second_period:
-        second = measure(prepared, n, n, min_modulation, check=False,
-                         shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
-        k, agree = _second_period_check(k, fs.phi, second.phi, spec)
-        valid = valid & second.valid & agree
-        maps["second_phase"] = second.phi
+    second = measure(prepared, n, n, min_modulation, check=False,
+                     shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
+    k, agree = _second_period_check(k, fs, second, spec)
+    valid = valid & second.valid & agree
+    maps["second_phase"] = second.phi
     ok = valid & (k >= 0) & (k < spec.fringes)
     maps["edges"] = np.where(valid, edges, -1).astype(np.int32)
     beyond = int(np.count_nonzero(valid & (k >= spec.fringes)))
-    return CodeMap(np.where(ok, k, -1).astype(np.int32), maps, edge_phase=edge_phase,
-                   beyond=beyond)
+    code = np.where(ok, k, -1).astype(np.int32)
+    # where the order the second phase chose fits the code's own evidence
+    maps["carried"] = orders_fit(prepared.raw, start, n_bits, prepared.scale, fs.avg,
+                                 bool(spec.inverse), fs.phi, fs.mod, code, mode, spec.fringes,
+                                 *evidence)
+    return CodeMap(code, maps, edge_phase=edge_phase, beyond=beyond)
 
 
-def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
+def _second_period_check(k: np.ndarray, fs: FringeSet, second: FringeSet,
                          spec: GrayCodeSpec) -> tuple[np.ndarray, np.ndarray]:
     """The order (the code's, or its neighbour on the phase's side) that predicts the second
-    phase best, and where that prediction is within half the candidates' separation."""
+    phase best, and where that prediction is within half the candidates' separation and
+    the two phases' noise (``CLEAR_NOISE`` sigmas of the prediction's) is under half of
+    it: where the second phase tells the two apart."""
     ratio = spec.period / spec.second_period
+    phi, phi2 = fs.phi, second.phi
     side = np.where(phi < np.pi, 1, -1)
-    best, best_err = k, None
     errs = []
     for cand in (k, k + side):
         pred = (cand + phi / TWO_PI) * (TWO_PI * ratio)
@@ -345,14 +374,16 @@ def _second_period_check(k: np.ndarray, phi: np.ndarray, phi2: np.ndarray,
     best = np.where(errs[1] < errs[0], k + side, k)
     best_err = np.minimum(errs[0], errs[1])
     separation = abs(wrap(np.array(TWO_PI * ratio)))
-    return best, best_err < 0.5 * separation
+    sigma = np.hypot(ratio * fs.phase_noise, second.phase_noise)
+    return best, (best_err < 0.5 * separation) & (CLEAR_NOISE * sigma < 0.5 * separation)
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
                   strategy: Literal["pixel", "region"] = "pixel") -> Orders:
-    """Stage 3: the code is the order, per pixel (``pixel``, the classic decode), or voted
-    per fringe region with the pixels far from the code's edges counting most (``region``:
-    a code misread beside its edges is outvoted by the rest of its fringe).
+    """Stage 3: the code is the order, per pixel (``pixel``, the classic decode; -1 where
+    the pixel's own evidence does not carry it, ``code.maps["carried"]``), or voted per
+    fringe region with the pixels far from the code's edges counting most (``region``: a
+    code misread beside its edges is outvoted by the rest of its fringe).
 
     Parameters
     ----------
@@ -369,8 +400,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     -------
     Orders
         (H, W) fringe order per pixel (-1 where invalid) and ``info``: the strategy, the
-        camera noise, the code bits, and for ``region`` the region counts and the phase
-        jumps across which the orders do not step by one.
+        camera noise, the code bits, the pixels read but left out (``left_out``), and for
+        ``region`` the region counts and the phase jumps across which the orders do not
+        step by one; per pixel, ``read``: the orders as read, which the checks judge.
 
     Raises
     ------
@@ -401,24 +433,32 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
                            "decodes per pixel")
     info = {"strategy": strategy, "noise": fs.noise,
             "bits": spec.code_bits + spec.complementary}
-    k = code.code
+    read = code.code
     if strategy == "pixel":
+        # the orders the pixels' own evidence carries (all read ones where it is not judged)
+        carried = code.maps.get("carried")
+        k = read if carried is None else np.where(carried, read, -1)
+        if carried is not None:
+            info["left_out"] = int(np.count_nonzero(read >= 0)) - int(np.count_nonzero(k >= 0))
         if spec.steps == 0:  # no phase to check the cells against: their direction
             against, steps = cell_steps(k)
             info.update(cell_steps=steps, cell_steps_against=against)
             refuse(direction_problem(against, steps))
-        return Orders(k, info)
-    labels, _ = fringe_regions(fs.phi, fs.valid & (k >= 0), phase_noise=fs.phase_noise)
+        return Orders(k, info, read=None if carried is None else read)
+    # every pixel read votes (votes from only the pixels whose evidence carries their order
+    # leave regions without votes to their neighbours: on the rendered presets 0.03-0.3% of
+    # the pixels wrong became 0.06-4%)
+    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        return labels, n, code_evidence(labels, n, k, spec.fringes, weight)
+        return labels, n, code_evidence(labels, n, read, spec.fringes, weight)
 
     def agrees(order: np.ndarray) -> np.ndarray:
-        return (k == order) | (k < 0)
+        return (read == order) | (read < 0)
 
-    order = orders_from_regions(fs.phi, fs.valid & (k >= 0), labels, evidence_of, agrees,
-                                   info)
+    order = orders_from_regions(fs.phi, fs.valid & (read >= 0), labels, evidence_of, agrees,
+                                info)
     return Orders(order, info)
 
 

@@ -325,7 +325,8 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the code phases sit ...
     """
-    theta = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)[0]
+    theta = (fs.stair if fs.stair is not None else
+             pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg))[0]
     codes = quantize32(theta, spec.levels, fs.valid)
     if stair_misfit(theta, fs.valid, stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
         refuse("the code phases sit halfway between the code's levels: are code-cos and "

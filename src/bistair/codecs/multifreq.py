@@ -46,6 +46,10 @@ from ..spec import BaseSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, shift_patterns
 from .multifreq_jit import agreed_orders, unwrap_chain
 
+# An unwrapping step's order is carried where the next order fits the step's miss worse by
+# CLEAR_NOISE**2 sigmas squared of its noise: odds of exp(-4.5), 1.1%, at the most
+CLEAR_NOISE = 3.0
+
 
 def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
     """Levels of beat periods: level 0 the periods ascending, each next the beats of
@@ -340,7 +344,8 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
                  min_modulation: float | None = None) -> CodeMap:
     """Stage 2: the shortest period's order from the longer periods (or their beats).
 
-    ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step and
+    ``maps["worst"]`` is the largest miss, in fringes, of any unwrapping step,
+    ``maps["spread"]`` the largest noise of a step's miss (:func:`unwrap_spread`) and
     ``maps["valid"]`` where every period is well modulated.
 
     Parameters
@@ -359,10 +364,11 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     -------
     CodeMap
         ``code``: (H, W) int32 order of the shortest period, -1 where some period is not
-        valid; ``maps``: ``worst`` (fringes), ``valid`` (bool) and ``residual`` (the last
-        step's signed miss, fringes), all (H, W). The hierarchical rule unwraps in float64
-        and stores float32 (``worst`` rounded toward zero: below 0.25 exactly where the
-        float64 miss is); the heterodyne rule keeps float64.
+        valid; ``maps``: ``worst`` (fringes), ``spread`` (float32 fringes), ``valid`` (bool)
+        and ``residual`` (the last step's signed miss, fringes), all (H, W). The
+        hierarchical rule unwraps in float64 and stores float32 (``worst`` rounded toward
+        zero: below 0.25 exactly where the float64 miss is); the heterodyne rule keeps
+        float64.
 
     Examples
     --------
@@ -373,24 +379,29 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     >>> fs = measure_columns(cols, spec)
     >>> code = code_columns(cols, spec, fs)
     >>> code.code[0, ::42].tolist(), sorted(code.maps), bool(code.maps["worst"].max() < 0.01)
-    ([0, 1, 2, 3, 4, 5, 6, 7], ['residual', 'valid', 'worst'], True)
+    ([0, 1, 2, 3, 4, 5, 6, 7], ['residual', 'spread', 'valid', 'worst'], True)
     """
     n = spec.steps
     shortest = float(spec.period)
     sets = {}  # period: (phase, valid); the other maps of a set are let go at once
+    noise = {}  # period: its phase noise (radians)
     for i, t in enumerate(spec.periods):
         s = fs if float(t) == shortest else measure(
             prepared, i * n, n, min_modulation, check=False, shift_sign=spec.shift_sign,
-            phase_offset=spec.phase_offset, maps=False)
+            phase_offset=spec.phase_offset)
         sets[float(t)] = (s.phi, s.valid)
+        noise[float(t)] = s.phase_noise
         del s
     valid = np.logical_and.reduce([v for _, v in sets.values()])
+    spread = unwrap_spread(noise, spec)
+    del noise
     if spec.unwrap == "hierarchical" and len(sets) > 1:  # per pixel in one pass
         chain = sorted(sets, reverse=True)
         code, worst, last = unwrap_chain(tuple(sets[t][0] for t in chain), tuple(chain),
                                          spec.coded_length, fs.phi, valid)
         return CodeMap(code, {"worst": np.broadcast_to(worst, valid.shape), "valid": valid,
-                              "residual": np.broadcast_to(last, valid.shape)})
+                              "residual": np.broadcast_to(last, valid.shape),
+                              "spread": spread})
     phase_of = {t: phi.astype(np.float64) for t, (phi, _) in sets.items()}
     unwrap = _Unwrapper()
     if spec.unwrap == "hierarchical":
@@ -413,11 +424,65 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
     order = order_from_reference(fs.phi, absolute[shortest])
     code = np.where(valid & np.isfinite(order), order, -1).astype(np.int32)
     return CodeMap(code, {"worst": np.broadcast_to(unwrap.worst, valid.shape), "valid": valid,
-                          "residual": np.broadcast_to(unwrap.last, valid.shape)})
+                          "residual": np.broadcast_to(unwrap.last, valid.shape),
+                          "spread": spread})
+
+
+def unwrap_spread(noise: dict[float, np.ndarray], spec: MultiFreqSpec) -> np.ndarray:
+    """The noise of the unwrapping steps' misses: per pixel, the largest standard
+    deviation, in fringes of the finer period, of any step's miss (the coarser phase,
+    scaled by the periods' ratio, less the finer one; a beat's phase noise is its two
+    periods' together).
+
+    Parameters
+    ----------
+    noise : dict of float to (H, W) float32 array
+        Each period's phase noise in radians (:attr:`~bistair.core.measure.FringeSet.phase_noise`).
+    spec : MultiFreqSpec
+        The spec of one coded axis (``unwrap`` chooses the rule).
+
+    Returns
+    -------
+    (H, W) float32 array
+        The largest step's noise, in fringes (0 with a single period).
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("multifreq", width=300, height=40, periods=(42, 45, 48), steps=4)
+    >>> sigma = {t: np.full((1, 1), 0.01, np.float32) for t in (42.0, 45.0, 48.0)}
+    >>> round(float(unwrap_spread(sigma, spec)[0, 0]), 4)  # 720 -> 45: 16 x 0.014 rad / 2 pi
+    0.036
+    """
+    two_pi = np.float32(TWO_PI)
+    spread = np.zeros(next(iter(noise.values())).shape, np.float32)
+    if len(noise) < 2:
+        return spread
+    sigma = dict(noise)
+    if spec.unwrap == "hierarchical":
+        steps = list(zip(sorted(sigma, reverse=True)[:-1], sorted(sigma, reverse=True)[1:],
+                         strict=True))
+    else:
+        levels = beat_tree(tuple(sigma))
+        for low in levels[:-1]:
+            for a, b in zip(low[:-1], low[1:], strict=True):
+                sigma[beat(a, b)] = np.hypot(sigma[a], sigma[b])
+        steps = []
+        for low in levels[-2::-1]:
+            for i, t in enumerate(low):
+                j = min(i, len(low) - 2)
+                steps.append((beat(low[j], low[j + 1]), t))
+    for coarse, fine in steps:
+        step = np.hypot(np.float32(coarse / fine) * sigma[coarse], sigma[fine]) / two_pi
+        np.maximum(spread, step, out=spread)
+    return spread
 
 
 def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
-    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe.
+    """Stage 3: keep the pixels where every unwrapping step lands within a quarter fringe
+    and whose phases carry their order: the next order fits the worst step's miss ``m``
+    worse by ``CLEAR_NOISE**2`` of that miss's variance (``1 - 2|m| >= (3 sigma)**2``,
+    ``sigma`` from :func:`unwrap_spread`); the others are left out (``info["left_out"]``).
 
     Captures where the periods agree on under half of the well-modulated pixels do not fit
     the spec (periods, frame order or phase convention) and are refused; a coordinate that
@@ -437,9 +502,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
     -------
     Orders
         (H, W) int32 order of the shortest period per pixel (-1 where invalid) and
-        ``info``: the unwrap rule, the camera noise, the well-modulated pixels
-        (``valid_modulation``), the share where every step agrees (``period_agreement``)
-        and any ``warnings``.
+        ``info``: the unwrap rule, the camera noise, the pixels left out (``left_out``), the
+        well-modulated pixels (``valid_modulation``), the share where every step agrees
+        (``period_agreement``) and any ``warnings``.
 
     Raises
     ------
@@ -469,7 +534,13 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: MultiFreqSpec) -> Orders:
                                                   fs.phi, 0.25, 4)
     share = float(np.int64(agreeing) / max(lit, 1))
     peaked = miss_peak(code.maps["worst"], valid)
-    info = {"unwrap": spec.unwrap, "noise": fs.noise,
+    # a pixel whose phases do not carry its order: at its worst step the next order, whose
+    # miss is 1 - |m| away, fits not CLEAR_NOISE**2 sigmas squared worse than its own,
+    # |m| away: (1 - |m|)**2 - m**2 = 1 - 2|m| under (CLEAR_NOISE * sigma)**2
+    worst, spread = code.maps["worst"], code.maps["spread"]
+    doubtful = (order >= 0) & ~(1.0 - 2.0 * worst >= (CLEAR_NOISE * spread) ** 2)
+    order[doubtful] = -1
+    info = {"unwrap": spec.unwrap, "noise": fs.noise, "left_out": int(doubtful.sum()),
             "valid_modulation": int(lit), "period_agreement": share,
             "miss_peak": round(peaked, 3)}
     # periods that do not fit miss their fringes at random: about half the pixels "agree"

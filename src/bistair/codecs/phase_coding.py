@@ -152,7 +152,8 @@ def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
     ([0, 1, 2, 3, 4, 5, 6, 7], ['code_phase'])
     """
     if spec.form == "pair":
-        theta = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)[0]
+        theta = (fs.stair if fs.stair is not None else
+                 pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg))[0]
     else:
         theta = wrapped_phase(prepared.frames[spec.steps:], spec.shift_sign)[0]
     codes = quantize32(theta, spec.levels, fs.valid)

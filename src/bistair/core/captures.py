@@ -1,6 +1,6 @@
 """Captured stacks: checks, scaling to float32 full scale, bit depths, the modulation
-threshold and the decodable check (the validity mask itself comes from
-:func:`bistair.core.measure_jit.pixel_validity`).
+threshold and the decodable check (the validity mask itself comes from the measure's pass,
+:func:`bistair.core.measure_jit.front_end`).
 
 Every codec calls :func:`prepare` first, so frame count, sizes, dark and saturated captures
 are refused the same way whatever the method.
@@ -16,8 +16,9 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -59,7 +60,6 @@ class Prepared:
     capture's own dtype), read as fractions of full scale through ``frames``."""
 
     raw: np.ndarray  # (F, H, W) the method's frames, any dtype
-    clipped: np.ndarray  # (H, W) bool: some frame at full scale
     full_scale: float  # the input value that maps to 1.0
     white: np.ndarray | None = None  # (H, W) the fully lit frame, if the capture has one
     black: np.ndarray | None = None  # (H, W) the dark frame, if the capture has one
@@ -74,10 +74,19 @@ class Prepared:
         """The frames as float32 fractions of full scale (converted when indexed)."""
         return ScaledStack(self.raw, 1.0 / self.full_scale)
 
+    @cached_property
+    def clipped(self) -> np.ndarray:
+        """(H, W) bool: pixels where some frame reaches full scale (a millionth below it for
+        float captures), computed on first use. A decode does not use it: each N-step set
+        judges saturation on its own frames in its pass
+        (:func:`bistair.core.measure_jit.front_end`)."""
+        if np.issubdtype(self.raw.dtype, np.integer):
+            return self.raw.max(axis=0) >= self.full_scale
+        return self.raw.max(axis=0) >= self.full_scale * (1.0 - 1e-6)
+
     def transposed(self) -> Prepared:
         """The same captures with image axes swapped (for the rows orientation)."""
-        return Prepared(np.ascontiguousarray(self.raw.transpose(0, 2, 1)),
-                        np.ascontiguousarray(self.clipped.T), self.full_scale,
+        return Prepared(np.ascontiguousarray(self.raw.transpose(0, 2, 1)), self.full_scale,
                         *(None if a is None else np.ascontiguousarray(a.T)
                           for a in (self.white, self.black)))
 
@@ -140,8 +149,8 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
     Returns
     -------
     Prepared
-        The selected frames as fractions of full scale, the clipped pixels, and the white
-        and black frames.
+        The selected frames as fractions of full scale and the white and black frames (the
+        clipped pixels computed when asked for).
 
     Raises
     ------
@@ -182,14 +191,10 @@ def prepare(images: np.ndarray, frame_count: int, method: str,
         raise BistairError("captures contain NaN or infinite values")
     lit = [stack[i][None] for i in (white, black) if i is not None]
     scale = max(full_scale_of(a) for a in (used, *lit))
-    if np.issubdtype(stack.dtype, np.integer):
-        clipped = used.max(axis=0) >= scale
-    else:
-        clipped = used.max(axis=0) >= scale * (1.0 - 1e-6)
     factor = np.float32(1.0 / scale)
     extra = [None if i is None else np.multiply(stack[i], factor, dtype=np.float32)
              for i in (white, black)]
-    return Prepared(used, clipped, scale, *extra)
+    return Prepared(used, scale, *extra)
 
 
 def modulation_threshold(noise: float, min_modulation: float | None = None) -> float:
@@ -258,8 +263,9 @@ def check_min_modulation(min_modulation: float | None) -> None:
                            f"scale), got {min_modulation}")
 
 
-def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: float | None = None,
-                    mod: np.ndarray | None = None) -> None:
+def check_decodable(valid: np.ndarray, clipped: np.ndarray | Callable[[], np.ndarray],
+                    min_modulation: float | None = None, mod: np.ndarray | None = None
+                    ) -> None:
     """Refuse captures with (almost) nothing to decode, saying whether they are dark or blown
     (``clipped``: pixels with a frame at full scale) or, when a ``min_modulation`` was asked
     for, how much modulation the captures have (``mod``).
@@ -270,8 +276,8 @@ def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: floa
     ----------
     valid : (H, W) bool array
         The valid pixels.
-    clipped : (H, W) bool array
-        Pixels where some frame reaches full scale.
+    clipped : (H, W) bool array, or a function of no argument that returns it
+        Pixels where some frame reaches full scale (called only to refuse).
     min_modulation : float, optional
         The modulation threshold asked for, if any.
     mod : (H, W) array, optional
@@ -293,13 +299,13 @@ def check_decodable(valid: np.ndarray, clipped: np.ndarray, min_modulation: floa
     bistair.errors.BistairError: no pixel has the minimum modulation 0.6 asked for (the most is 0.3)
     """
     min_pixels = max(50, valid.size // 10000)
-    if int(valid.sum()) >= min_pixels:
+    if int(np.count_nonzero(valid)) >= min_pixels:
         return
     if min_modulation is not None and mod is not None:
         top = float(np.nanmax(mod)) if mod.size else 0.0
         raise BistairError(f"no pixel has the minimum modulation {min_modulation:g} asked for "
                            f"(the most is {top:.3g})")
-    share = float(clipped.mean())
+    share = float((clipped() if callable(clipped) else clipped).mean())
     if share > 0.25:
         raise BistairError(
             f"captures are saturated: {100 * share:.0f}% of pixels reach full scale"

@@ -357,13 +357,7 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
     if os.environ.get(RECORD_ENV) and not _STATE.get("recording"):
         _STATE["recording"] = True
         atexit.register(_record, os.environ[RECORD_ENV])
-    module = fn.__globals__  # the kernel's own module (a *_jit.py)
-    if module.get("prange") is range:  # its first kernel: helpers compiled once
-        module["prange"] = numba.prange
-        for name, value in list(module.items()):
-            how = getattr(value, "_inline", None)
-            if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
-                module[name] = numba.njit(cache=True, inline=how)(value)
+    _compile_helpers(fn.__globals__, numba)  # the kernel's own module (a *_jit.py)
     # nogil: two threads may run kernels at once (:func:`side_by_side`)
     compiled = numba.njit(cache=False, parallel=parallel, fastmath=False,
                           error_model="numpy", nogil=True)(fn)
@@ -372,6 +366,21 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
     except (RuntimeError, OSError):  # numba finds no folder to keep compiled code in
         pass  # compiled in every process, as numba's cache=True would refuse to
     return compiled
+
+
+def _compile_helpers(module: dict[str, Any], numba: Any) -> None:
+    """On a module's first kernel: its ``prange`` made numba's and its helpers (marked with
+    :func:`_numba_inline` or :func:`_numba_called`) compiled, once; a helper imported from
+    another module is compiled after that module's own helpers, which it may call."""
+    if module.get("prange") is not range:
+        return
+    module["prange"] = numba.prange
+    for name, value in list(module.items()):
+        how = getattr(value, "_inline", None)
+        if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
+            if value.__globals__ is not module:
+                _compile_helpers(value.__globals__, numba)
+            module[name] = numba.njit(cache=True, inline=how)(value)
 
 
 def _record(path: str) -> None:
@@ -532,6 +541,44 @@ def set_threads(count: int | None) -> int:
     count = count or os.cpu_count() or 1
     numba.set_num_threads(max(1, min(int(count), numba.config.NUMBA_NUM_THREADS)))
     return numba.get_num_threads()
+
+
+def thread_count() -> int:
+    """The threads the kernels called from this thread use (numba keeps the count per
+    thread: a new thread starts with every core, whatever :func:`set_threads` said in the
+    thread that started it; give it the count with :func:`set_threads`).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> set_threads(1), thread_count()
+    (1, 1)
+    >>> set_threads(None) == thread_count()
+    True
+    """
+    return int(_numba().get_num_threads())
+
+
+def threading_layer() -> str:
+    """numba's threading layer (``omp``, ``tbb`` or ``workqueue``), or ``not started`` before
+    the first parallel kernel of the process has run.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> threading_layer() in ("omp", "tbb", "workqueue", "not started")
+    True
+    """
+    try:
+        return str(_numba().threading_layer())
+    except ValueError:  # no parallel kernel has run yet
+        return "not started"
 
 
 def side_by_side(first: Callable[[], Any], second: Callable[[], Any]) -> tuple[Any, Any]:

@@ -20,13 +20,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import special
 
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
-from .measure_jit import fit_residual_energy, keep_coherent, phase_noise, pixel_validity
-from .phase import phase_of_sums, shifts_of
-from .phase_jit import nstep_sums
+from .measure_jit import fit_residual_energy, front_end, keep_coherent, phase_noise
+from .phase import shifts_of
+from .phase_jit import offset_parts, shift_weights
 from .regions import MIN_REGION, label_fringes
+from .sample import Sample, chi2_median, clip_level, kernel_view, set_noise, take_sample
 
 
 @dataclass(frozen=True)
@@ -40,19 +40,28 @@ class FringeSet:
     noise: float  # camera noise sigma estimated from the fit residual
     steps: int | None = None  # N
     threshold: float | None = None  # the modulation a valid pixel needs
+    sigma: np.ndarray | None = None  # the phase noise per pixel of the full pass, if kept
+    stair: tuple[np.ndarray, np.ndarray] | None = None  # the stair pair's phase, modulation
+    sample: Sample | None = None  # pass 0's sample of the capture (column layout)
 
     @property
     def phase_noise(self) -> np.ndarray:
         """Standard deviation of the wrapped phase per pixel, ``noise / (B * sqrt(N/2))``
-        (float32, :func:`~bistair.core.measure_jit.phase_noise`; computed when asked for, not
-        kept: a map of 4 bytes a pixel that most stages need only for a moment)."""
+        (float32 radians): the full pass's (``sigma``) where it kept it, else computed
+        when asked for (:func:`~bistair.core.measure_jit.phase_noise`)."""
+        if self.sigma is not None:
+            return self.sigma
         return phase_noise(self.mod, self.noise, 4 if self.steps is None else self.steps)
 
     def transposed(self) -> FringeSet:
-        """The same set with image axes swapped (for the rows orientation)."""
-        return FringeSet(*(np.ascontiguousarray(a.T) for a in (self.phi, self.avg, self.mod,
-                                                                 self.valid)),
-                         self.noise, self.steps, self.threshold)
+        """The same set with image axes swapped (for the rows orientation; the sample, of
+        the column layout, is left out)."""
+        def t(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else np.ascontiguousarray(a.T)
+
+        return FringeSet(t(self.phi), t(self.avg), t(self.mod), t(self.valid), self.noise,
+                         self.steps, self.threshold, t(self.sigma),
+                         None if self.stair is None else (t(self.stair[0]), t(self.stair[1])))
 
 
 def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
@@ -106,7 +115,7 @@ def noise_level(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.nd
                                      shifts_of(steps, shift_sign, phase_offset))
     sample = energy[ok] if ok.sum() >= 100 else energy.ravel()
     dof = steps - 3
-    return float(np.sqrt(np.median(sample) / (2.0 * _chi2_median(dof))))
+    return float(np.sqrt(np.median(sample) / (2.0 * chi2_median(dof))))
 
 
 def along_fringe_noise(frames: np.ndarray) -> float:
@@ -144,13 +153,22 @@ def along_fringe_noise(frames: np.ndarray) -> float:
 
 def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | None = None,
             check: bool = True, shift_sign: int = 1, phase_offset: float = 0.0,
-            coherent: bool = True, maps: bool = True) -> FringeSet:
-    """Measure frames ``start .. start+steps-1`` of a prepared stack as an N-step set.
+            coherent: bool = True, maps: bool = True, pair: int | None = None) -> FringeSet:
+    """Measure frames ``start .. start+steps-1`` of a prepared stack as an N-step set (and,
+    with ``pair``, the stair pair of frames ``pair``, ``pair + 1`` in the same pass).
+
+    Two passes: pass 0 (:mod:`bistair.core.sample`) takes the camera noise from a sparse
+    grid (:func:`~bistair.core.sample.set_noise`), hence the thresholds, and with ``check``
+    the set's :class:`~bistair.core.sample.Sample` for the checks of the whole capture;
+    pass 1 (:func:`~bistair.core.measure_jit.front_end`) measures every pixel in tiles of
+    rows, each frame read once: phase, average, modulation, validity, the phase noise and
+    the pair's stair phase.
 
     ``shift_sign`` and ``phase_offset`` are the rig's phase convention
-    (:func:`~bistair.core.phase.wrapped_phase`). Valid pixels are not saturated, have, when
-    the capture has white and black frames, twice the modulation threshold of contrast
-    between them, and have enough modulation:
+    (:func:`~bistair.core.phase.wrapped_phase`). Valid pixels are not saturated (a frame of
+    the set or of the pair at full scale, and the fitted sinusoid above it), have, when the
+    capture has white and black frames, twice the modulation threshold of contrast between
+    them, and have enough modulation:
 
     - at least the threshold (:func:`~bistair.core.captures.modulation_threshold`: four
       times the noise, at least 1% of full scale, or ``min_modulation`` if given), or
@@ -174,22 +192,26 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         The modulation a valid pixel needs (fraction of full scale, strictly between 0 and
         1); from the noise when not given.
     check : bool
-        Refuse captures with (almost) nothing to decode.
+        Refuse captures with (almost) nothing to decode, and keep the sample.
     shift_sign, phase_offset : int, float
         The rig's phase convention.
     coherent : bool
         Also accept dim pixels in coherent fringe regions (see above).
     maps : bool
-        Keep the average and modulation; without, they are let go once the validity is
-        known (before the fringe regions of ``coherent``, the stage's largest) and the set
-        holds ``None`` for them: for sets of which only phase and validity are read.
+        Keep the average, the modulation and the phase noise; without, they are let go once
+        the validity is known (before the fringe regions of ``coherent``, the stage's
+        largest) and the set holds ``None`` for them: for sets of which only phase and
+        validity are read.
+    pair : int, optional
+        The stair pair's cosine frame (its sine frame follows): its phase in ``[-pi, pi]``
+        (``atan2(sin - A, cos - A)``) and modulation are kept in ``stair``.
 
     Returns
     -------
     FringeSet
         Float32 (H, W) wrapped phase in ``[0, 2*pi)``, average and modulation (fractions of
-        full scale), the bool validity mask, the noise sigma, ``steps`` and the modulation
-        threshold.
+        full scale), the bool validity mask, the noise sigma, ``steps``, the modulation
+        threshold, the phase noise (``sigma``), the stair pair's maps and the sample.
 
     Raises
     ------
@@ -212,33 +234,32 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     ...
     bistair.errors.BistairError: captures are dark: no pixel has enough fringe modulation to decode
     """
-    shifts = shifts_of(steps, shift_sign)
-    raw = prepared.raw if prepared.raw.flags.c_contiguous else np.ascontiguousarray(prepared.raw)
-    num, den, avg = nstep_sums(raw, start, steps, float(prepared.scale),
-                               np.sin(shifts).astype(np.float32),
-                               np.cos(shifts).astype(np.float32))
-    phi, mod = phase_of_sums(num, den, steps, phase_offset)
-    del num, den
-    frames = ScaledStack(prepared.raw[start:start + steps], float(prepared.scale))
-    noise = noise_level(frames, phi, avg, mod, shift_sign, phase_offset)
+    noise = set_noise(prepared, start, steps)  # pass 0: the noise, hence the thresholds
     threshold = modulation_threshold(noise, min_modulation)
     lowest = threshold if (min_modulation is not None or not coherent) else \
         max(0.005, 2.0 * noise)
-    # saturation, validity and the white/black contrast of captures.py, in one pass
-    valid, strong, weak = pixel_validity(mod, avg, prepared.clipped, lowest, threshold,
-                                         prepared.white, prepared.black)
+    sample = None if not check else take_sample(prepared, start, steps, pair, lowest,
+                                                threshold, shift_sign, phase_offset)
+    contrast = prepared.white is not None and prepared.black is not None
+    none = np.zeros((1, 1), np.float32)
+    raw, first, cos_frame = kernel_view(prepared, start, steps, pair)
+    phi, mod, avg, valid, strong, sigma, theta, stair_mod, weak = front_end(  # pass 1
+        raw, first, int(steps), cos_frame, float(prepared.scale),
+        *shift_weights(steps, shift_sign), *offset_parts(phase_offset), clip_level(prepared),
+        float(lowest), float(threshold), np.float32(noise / np.sqrt(steps / 2.0)),
+        prepared.white if contrast else none, prepared.black if contrast else none, contrast)
     if not maps:
         avg = None
-    if lowest < threshold and weak:  # dim pixels to judge by their regions
-        sigma = phase_noise(mod, noise, steps)
-        if not (maps or check):
+        if not check:
             mod = None
+    if lowest < threshold and weak:  # dim pixels to judge by their regions
         valid = coherent_pixels(phi, valid, strong, sigma)
-        del sigma
     del strong
     if check:
-        check_decodable(valid, prepared.clipped, min_modulation, mod)
-    return FringeSet(phi, avg, None if not maps else mod, valid, noise, steps, threshold)
+        check_decodable(valid, lambda: prepared.clipped, min_modulation, mod)
+    return FringeSet(phi, avg, mod if maps else None, valid, noise, steps, threshold,
+                     sigma if maps else None,
+                     None if pair is None else (theta, stair_mod), sample)
 
 
 def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
@@ -287,9 +308,3 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     lab = label_fringes(phi, weak, phase_noise=phase_noise, strong=strong)
     return keep_coherent(lab.labels, lab.roots, lab.size, lab.strong, strong, min_strong,
                          min_size, MIN_REGION)
-
-
-def _chi2_median(dof: int) -> float:
-    """The median of a chi-squared distribution of ``dof`` degrees of freedom (scipy.stats'
-    ``chi2.ppf(0.5, dof)`` without importing scipy.stats, half a second at start-up)."""
-    return float(2.0 * special.gammaincinv(dof / 2.0, 0.5))

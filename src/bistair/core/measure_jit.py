@@ -1,8 +1,11 @@
-"""Compiled passes of the phase stage's measure (:mod:`bistair.core.measure`): pixel
-validity, the phase noise per pixel, the fit residual sample of the camera noise and the
-coherent dim pixels.
+"""Compiled passes of the phase stage's measure (:mod:`bistair.core.measure`): pass 1 of a
+decode (:func:`front_end`: every pixel of an N-step set and its stair pair measured in one
+pass over tiles of rows), the phase noise per pixel, the fit residual sample of the camera
+noise (the full-resolution reference of pass 0's) and the coherent dim pixels.
 
-Each gives, bit for bit, what the NumPy it replaces gives (the noise sample's cosines come
+Each gives, bit for bit, what the NumPy it replaces gives (:func:`front_end`: what
+:func:`bistair.core.phase_jit.phase_of_sums32` and
+:func:`bistair.core.sample.judge` give from the same sums; the noise sample's cosines come
 from the C library's ``cosf``, whose last bit may differ from NumPy's: see
 :func:`fit_residual_energy`).
 
@@ -18,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import chunk_count, kernel, kernel_frames
+from .phase_jit import _angle, _hypot32, _phase, _quarter_sums, _quarter_turns
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -173,85 +177,6 @@ def _fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
 
 
 @kernel(parallel=True)
-def _validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, white: np.ndarray,
-              black: np.ndarray, contrast: bool, lowest: float, threshold: float
-              ) -> tuple[np.ndarray, np.ndarray, int]:
-    h, w = mod.shape
-    valid = np.empty((h, w), np.bool_)
-    strong = np.empty((h, w), np.bool_)
-    weak_rows = np.zeros(h, np.int64)
-    low32 = np.float32(lowest)
-    thr32 = np.float32(threshold)
-    sat32 = np.float32(1.02)
-    need32 = np.float32(2.0 * lowest)
-    for y in prange(h):
-        weak = 0
-        for x in range(w):
-            m = mod[y, x]
-            ok = m >= low32 and not (clipped[y, x] and avg[y, x] + m > sat32)
-            if contrast and not (white[y, x] - black[y, x] >= need32):
-                ok = False
-            valid[y, x] = ok
-            s = ok and m >= thr32
-            strong[y, x] = s
-            if ok and not s:
-                weak += 1
-        weak_rows[y] = weak
-    return valid, strong, weak_rows.sum()
-
-
-
-def pixel_validity(mod: np.ndarray, avg: np.ndarray, clipped: np.ndarray, lowest: float,
-                   threshold: float, white: np.ndarray | None = None,
-                   black: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, int]:
-    """The valid pixels of a measured set, those of them with the full modulation
-    threshold, and how many valid pixels fall short of it, in one pass.
-
-    Valid: modulation at least ``lowest``, not saturated (clipped with ``avg + mod`` above
-    1.02: clipped by the camera) and, with ``white`` and ``black``,
-    twice ``lowest`` of contrast between them. Thresholds compare in float32, as NumPy
-    compares a float32 array with a Python float.
-
-    Parameters
-    ----------
-    mod, avg : (H, W) float32 arrays
-        The set's modulation and average (fractions of full scale).
-    clipped : (H, W) bool array
-        Pixels that some frame clips.
-    lowest : float
-        The modulation a valid pixel needs.
-    threshold : float
-        The full modulation threshold (``strong`` pixels).
-    white, black : (H, W) float32 arrays, optional
-        The fully lit and the dark frame, if the capture has both.
-
-    Returns
-    -------
-    valid : (H, W) bool array
-        The valid pixels.
-    strong : (H, W) bool array
-        The valid pixels with at least ``threshold``.
-    weak : int
-        Valid pixels below ``threshold``.
-
-    Examples
-    --------
-    >>> mod = np.float32([[0.004, 0.006, 0.02, 0.5]])
-    >>> avg = np.float32([[0.5, 0.5, 0.5, 0.6]])
-    >>> clipped = np.array([[False, False, False, True]])
-    >>> valid, strong, weak = pixel_validity(mod, avg, clipped, 0.005, 0.01)
-    >>> valid.tolist(), strong.tolist(), weak
-    ([[False, True, True, False]], [[False, False, True, False]], 1)
-    """
-    contrast = white is not None and black is not None
-    valid, strong, weak = _validity(mod, avg, clipped, white if contrast else avg,
-                                    black if contrast else avg, contrast, float(lowest),
-                                    float(threshold))
-    return valid, strong, int(weak)
-
-
-
-@kernel(parallel=True)
 def _phase_noise(mod: np.ndarray, noise: float, factor: float, chunks: int) -> np.ndarray:
     n = mod.size
     out = np.empty(n, np.float32)
@@ -294,3 +219,177 @@ def phase_noise(mod: np.ndarray, noise: float, steps: int) -> np.ndarray:
     flat = np.ascontiguousarray(mod, np.float32).reshape(-1)
     out = _phase_noise(flat, float(noise), float(np.sqrt(steps / 2.0)), chunk_count(flat.size))
     return out.reshape(np.shape(mod))
+
+
+TILE_ROWS = 16  # rows a task of the full pass works on
+
+
+@kernel(parallel=True)
+def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
+              sin_w: np.ndarray, cos_w: np.ndarray, off_hi: np.float32, off_lo: np.float32,
+              full: float, lowest: float, threshold: float, sigma_scale: np.float32,
+              white: np.ndarray, black: np.ndarray, contrast: bool
+              ) -> tuple[np.ndarray, ...]:
+    """Pass 1 of a decode: every pixel of an N-step set (and its stair pair) measured in one
+    pass over tiles of rows on every core, each frame read once.
+
+    Per pixel: the N-step sums (:func:`~bistair.core.phase_jit._set_sums`), the wrapped
+    phase less the phase offset in ``[0, 2*pi)`` (:func:`~bistair.core.phase_jit._phase`,
+    the float32 arctangent of :func:`~bistair.core.phase_jit.arctan2_32`), the modulation
+    ``2/N * hypot`` and the average (float32); whether a frame of the set or of the pair
+    reaches ``full`` (clipped); valid (modulation at least ``lowest``, not saturated:
+    clipped with ``avg + mod`` above 1.02, and, with ``contrast``, ``white - black`` at
+    least ``2 * lowest``) and strong (also at least ``threshold``); the phase noise
+    ``sigma_scale / max(mod, 1e-6)``; with ``pair >= 0`` the stair phase
+    ``atan2(sin - A, cos - A)`` in ``[-pi, pi]`` and its modulation. Each tile writes only
+    its own rows, so the results do not depend on the threads.
+
+    Parameters
+    ----------
+    raw : (F, H, W) array
+        The capture stack, uint8, uint16 or float32, C-contiguous.
+    start, steps : int
+        The set's first frame and its frame count ``N``.
+    pair : int
+        The stair pair's cosine frame (its sine frame follows), or -1.
+    scale : float
+        Factor that turns a raw value into a fraction of full scale.
+    sin_w, cos_w : (N,) float32 arrays
+        Sine and cosine of each frame's phase shift
+        (:func:`~bistair.core.phase_jit.shift_weights`).
+    off_hi, off_lo : float32
+        The phase offset (:func:`~bistair.core.phase_jit.offset_parts`).
+    full : float
+        The raw value at which a frame clips.
+    lowest, threshold : float
+        The modulation a valid and a strong pixel need.
+    sigma_scale : float32
+        ``noise / sqrt(N/2)``.
+    white, black : (H, W) float32 arrays
+        The fully lit and the dark frame (read with ``contrast`` only).
+    contrast : bool
+        Judge the white/black contrast.
+
+    Returns
+    -------
+    phi, mod, avg : (H, W) float32 arrays
+    valid, strong : (H, W) bool arrays
+    sigma : (H, W) float32 array
+        The phase noise, radians.
+    theta, stair_mod : (H, W) float32 arrays
+        The pair's phase and modulation ((1, 1) without a pair).
+    weak : int
+        Valid pixels that are not strong.
+
+    Examples
+    --------
+    >>> from bistair.core.phase_jit import shift_weights
+    >>> raw = np.zeros((4, 2, 3), np.uint8)
+    >>> raw[0], raw[2] = 200, 100  # a phase of 0, a modulation of 50 levels
+    >>> raw[0, 0, 0], raw[2, 0, 0] = 110, 100  # 5 levels
+    >>> dummy = np.zeros((1, 1), np.float32)
+    >>> out = front_end(raw, 0, 4, -1, 1 / 255, *shift_weights(4), np.float32(0),
+    ...                 np.float32(0), 255.0, 0.01, 0.1, np.float32(0.01), dummy, dummy, False)
+    >>> phi, valid, strong, weak = out[0], out[3], out[4], out[8]
+    >>> float(phi.max()), bool(valid.all()), strong[0].tolist(), weak
+    (0.0, True, [False, True, True], 1)
+    """
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    zero = np.float32(0.0)
+    full32 = np.float32(full)
+    low32 = np.float32(lowest)
+    thr32 = np.float32(threshold)
+    sat32 = np.float32(1.02)
+    need32 = np.float32(2.0 * lowest)
+    floor32 = np.float32(1e-6)
+    quarter = _quarter_turns(sin_w, cos_w)
+    phi = np.empty((h, w), np.float32)
+    mod = np.empty((h, w), np.float32)
+    avg = np.empty((h, w), np.float32)
+    valid = np.empty((h, w), np.bool_)
+    strong = np.empty((h, w), np.bool_)
+    sigma = np.empty((h, w), np.float32)
+    ph = h if pair >= 0 else 1
+    pw = w if pair >= 0 else 1
+    theta = np.empty((ph, pw), np.float32)
+    stair_mod = np.empty((ph, pw), np.float32)
+    tiles = (h + TILE_ROWS - 1) // TILE_ROWS
+    weak = np.zeros(tiles, np.int64)
+    for t in prange(tiles):
+        s = np.empty(w, np.float32)
+        c = np.empty(w, np.float32)
+        top = np.empty(w, raw.dtype)
+        count = 0
+        for y in range(t * TILE_ROWS, min(h, (t + 1) * TILE_ROWS)):
+            p = phi[y]
+            m = mod[y]
+            a = avg[y]
+            if quarter:  # four quarter-turn shifts: each pixel's sums in registers
+                r0 = raw[start, y]
+                r1 = raw[start + 1, y]
+                r2 = raw[start + 2, y]
+                r3 = raw[start + 3, y]
+                for x in range(w):
+                    v0 = r0[x]
+                    v1 = r1[x]
+                    v2 = r2[x]
+                    v3 = r3[x]
+                    top[x] = max(max(v0, v1), max(v2, v3))
+                    num, den, av = _quarter_sums(v0, v1, v2, v3, s32, sin_w, cos_w)
+                    p[x] = _phase(num, den, off_hi, off_lo)
+                    m[x] = _hypot32(num, den) * np.float32(0.5)
+                    a[x] = av
+            else:  # frame by frame along the row, in frame order: the loops vectorise
+                n32 = np.float32(steps)
+                first = raw[start, y]
+                for x in range(w):
+                    s[x] = zero
+                    c[x] = zero
+                    a[x] = zero
+                    top[x] = first[x]
+                for n in range(steps):
+                    sw = sin_w[n]
+                    cw = cos_w[n]
+                    row = raw[start + n, y]
+                    for x in range(w):
+                        v = row[x]
+                        top[x] = max(top[x], v)
+                        f = np.float32(v) * s32
+                        s[x] += sw * f
+                        c[x] += cw * f
+                        a[x] += f
+                mod_scale = np.float32(2.0) / n32
+                for x in range(w):
+                    num = -s[x]
+                    a[x] = a[x] / n32
+                    p[x] = _phase(num, c[x], off_hi, off_lo)
+                    m[x] = _hypot32(num, c[x]) * mod_scale
+            if pair >= 0:
+                cos_row = raw[pair, y]
+                sin_row = raw[pair + 1, y]
+                th = theta[y]
+                sm = stair_mod[y]
+                for x in range(w):
+                    top[x] = max(top[x], max(cos_row[x], sin_row[x]))
+                    cc = np.float32(cos_row[x]) * s32 - a[x]
+                    ss = np.float32(sin_row[x]) * s32 - a[x]
+                    th[x] = _angle(ss, cc)
+                    sm[x] = _hypot32(cc, ss)
+            ok_row = valid[y]
+            st_row = strong[y]
+            sg = sigma[y]
+            for x in range(w):  # (bitwise: the loop vectorises)
+                mx = m[x]
+                ok = (mx >= low32) & ~((np.float32(top[x]) >= full32) & (a[x] + mx > sat32))
+                ok_row[x] = ok
+                st_row[x] = ok & (mx >= thr32)
+                sg[x] = sigma_scale / max(mx, floor32)
+            if contrast:
+                for x in range(w):
+                    ok_row[x] = ok_row[x] & (white[y, x] - black[y, x] >= need32)
+                    st_row[x] = st_row[x] & ok_row[x]
+            for x in range(w):  # (a loop of its own: counted inside, nothing vectorised)
+                count += ok_row[x] ^ st_row[x]
+        weak[t] = count
+    return phi, mod, avg, valid, strong, sigma, theta, stair_mod, weak.sum()

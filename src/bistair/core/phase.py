@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .phase_jit import arctan2_32, finish_phase, wrap_angles
+from .phase_jit import phase_of_sums32, wrap_angles
 
 TWO_PI = 2.0 * np.pi
 
@@ -143,8 +143,9 @@ def wrapped_phase(frames: np.ndarray, shift_sign: int = 1, phase_offset: float =
 def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: float = 0.0
                   ) -> tuple[np.ndarray, np.ndarray]:
     """The wrapped phase in ``[0, 2*pi)`` and the modulation of an N-step set from its sums
-    ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32; the arctangent
-    correctly rounded, :func:`~bistair.core.phase_jit.arctan2_32`).
+    ``num = -sum I_n sin d_n`` and ``den = sum I_n cos d_n`` (float32, as the decode's own
+    pass computes them: :func:`~bistair.core.phase_jit.phase_of_sums32`, the arctangent
+    of :func:`~bistair.core.phase_jit.arctan2_32`).
 
     Parameters
     ----------
@@ -168,13 +169,7 @@ def phase_of_sums(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: fl
     >>> phi.astype(float).round(4).tolist(), mod.tolist()
     ([0.0, 1.5708, 4.7124], [1.0, 1.0, 1.0])
     """
-    num, den = np.asarray(num, np.float32), np.asarray(den, np.float32)
-    phi = arctan2_32(num, den)
-    if phase_offset:
-        phi = (phi - np.float32(phase_offset)) % np.float32(TWO_PI)
-    # into [0, 2*pi) (float32 rounding of tiny negatives gives 0) and the modulation
-    mod = finish_phase(phi, num, den, steps)
-    return phi, mod
+    return phase_of_sums32(num, den, steps, phase_offset)
 
 
 def residuals(frames: np.ndarray, phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,

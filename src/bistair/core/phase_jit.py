@@ -1,21 +1,24 @@
-"""Compiled passes of the wrapped phase (:mod:`bistair.core.phase`): the arctangent, the
-N-step sums and the phase's last pass.
+"""Compiled passes of the wrapped phase (:mod:`bistair.core.phase`): the float32
+arctangent every phase of a decode comes from, the phase and modulation of N-step sums, and
+the wrap of angles.
 
-Every pass gives, bit for bit, what the NumPy expression it replaces gives (the same float32
-or float64 operations in the same order), without the temporaries. The arctangent is the one
-exception: NumPy's float32 ``arctan2`` rounds differently from machine to machine (on
-AVX-512 a third of its values are 1-3 units in the last place from the true angle, without
-AVX-512 it is several times slower), so the phases come from :func:`arctan2_32`, the
-correctly rounded angle on every machine. Loops over chunks of pixels run on every core
-(:func:`bistair.core.jit.set_threads`; each chunk writes only its own outputs, so the
-results do not depend on the threads).
+**The arctangent** (:func:`_octant`, :func:`_angle`, :func:`_phase`; :func:`arctan2_32` on
+arrays) is a float32 minimax polynomial after reduction to ``|u| <= tan(pi/8)``, written
+with selects (its loops vectorise) in a fixed order of operations and compiled without
+fastmath (numba's default here: no reassociation, no fused multiply-add; the decode's
+kernels hold no ``fma`` instruction), so that a capture decodes to the same phases, bit for
+bit, on every x86 machine whatever its vector units. NumPy's float32 ``arctan2`` does not
+(on AVX-512 a third of its values are 1-3 units in the last place from the true angle,
+without AVX-512 it is several times slower). Its error is under :data:`ATAN_ERROR`
+(3.2e-7 rad, about half a unit in the last place of a phase near 2*pi): the phase is
+composed as ``m*pi/4 - offset + t`` from exact parts and rounded once. Loops over chunks of
+pixels run on every core (:func:`bistair.core.jit.set_threads`; each chunk writes only its
+own outputs, so the results do not depend on the threads).
 
 Examples
 --------
 >>> import numpy as np
->>> num, den = np.float32([0.0, 3.0]), np.float32([4.0, -4.0])
->>> phi = np.arctan2(num, den)
->>> mod = finish_phase(phi, num, den, 2)  # phi is made [0, 2*pi) in place
+>>> phi, mod = phase_of_sums32(np.float32([0.0, 3.0]), np.float32([4.0, -4.0]), 2)
 >>> phi.astype(float).round(4).tolist(), mod.tolist()
 ([0.0, 2.4981], [4.0, 5.0])
 """
@@ -23,57 +26,193 @@ Examples
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
-from .jit import TWO_PI32, _numba_inline, chunk_count, kernel, kernel_frames
+from .jit import TWO_PI32, _numba_inline, chunk_count, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
-# atan(u) / u = P(u^2) on |u| <= tan(pi/8): a Chebyshev fit, relative error 2.6e-14
-_ATAN = (0.9999999999999744, -0.3333333333087206, 0.1999999961323299,
-         -0.1428569081054061, 0.11110393860558447, -0.09078501279416004,
-         0.07564453629534063, -0.05877189674091674, 0.030701474337983595)
+# atan(u) = u + u*s*P(s), s = u*u, on |u| <= tan(pi/8): a minimax fit (Lawson's iteration on
+# the absolute error), 4.9e-9 rad from atan in exact arithmetic; in float32 here
+_P0 = np.float32(-0.33332756763998145)
+_P1 = np.float32(0.1997188267143458)
+_P2 = np.float32(-0.13824488875543586)
+_P3 = np.float32(0.07902710215562109)
+_TAN_PI8 = np.float32(math.tan(math.pi / 8))
+_QUANTUM = 2.0 ** -12  # pi/4, 2*pi and a phase offset split into a multiple of this and a rest
+_PI4_HI = np.float32(round(math.pi / 4 / _QUANTUM) * _QUANTUM)
+_PI4_LO = np.float32(math.pi / 4 - float(_PI4_HI))
+_TWO_PI_HI = np.float32(8.0 * float(_PI4_HI))
+_TWO_PI_LO = np.float32(2.0 * math.pi - float(_TWO_PI_HI))
+ATAN_ERROR = 3.2e-7  # the largest error of _phase and _angle (radians), measured: see arctan2_32
 
 
 @_numba_inline
-def _atan2(y: np.float32, x: np.float32) -> np.float32:
-    """``arctan2(y, x)`` of float32 values, in float64 (relative error under 3e-14) and
-    rounded once to float32: the correctly rounded angle unless it lies within 3e-14 of a
-    float32 rounding boundary, with ``arctan2``'s signs of zero (``atan2(+-0, -0) =
-    +-pi``), infinities and NaN. Branch-free (the loops over it vectorise)."""
-    ax = abs(np.float64(x))
-    ay = abs(np.float64(y))
-    both = ax == math.inf and ay == math.inf  # the diagonal: pi/4 and its reflections
-    ax = 1.0 if both else ax
-    ay = 1.0 if both else ay
+def _octant(y: np.float32, x: np.float32) -> tuple[np.float32, np.float32]:
+    """``(m, t)`` with ``atan2(y, x) = m*pi/4 + t`` for ``y >= 0`` (``m`` a whole number 0-4
+    as float32, ``|t| <= pi/8``); the caller mirrors it for ``y < 0``. Float32, branch-free
+    (selects: the loops over it vectorise), in a fixed order of operations."""
+    ax = abs(x)
+    ay = abs(y)
     steep = ay > ax
     hi = ay if steep else ax
     lo = ax if steep else ay
-    # t = lo / hi in [0, 1]; past tan(pi/8), atan(t) = pi/4 + atan((lo - hi) / (lo + hi))
-    big = lo > 0.41421356237309503 * hi
-    u = (lo - hi if big else lo) / (lo + hi if big else (hi if hi > 0.0 else 1.0))
-    w = u * u
-    p = (((((((_ATAN[8] * w + _ATAN[7]) * w + _ATAN[6]) * w + _ATAN[5]) * w + _ATAN[4]) * w
-           + _ATAN[3]) * w + _ATAN[2]) * w + _ATAN[1]) * w + _ATAN[0]
-    r = (math.pi / 4 if big else 0.0) + u * p
-    r = math.pi / 2 - r if steep else r
-    r = math.pi - r if math.copysign(1.0, np.float64(x)) < 0.0 else r  # also x = -0
-    r = np.nan if (x != x or y != y) else r
-    return np.float32(math.copysign(r, np.float64(y)))
+    # past tan(pi/8), atan(lo/hi) = pi/4 + atan((lo - hi) / (lo + hi))
+    big = lo > _TAN_PI8 * hi
+    num = lo - hi if big else lo
+    den = lo + hi if big else hi
+    den = den if den > np.float32(0.0) else np.float32(1.0)  # (0, 0): angle 0
+    u = num / den
+    s = u * u
+    t = u + u * (s * (((_P3 * s + _P2) * s + _P1) * s + _P0))
+    m = np.float32(1.0) if big else np.float32(0.0)
+    m = np.float32(2.0) - m if steep else m  # pi/2 - angle
+    t = -t if steep else t
+    left = x < np.float32(0.0)
+    m = np.float32(4.0) - m if left else m  # pi - angle
+    t = -t if left else t
+    return m, t
+
+
+@_numba_inline
+def _angle(y: np.float32, x: np.float32) -> np.float32:
+    """``arctan2(y, x)`` in ``[-pi, pi]`` of finite float32 values, float32 (see
+    :func:`arctan2_32`; ``atan2(-0.0, x < 0)`` is ``pi`` here)."""
+    m, t = _octant(y, x)
+    below = y < np.float32(0.0)
+    m = -m if below else m
+    t = -t if below else t
+    return m * _PI4_HI + (m * _PI4_LO + t)  # m * _PI4_HI is exact
+
+
+@_numba_inline
+def _phase(y: np.float32, x: np.float32, off_hi: np.float32, off_lo: np.float32
+           ) -> np.float32:
+    """The phase of ``(x, y)`` less a phase offset (``off_hi + off_lo``,
+    :func:`offset_parts`), in ``[0, 2*pi)``, float32, one rounding at the end (see
+    :func:`arctan2_32`)."""
+    m, t = _octant(y, x)
+    below = y < np.float32(0.0)
+    m = np.float32(8.0) - m if below else m  # 2*pi - angle
+    t = -t if below else t
+    a = m * _PI4_HI - off_hi  # exact: both multiples of 2**-12 under 2**11
+    b = (m * _PI4_LO - off_lo) + t
+    r = a + b
+    low = r < np.float32(0.0)
+    high = r >= TWO_PI32
+    a = a + _TWO_PI_HI if low else a  # (exact)
+    b = b + _TWO_PI_LO if low else b
+    a = a - _TWO_PI_HI if high else a
+    b = b - _TWO_PI_LO if high else b
+    r = a + b
+    # a phase just short of 2*pi rounds to 2*pi (then below 0 once 2*pi is taken off): 0
+    return r if (r >= np.float32(0.0) and r < TWO_PI32) else np.float32(0.0)
+
+
+@_numba_inline
+def _hypot32(a: np.float32, b: np.float32) -> np.float32:
+    """``hypot(a, b)`` of float32 values in float32: the square root of ``a*a + b*b``
+    (correctly rounded; values of a capture neither overflow nor matter where they
+    underflow)."""
+    return np.sqrt(a * a + b * b)
+
+
+@_numba_inline
+def _quarter_turns(sin_w: np.ndarray, cos_w: np.ndarray) -> bool:
+    """Four shifts a quarter turn apart (:func:`shift_weights` of N = 4): weights 0 where
+    :func:`_quarter_sums` leaves them out."""
+    return (sin_w.size == 4 and sin_w[0] == 0 and sin_w[2] == 0 and cos_w[1] == 0
+            and cos_w[3] == 0)
+
+
+@_numba_inline
+def _quarter_sums(v0: Any, v1: Any, v2: Any, v3: Any, scale: np.float32,
+                  sin_w: np.ndarray, cos_w: np.ndarray
+                  ) -> tuple[np.float32, np.float32, np.float32]:
+    """``(num, den, avg)`` of a pixel's four quarter-turn frames (raw values times
+    ``scale``): ``-(s1*f1 + s3*f3)``, ``c0*f0 + c2*f2`` and the mean, float32; what the
+    frame-by-frame sums over all four weights give (the others are 0), in fewer
+    operations."""
+    f0 = np.float32(v0) * scale
+    f1 = np.float32(v1) * scale
+    f2 = np.float32(v2) * scale
+    f3 = np.float32(v3) * scale
+    num = -(sin_w[1] * f1 + sin_w[3] * f3)
+    den = cos_w[0] * f0 + cos_w[2] * f2
+    return num, den, (((f0 + f1) + f2) + f3) * np.float32(0.25)
+
+
+def shift_weights(steps: int, shift_sign: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """Sine and cosine of each frame's phase shift ``shift_sign*2*pi*n/steps``, float32,
+    those within 1e-12 of 0 or of 1 in size made exactly so (``sin(pi)`` is 0, not 1.2e-16):
+    the weights of the N-step sums.
+
+    Parameters
+    ----------
+    steps : int
+        Number of frames ``N``.
+    shift_sign : int
+        +1 or -1.
+
+    Returns
+    -------
+    sin_w, cos_w : (N,) float32 arrays
+
+    Examples
+    --------
+    >>> [w.tolist() for w in shift_weights(4, -1)]
+    [[0.0, -1.0, 0.0, 1.0], [1.0, 0.0, -1.0, 0.0]]
+    """
+    d = shift_sign * 2.0 * math.pi * np.arange(steps) / steps
+    out = []
+    for w in (np.sin(d), np.cos(d)):
+        near = np.round(w)
+        out.append(np.where(np.abs(w - near) < 1e-12, near, w).astype(np.float32) + 0.0)
+    return out[0], out[1]
+
+
+def offset_parts(offset: float) -> tuple[np.float32, np.float32]:
+    """A phase offset as the two float32 parts the compiled phase subtracts: the offset
+    modulo 2*pi, rounded to a multiple of 2**-12, and the rest.
+
+    Parameters
+    ----------
+    offset : float
+        Radians, finite.
+
+    Returns
+    -------
+    (hi, lo) : tuple of numpy.float32
+        ``hi + lo`` is the offset in ``[0, 2*pi)`` to float32's precision of ``lo``.
+
+    Examples
+    --------
+    >>> hi, lo = offset_parts(-np.pi / 2)
+    >>> float(hi) * 4096 % 1, round(float(hi) + float(lo), 6)
+    (0.0, 4.712389)
+    """
+    wrapped = float(offset) % (2.0 * math.pi)
+    hi = round(wrapped / _QUANTUM) * _QUANTUM
+    return np.float32(hi), np.float32(wrapped - hi)
 
 
 def arctan2_32(y: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``np.arctan2`` of float32 arrays, in one compiled pass on every core: the correctly
-    rounded float32 arctangent (computed in float64 to 3e-14; it matched float64
-    ``arctan2`` rounded once on all of 4 million random pairs). NumPy's own float32
-    ``arctan2`` differs between machines (a vectorised one with AVX-512, a third of its
-    values 1-3 units in the last place off; the C library's without, several times
-    slower); this one does not.
+    """``np.arctan2`` of float32 arrays, as the decode computes its phases: a float32
+    minimax polynomial after reduction to ``|u| <= tan(pi/8)``, in a fixed order of
+    operations, compiled without fastmath (no reassociation, no fused multiply-add), so
+    the same bits on every x86 machine whatever its vector units, in one pass on every core.
+
+    Error against float64 ``np.arctan2``: under :data:`ATAN_ERROR` (3.2e-7 rad; measured
+    2.8e-7 on every pair of whole numbers in [-512, 512] and 3.0e-7 on 4 million random
+    pairs over five decades, offsets included; 0.5-0.65 units in the last place of
+    ``[4, 2*pi)``); 92-95% of the angles are the correctly rounded ones. Finite values
+    only (``arctan2(0, 0) = 0``; ``atan2(-0.0, x < 0)`` is ``pi``, not ``-pi``).
 
     Parameters
     ----------
     y, x : float32 arrays
-        Of one shape.
+        Of one shape, finite.
 
     Returns
     -------
@@ -95,65 +234,56 @@ def arctan2_32(y: np.ndarray, x: np.ndarray) -> np.ndarray:
 def _arctan2(y: np.ndarray, x: np.ndarray) -> np.ndarray:
     out = np.empty(y.size, np.float32)
     for i in prange(y.size):  # (one flat loop: numba vectorises it)
-        out[i] = _atan2(y[i], x[i])
+        out[i] = _angle(y[i], x[i])
     return out
 
 
 @kernel(parallel=True)
-def _finish_phase(phi: np.ndarray, num: np.ndarray, den: np.ndarray, scale: float,
-                  chunks: int) -> np.ndarray:
-    n = phi.size
+def _phase_of_sums(num: np.ndarray, den: np.ndarray, off_hi: np.float32, off_lo: np.float32,
+                   scale: np.float32, chunks: int) -> tuple[np.ndarray, np.ndarray]:
+    n = num.size
+    phi = np.empty(n, np.float32)
     mod = np.empty(n, np.float32)
-    s32 = np.float32(scale)
-    zero = np.float32(0.0)
     for c in prange(chunks):
-        lo = c * n // chunks
-        hi = (c + 1) * n // chunks
-        for i in range(lo, hi):
-            p = phi[i]
-            if p < zero:
-                p = p + TWO_PI32
-            if p >= TWO_PI32:
-                p = zero
-            phi[i] = p
-            a = np.float64(num[i])
-            b = np.float64(den[i])
-            # hypotf as glibc computes it: the double square root, rounded once
-            mod[i] = np.float32(math.sqrt(a * a + b * b)) * s32
-    return mod
+        for i in range(c * n // chunks, (c + 1) * n // chunks):
+            a = num[i]
+            b = den[i]
+            phi[i] = _phase(a, b, off_hi, off_lo)
+            mod[i] = _hypot32(a, b) * scale
+    return phi, mod
 
 
-def finish_phase(phi: np.ndarray, num: np.ndarray, den: np.ndarray, steps: int) -> np.ndarray:
-    """Bring an ``arctan2`` phase into ``[0, 2*pi)`` in place and return the modulation
-    ``2/N * hypot(num, den)``, in one pass (float32, as NumPy rounds them).
+def phase_of_sums32(num: np.ndarray, den: np.ndarray, steps: int, phase_offset: float = 0.0
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """The wrapped phase ``atan2(num, den) - phase_offset`` in ``[0, 2*pi)`` and the
+    modulation ``2/N * hypot(num, den)`` of N-step sums, float32, in one pass: the
+    arithmetic of the decode's own pass (:func:`bistair.core.measure_jit.front_end`).
 
     Parameters
     ----------
-    phi : float32 array
-        ``arctan2(num, den)`` (possibly less a phase offset), contiguous; changed in place.
     num, den : float32 arrays
-        The N-step sums, of ``phi``'s shape.
+        ``-sum I_n sin d_n`` and ``sum I_n cos d_n``, of one shape.
     steps : int
         Number of frames ``N`` the sums are over.
+    phase_offset : float
+        Radians subtracted from the phase.
 
     Returns
     -------
-    float32 array
-        The modulation, of ``phi``'s shape.
+    phi, mod : float32 arrays
+        Of ``num``'s shape.
 
     Examples
     --------
-    >>> num, den = np.float32([[-1.0, 1.0]]), np.float32([[-1.0, 0.0]])
-    >>> phi = np.arctan2(num, den)
-    >>> mod = finish_phase(phi, num, den, 4)
-    >>> mod.astype(float).round(4).tolist(), phi.astype(float).round(4).tolist()
-    ([[0.7071, 0.5]], [[3.927, 1.5708]])
+    >>> phi, mod = phase_of_sums32(np.float32([[-1.0, 1.0]]), np.float32([[-1.0, 0.0]]), 4)
+    >>> phi.astype(float).round(4).tolist(), mod.astype(float).round(4).tolist()
+    ([[3.927, 1.5708]], [[0.7071, 0.5]])
     """
-    flat = phi.reshape(-1)
-    mod = _finish_phase(flat, np.ascontiguousarray(num, np.float32).reshape(-1),
-                        np.ascontiguousarray(den, np.float32).reshape(-1),
-                        float(np.float32(2.0 / steps)), chunk_count(flat.size))
-    return mod.reshape(phi.shape)
+    a = np.ascontiguousarray(num, np.float32).reshape(-1)
+    hi, lo = offset_parts(phase_offset)
+    phi, mod = _phase_of_sums(a, np.ascontiguousarray(den, np.float32).reshape(-1), hi, lo,
+                              np.float32(2.0 / steps), chunk_count(a.size))
+    return phi.reshape(np.shape(num)), mod.reshape(np.shape(num))
 
 
 @kernel(parallel=True)
@@ -201,75 +331,3 @@ def wrap_angles(angle: np.ndarray) -> np.ndarray:
     kind = flat.dtype.type
     out = _wrap(flat, kind(math.pi), kind(2.0 * math.pi), chunk_count(flat.size))
     return out.reshape(np.shape(angle))
-
-
-@kernel(parallel=True)
-def _nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.ndarray,
-                cos_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    _, h, w = raw.shape
-    s32 = np.float32(scale)
-    n32 = np.float32(steps)
-    zero = np.float32(0.0)
-    num = np.empty((h, w), np.float32)
-    den = np.empty((h, w), np.float32)
-    avg = np.empty((h, w), np.float32)
-    for y in prange(h):
-        s = num[y]
-        c = den[y]
-        t = avg[y]
-        for x in range(w):
-            s[x] = zero
-            c[x] = zero
-            t[x] = zero
-        for n in range(steps):  # frame by frame along the row: the loop over x vectorises
-            sw = sin_w[n]
-            cw = cos_w[n]
-            row = raw[start + n, y]
-            for x in range(w):
-                f = np.float32(row[x]) * s32
-                s[x] += sw * f
-                c[x] += cw * f
-                t[x] += f
-        for x in range(w):
-            s[x] = -s[x]
-            t[x] = t[x] / n32
-    return num, den, avg
-
-
-def nstep_sums(raw: np.ndarray, start: int, steps: int, scale: float, sin_w: np.ndarray,
-               cos_w: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(num, den, avg)`` of frames ``start .. start+steps-1`` of a raw capture stack (each
-    value times ``scale`` is its fraction of full scale), float32, summed in frame order as
-    :func:`bistair.core.phase.wrapped_phase` sums them; the frames are the outer loop of each
-    row, so that the loop along the row vectorises.
-
-    Parameters
-    ----------
-    raw : (F, H, W) array
-        The capture stack, any numeric dtype, C-contiguous.
-    start : int
-        Index of the set's first frame.
-    steps : int
-        Number of frames ``N`` of the set.
-    scale : float
-        Factor that turns a raw value into a fraction of full scale.
-    sin_w, cos_w : (N,) float32 arrays
-        Sine and cosine of each frame's phase shift.
-
-    Returns
-    -------
-    num, den, avg : (H, W) float32 arrays
-        ``-sum sin_w[n] I_n``, ``sum cos_w[n] I_n`` and the average intensity.
-
-    Examples
-    --------
-    >>> raw = np.uint8([[[255, 0]], [[0, 255]], [[0, 0]], [[255, 255]]])
-    >>> d = 2 * np.pi * np.arange(4) / 4
-    >>> sums = nstep_sums(raw, 0, 4, 1 / 255, np.sin(d).astype(np.float32),
-    ...                   np.cos(d).astype(np.float32))
-    >>> [(a.astype(float).round(3) + 0.0).tolist() for a in sums]
-    [[[1.0, 0.0]], [[1.0, 0.0]], [[0.5, 0.5]]]
-    """
-    raw, start = kernel_frames(raw, start, steps)
-    return _nstep_sums(raw, start, int(steps), float(np.float32(scale)),
-                       np.asarray(sin_w, np.float32), np.asarray(cos_w, np.float32))

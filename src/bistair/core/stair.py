@@ -104,7 +104,8 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
         Float32 stair phase in radians (:func:`~bistair.core.phase_jit.arctan2_32` of the frames
         minus ``avg``).
     modulation : ndarray
-        Float32 length of that (cos, sin) vector, same shape.
+        Float32 length of that (cos, sin) vector (``sqrt(c*c + s*s)`` in float32), same
+        shape.
 
     Examples
     --------
@@ -113,9 +114,9 @@ def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
     >>> theta.astype(float).round(4).tolist(), mod.astype(float).round(3).tolist()
     ([-2.3562, -0.7854, 0.7854, 2.3562], [0.5, 0.5, 0.5, 0.5])
     """
-    c = np.asarray(cos_frame, dtype=np.float32) - avg
-    s = np.asarray(sin_frame, dtype=np.float32) - avg
-    return arctan2_32(s, c), np.hypot(s, c).astype(np.float32)
+    c = np.asarray(cos_frame, dtype=np.float32) - np.asarray(avg, np.float32)
+    s = np.asarray(sin_frame, dtype=np.float32) - np.asarray(avg, np.float32)
+    return arctan2_32(s, c), np.sqrt(c * c + s * s)
 
 
 def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
@@ -208,3 +209,190 @@ def half_gaps(levels: np.ndarray) -> np.ndarray:
         levels = levels.astype(np.float64)
     gaps = np.abs(wrap(levels[:, None] - levels[None, :])) + np.eye(levels.size) * TWO_PI
     return 0.5 * gaps.min(axis=1)
+
+
+def level_readings(levels: np.ndarray, exponent: float, offset: float = 0.5,
+                   amplitude: float = 0.5) -> np.ndarray:
+    """Where stair levels read through a response that raises each pattern value to
+    ``exponent`` (a projector's uncompensated gamma, or what is left of it).
+
+    The pair ``(offset + amplitude*cos(theta)) ** exponent``, ``(offset + amplitude *
+    sin(theta)) ** exponent``, read against the fringes' average (the mean of ``(offset +
+    amplitude*cos(psi)) ** exponent`` over a period), as :func:`stair_phase` reads it. Ambient
+    light, albedo and gain cancel; a linear response (``exponent`` 1) reads every level
+    where the patterns put it.
+
+    Parameters
+    ----------
+    levels : (L,) float array
+        Level phases in radians.
+    exponent : float
+        The response exponent, at least 0.4 (where the readings keep the levels' order for
+        any offset and amplitude that fit in [0, 1]).
+    offset, amplitude : float
+        The patterns' offset and amplitude (fractions of full scale).
+
+    Returns
+    -------
+    (L,) float64 array
+        The phase each level reads, radians in [-pi, pi].
+
+    Examples
+    --------
+    >>> levels = stair_level_phase(np.arange(8), 8)
+    >>> bool(np.allclose(level_readings(levels, 1.0), levels))
+    True
+    >>> (level_readings(levels, 2.2) - levels).round(3).tolist()  # gamma 2.2 left in
+    [0.277, -0.277, -0.162, -0.078, -0.243, 0.243, 0.078, 0.162]
+    """
+    levels = np.asarray(levels, dtype=np.float64)
+    psi = np.linspace(0.0, TWO_PI, 256, endpoint=False)
+    avg = np.mean(np.maximum(offset + amplitude * np.cos(psi), 0.0) ** exponent)
+    c = np.maximum(offset + amplitude * np.cos(levels), 0.0) ** exponent - avg
+    s = np.maximum(offset + amplitude * np.sin(levels), 0.0) ** exponent - avg
+    return np.arctan2(s, c)
+
+
+def fit_level_response(theta: np.ndarray, levels: np.ndarray, offset: float = 0.5,
+                       amplitude: float = 0.5) -> tuple[float, float]:
+    """The response exponent (:func:`level_readings`) whose level readings lie nearest a
+    sample of stair phases, and how much better they fit than the levels themselves.
+
+    Each phase (binned in 1024 steps of the circle) counts its squared distance to the
+    nearest reading, clipped at a quarter of the smallest gap between two levels (phases
+    between bands, blurred or noisy, weigh no more than that); exponents 0.4 to 4 in steps
+    of 10%, then of 2% around the best.
+
+    Parameters
+    ----------
+    theta : (n,) float array
+        Stair phases in radians (a sample of the valid pixels).
+    levels : (L,) float array
+        The code's level phases in radians.
+    offset, amplitude : float
+        The patterns' offset and amplitude.
+
+    Returns
+    -------
+    exponent : float
+        The best exponent (1.0 when ``theta`` is empty).
+    ratio : float
+        Its mean clipped squared distance over the levels' own (1.0: no better; 0.0 when
+        the levels' own is already 0).
+
+    Examples
+    --------
+    >>> levels = stair_level_phase(np.arange(8), 8)
+    >>> rng = np.random.default_rng(0)
+    >>> read = level_readings(levels, 2.2)[rng.integers(0, 8, 4000)]
+    >>> exponent, ratio = fit_level_response(read + rng.normal(0, 0.05, 4000), levels)
+    >>> round(exponent, 1), round(ratio, 2)
+    (2.2, 0.09)
+    >>> fit_level_response(levels[rng.integers(0, 8, 4000)], levels)  # read where they are
+    (1.0, 1.0)
+    """
+    theta = np.asarray(theta, dtype=np.float64).ravel()
+    levels = np.asarray(levels, dtype=np.float64)
+    if theta.size == 0 or levels.size < 2:
+        return 1.0, 1.0
+    clip = 0.5 * float(half_gaps(levels).min())
+    # the phases as a histogram of 1024 steps: each exponent is judged on the steps' centres
+    bins = 1024
+    step = np.floor((wrap(theta) + np.pi) * (bins / TWO_PI)).astype(np.int64)
+    counts = np.bincount(np.clip(step, 0, bins - 1), minlength=bins)
+    seen = np.flatnonzero(counts)
+    centre, count = -np.pi + (seen + 0.5) * (TWO_PI / bins), counts[seen] / theta.size
+
+    def cost(exponent: float) -> float:
+        read = np.sort(level_readings(levels, exponent, offset, amplitude))
+        i = np.searchsorted(read, centre)
+        d = np.minimum(np.abs(wrap(centre - read[i % read.size])),
+                       np.abs(wrap(centre - read[i - 1])))
+        return float(count @ np.minimum(d, clip) ** 2)
+
+    base = cost(1.0)
+    coarse = np.exp(np.linspace(math.log(0.4), math.log(4.0), 25))  # steps of 10%
+    best = float(coarse[int(np.argmin([cost(e) for e in coarse]))])
+    fine = [1.0, *np.clip(best * np.exp(np.linspace(-0.1, 0.1, 11)), 0.4, 4.0)]
+    costs = [cost(e) for e in fine]
+    i = int(np.argmin(costs))  # ties keep 1.0 (listed first)
+    return float(fine[i]), costs[i] / base if base > 0 else 0.0
+
+
+def level_table(readings: np.ndarray, levels: np.ndarray, bins: int = 8192) -> np.ndarray:
+    """The map that puts each level's reading on the level, piecewise linear on the circle
+    between the readings, as a table: entry ``i`` is where the phases from ``-pi + 2*pi*i /
+    bins`` on go (its step's centre mapped; the error at most half a step times the map's
+    slope).
+
+    Parameters
+    ----------
+    readings : (L,) float array
+        Where the levels read (:func:`level_readings`), in the levels' circular order.
+    levels : (L,) float array
+        The levels' phases, radians.
+    bins : int
+        Table steps over the circle.
+
+    Returns
+    -------
+    (bins,) float32 array
+        The mapped phases, in [-pi, pi).
+
+    Raises
+    ------
+    ValueError
+        The readings do not keep the levels' circular order.
+
+    Examples
+    --------
+    >>> levels = stair_level_phase(np.arange(6), 6)
+    >>> table = level_table(level_readings(levels, 2.2), levels)
+    >>> table.shape, table.dtype
+    ((8192,), dtype('float32'))
+    >>> level_table(levels[::-1] + 0.0, levels)
+    Traceback (most recent call last):
+    ...
+    ValueError: the readings do not keep the levels' circular order
+    """
+    readings = np.asarray(readings, dtype=np.float64)
+    levels = np.asarray(levels, dtype=np.float64)
+    order = np.argsort(readings)
+    x, y = readings[order], levels[order]
+    y = y[0] + np.r_[0.0, np.cumsum((np.diff(y)) % TWO_PI)]
+    if not math.isclose(y[-1] - y[0] + (levels[order[0]] - levels[order[-1]]) % TWO_PI,
+                        TWO_PI, abs_tol=1e-6):
+        raise ValueError("the readings do not keep the levels' circular order")
+    x = np.r_[x - TWO_PI, x, x + TWO_PI]
+    y = np.r_[y - TWO_PI, y, y + TWO_PI]
+    grid = -np.pi + (np.arange(bins) + 0.5) * (TWO_PI / bins)
+    return wrap(np.interp(grid, x, y)).astype(np.float32)
+
+
+def relinearize(theta: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """NumPy reference of :func:`~bistair.core.stair_jit.relinearize32`, which a decode runs:
+    stair phases through a :func:`level_table` (float32 arithmetic, as the kernel's).
+
+    Parameters
+    ----------
+    theta : ndarray
+        Stair phases in radians in [-pi, pi], any shape.
+    table : (bins,) float32 array
+        From :func:`level_table`.
+
+    Returns
+    -------
+    float32 ndarray
+        The mapped phases, ``theta``'s shape.
+
+    Examples
+    --------
+    >>> levels = stair_level_phase(np.arange(6), 6)
+    >>> readings = level_readings(levels, 2.2)
+    >>> mapped = relinearize(readings.astype(np.float32), level_table(readings, levels))
+    >>> bool(np.allclose(mapped, levels, atol=1e-3))
+    True
+    """
+    step = np.float32(table.size / TWO_PI)
+    index = ((np.asarray(theta, dtype=np.float32) + np.float32(np.pi)) * step).astype(np.int64)
+    return table[np.clip(index, 0, table.size - 1)]

@@ -2,8 +2,10 @@
 share: the stair pair's phase and modulation in one pass, and its quantisation to levels.
 
 :func:`bistair.core.stair.stair_phase` and :func:`bistair.core.stair.quantize` are the
-NumPy references; these give the same (the arctangent correctly rounded, as
-:func:`bistair.core.phase_jit.arctan2_32`).
+NumPy references; these give the same, bit for bit (the arctangent is
+:func:`bistair.core.phase_jit.arctan2_32`'s). A decode reads the pair in the phase stage's
+own pass (:func:`bistair.core.measure_jit.front_end`, the same arithmetic):
+:func:`pair_phase` serves a set measured without it.
 
 Examples
 --------
@@ -19,7 +21,7 @@ import math
 import numpy as np
 
 from .jit import PI32, kernel, kernel_frames
-from .phase_jit import _atan2
+from .phase_jit import _angle, _hypot32
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -49,14 +51,67 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
     """
     h, w = theta.shape
     scale = np.float32(levels / (2.0 * math.pi))
+    cycle = np.float64(levels)
+    out = np.empty((h, w), np.int32)
+    for y in prange(h):
+        t = theta[y]
+        ok = valid[y]
+        o = out[y]
+        for x in range(w):  # the modulo in float64 (exact): the loop vectorises
+            q = np.float64(math.floor((t[x] + PI32) * scale))
+            q = q - cycle * math.floor(q / cycle)
+            o[x] = np.int32(q) if ok[x] else np.int32(-1)
+    return out
+
+
+@kernel(parallel=True)
+def relinearize32(theta: np.ndarray, table: np.ndarray, levels: int, valid: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """The stair phase through a level table (:func:`bistair.core.stair.relinearize`, bit for
+    bit) and its :func:`quantize32` levels, in one pass.
+
+    Parameters
+    ----------
+    theta : (H, W) float32 array
+        Stair phase in radians.
+    table : (bins,) float32 array
+        From :func:`bistair.core.stair.level_table`.
+    levels : int
+        Number of steps of the stair the levels are read for.
+    valid : (H, W) bool array
+        Pixels to quantise.
+
+    Returns
+    -------
+    mapped : (H, W) float32 array
+        The phase through the table.
+    level : (H, W) int32 array
+        Its level, -1 where not valid.
+
+    Examples
+    --------
+    >>> table = np.float32([-3.0, -1.0, 1.0, 3.0])  # four steps of the circle
+    >>> mapped, level = relinearize32(np.float32([[-3.1, 0.1, 2.0]]), table, 4,
+    ...                               np.array([[True, True, False]]))
+    >>> mapped.tolist(), level.tolist()
+    ([[-3.0, 1.0, 3.0]], [[0, 2, -1]])
+    """
+    h, w = theta.shape
+    n = table.size
+    step = np.float32(n / (2.0 * math.pi))
+    scale = np.float32(levels / (2.0 * math.pi))
+    mapped = np.empty((h, w), np.float32)
     out = np.empty((h, w), np.int32)
     for y in prange(h):
         for x in range(w):
+            i = int((theta[y, x] + PI32) * step)
+            m = table[min(max(i, 0), n - 1)]
+            mapped[y, x] = m
             if valid[y, x]:
-                out[y, x] = np.int32(math.floor((theta[y, x] + PI32) * scale)) % levels
+                out[y, x] = np.int32(math.floor((m + PI32) * scale)) % levels
             else:
                 out[y, x] = -1
-    return out
+    return mapped, out
 
 
 @kernel(parallel=True)
@@ -70,10 +125,8 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
         for x in range(w):
             a = np.float32(raw[first, y, x]) * s32 - avg[y, x]
             b = np.float32(raw[first + 1, y, x]) * s32 - avg[y, x]
-            theta[y, x] = _atan2(b, a)
-            da = np.float64(a)
-            db = np.float64(b)
-            mod[y, x] = np.float32(math.sqrt(da * da + db * db))
+            theta[y, x] = _angle(b, a)
+            mod[y, x] = _hypot32(a, b)
     return theta, mod
 
 
@@ -98,7 +151,8 @@ def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     Returns
     -------
     theta : (H, W) float32 array
-        The stair phase in radians, ``arctan2(sin - A, cos - A)`` (as :func:`arctan2_32`).
+        The stair phase in radians, ``arctan2(sin - A, cos - A)`` (as
+        :func:`~bistair.core.phase_jit.arctan2_32`), in ``[-pi, pi]``.
     modulation : (H, W) float32 array
         The length of that vector.
 

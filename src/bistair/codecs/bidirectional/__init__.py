@@ -47,15 +47,14 @@ import numpy as np
 from ...core.captures import Prepared
 from ...core.checks import refuse, stair_misfit, wrap_steps
 from ...core.measure import FringeSet
-from ...core.phase import wrap
 from ...core.regions import core_weight, fringe_direction, fringe_regions
 from ...core.resolve import orders_from_regions
-from ...core.stair import half_gaps, stair_level_phase, stair_pair
+from ...core.stair import stair_level_phase, stair_pair
 from ...core.stair_jit import pair_phase, quantize32
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
-from .bands import nearest_level, row_runs, union_levels
+from .bands import row_runs, union_levels
 from .evidence import (
     BandLayout,
     band_splits,
@@ -72,6 +71,13 @@ from .profiles import (
     row_profiles,
     stair_row_profiles,
     stair_values,
+)
+from .response import (
+    LEVEL_DOUBT,
+    UNREADABLE,
+    doubtful_regions,
+    level_offsets,
+    linear_stair,
 )
 from .stairs import stair_edges, stair_fit
 from .stairs_jit import stair_agreement, stair_noise
@@ -221,7 +227,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the stair phases sit ...
     """
-    theta, stair_mod = pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg)
+    theta, stair_mod = fs.stair if fs.stair is not None else pair_phase(
+        prepared.raw, spec.steps, prepared.scale, fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
     if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
         refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
@@ -233,7 +240,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
                   strategy: Literal["region", "paper"] = "region") -> Orders:
     """Stage 3: one fringe order per pixel by the ``region`` (default) or ``paper`` strategy.
 
-    The orders are then checked against the stair phase (:func:`stair_fit`).
+    The region strategy reads the stair levels where this capture's response puts them
+    (:func:`~.response.linear_stair`). The orders are then checked against the stair phase
+    (:func:`stair_fit`).
 
     Parameters
     ----------
@@ -252,13 +261,19 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     Orders
         (H, W) int32 fringe order per pixel (-1 where invalid) and ``info``: the strategy,
         the camera noise, the well-modulated pixels, the phase jumps across which the
-        orders do not step by one, ``stair_misfit`` and any ``warnings``.
+        orders do not step by one, ``stair_misfit``, for the region strategy how far the
+        band rows read from their levels (``level_offset``, ``worst_level_offset``), the
+        levels too far to decide a region (``doubtful_levels``) and the response exponent
+        the levels were read through (``stair_response``, :mod:`.response`), and any
+        ``warnings``.
 
     Raises
     ------
     BistairError
-        ``strategy`` is neither ``"region"`` nor ``"paper"``, or over 10% of the decoded
-        pixels' stair phases contradict their orders (the spec does not fit).
+        ``strategy`` is neither ``"region"`` nor ``"paper"``, over 10% of the decoded
+        pixels' stair phases contradict their orders (the spec does not fit), or the band
+        rows read as far from the levels as at random (``level_offset`` at least
+        ``UNREADABLE``).
 
     Examples
     --------
@@ -282,8 +297,9 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
     """
     if strategy not in ("region", "paper"):
         raise BistairError(f"unknown strategy {strategy!r} (use 'region' or 'paper')")
-    theta, ks = code.maps["stair_phase"], code.code
+    theta, ks, stair_mod = code.maps["stair_phase"], code.code, code.maps["stair_modulation"]
     info = {"strategy": strategy, "noise": fs.noise, "valid_modulation": int(fs.valid.sum())}
+    readings = None
     if strategy == "paper":
         order = paper_orders(ks, theta, fs, spec).astype(np.int32)
         # the published decoder as published: its orders are judged by the same limit as
@@ -293,9 +309,13 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
         if links and bad > 0.005 * links:
             info["warnings"] = [f"the paper decoder's orders do not step by one across "
                                 f"{100 * bad / links:.1f}% of the phase jumps"]
-    else:
-        order = _region_orders(fs, theta, code.maps["stair_modulation"], ks, spec, info)
-    misfit = stair_fit(fs, theta, code.maps["stair_modulation"], order, spec)
+    else:  # read the levels where this capture's response puts them
+        lin = linear_stair(fs, theta, stair_mod, ks, spec)
+        if lin.readings is not None:
+            info["stair_response"] = round(lin.exponent, 2)
+        order = _region_orders(fs, lin.theta, stair_mod, lin.ks, spec, info)
+        readings = lin.readings
+    misfit = stair_fit(fs, theta, stair_mod, order, spec, readings=readings)
     info["stair_misfit"] = round(misfit, 4)
     band = info.get("group_height", spec.group_rows) * (1 - spec.local_rows / spec.group_rows)
     if band < MIN_BAND_PX:
@@ -303,11 +323,24 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: BidirectionalSpec, *,
             f"the partition bands are {band:.1f} camera pixels tall: at this resolution blur "
             "mixes them with the local bands and some regions can read a wrong partition "
             "(more group_rows, a longer period or a closer camera give thicker bands)")]
-    if info.get("level_offset", 0.0) > OFFSET_WARNING:
+    if "stair_response" in info:
         info["warnings"] = [*info.get("warnings", []), (
-            f"the band rows read {100 * info['level_offset']:.0f}% of the way to the next "
-            "stair level (median): is the projector's gamma compensated (spec field gamma, "
-            "'bistair gamma')? With many levels whole partitions can read wrong")]
+            f"the stair levels read where a projector response of exponent "
+            f"{info['stair_response']:g} puts them and were read there: is the projector's "
+            "gamma compensated (spec field gamma, 'bistair gamma')? It also ripples the "
+            "fringes' phase")]
+    if "doubtful_levels" in info:
+        info["warnings"] = [*info.get("warnings", []), (
+            f"{info['doubtful_levels']} of the {len(union_levels(spec.partitions, spec.stairs))} "
+            f"stair levels read at least {100 * LEVEL_DOUBT:.0f}% of the way to halfway to the "
+            "next (median of their band rows): the regions that read one take their orders "
+            "from their neighbours or stay undecided")]
+    if info.get("level_offset", 0.0) >= UNREADABLE:
+        refuse(f"the band rows read {100 * info['level_offset']:.0f}% of the way to halfway "
+               "between two stair levels (median; 50% at random): the levels cannot be told "
+               f"apart (too much noise or blur for {spec.partitions} x {spec.stairs} levels, "
+               "or a projector response the decoder cannot undo: compensate its gamma, spec "
+               "field gamma, 'bistair gamma')")
     if misfit > 0.1:
         refuse(
             f"at {100 * misfit:.0f}% of the decoded pixels "
@@ -349,11 +382,17 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
                               sign=direction)[0]
 
     levels = union_levels(spec.partitions, spec.stairs)
+    doubt = np.zeros(levels.size, bool)  # the levels whose rows read too far from them
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         prof = profiles(labels)
         if "level_offset" not in info:  # how far the band rows read from the levels
-            info["level_offset"] = round(level_offset(prof, levels), 3)
+            offset, per_level = level_offsets(prof, levels)
+            info.update(level_offset=round(offset, 3),
+                        worst_level_offset=round(float(per_level.max()), 3))
+            doubt[:] = per_level >= LEVEL_DOUBT
+            if doubt.any():
+                info["doubtful_levels"] = int(doubt.sum())
         runs = row_runs(prof, levels)
         heights = group_heights(runs, n, profile_centroids(prof, n))
         splits = edge_rows(runs, band_splits(runs, heights, spec.local_rows / spec.group_rows))
@@ -367,8 +406,10 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
                             default)
         info.update(region_splits=info.get("region_splits", 0) + len(splits),
                     group_height=default)
-        evidence = region_evidence(runs, n, heights, layout)
-        return labels, n, thin_band_doubt(evidence, default, spec)
+        evidence = thin_band_doubt(region_evidence(runs, n, heights, layout), default, spec)
+        if doubt.any():  # regions that read a level too far from its place: faint
+            evidence[doubtful_regions(runs, n, doubt)] *= THIN_DOUBT
+        return labels, n, evidence
 
     def agrees(k: np.ndarray) -> np.ndarray:
         """A pixel reads its order's local or partition level (its row decides which)."""
@@ -428,51 +469,6 @@ def thin_band_doubt(evidence: np.ndarray, group_height: float,
     return out
 
 
-def level_offset(prof: RowProfiles, levels: np.ndarray) -> float:
-    """How far the band rows of the regions read from the nearest stair level: the weighted
-    median distance, as a share of half the gap to the next level (0 on the levels, 1
-    halfway between two). The rows of band cores only (stair-pair modulation at least 0.7
-    of the fringes'). A compensated projector reads about 0.1-0.2 (noise, blur at the
-    band edges); an uncompensated gamma of 2.2 about 0.5-0.6, where a distortion that
-    varies along the stair can put a level nearer its neighbour.
-
-    Parameters
-    ----------
-    prof : RowProfiles
-        The regions' row profiles.
-    levels : numpy.ndarray
-        (levels,) nominal level phases (:func:`~.bands.union_levels`).
-
-    Returns
-    -------
-    float
-        The median share (0.0 with no band row).
-
-    Examples
-    --------
-    >>> from bistair.codecs.bidirectional.profiles import RowProfiles
-    >>> levels = union_levels(4, 4)
-    >>> theta = levels[[0, 1, 2, 3]] + np.array([0.0, 0.1, -0.1, 0.2])
-    >>> one = np.ones(4)
-    >>> prof = RowProfiles(one, one, np.cos(theta), np.sin(theta), one, one, one, one)
-    >>> round(level_offset(prof, levels), 3)
-    0.127
-    """
-    theta = np.arctan2(prof.sin, prof.cos)
-    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
-    if theta.size == 0 or not weight.sum() > 0:
-        return 0.0
-    # the nearest level's index as argmin gives it, compiled: NumPy's argmin and min over
-    # a (rows, levels) array take milliseconds along so short an axis
-    nearest = nearest_level(theta, levels)
-    near = np.abs(wrap(theta - levels[nearest]))
-    share = near / half_gaps(levels)[nearest]
-    order = np.argsort(share)
-    cum = np.cumsum(weight[order])
-    return float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
-
-
-OFFSET_WARNING = 0.4  # level_offset above which the decode warns of an uncompensated gamma
 MIN_BAND_PX = 4.0  # partition bands thinner than this (camera pixels) are read with doubt
 THIN_DOUBT = 0.4  # below the resolve stage's min_score: faint
 

@@ -25,7 +25,8 @@ if TYPE_CHECKING:
 
 
 def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np.ndarray,
-              spec: BidirectionalSpec, samples: int = 20000) -> float:
+              spec: BidirectionalSpec, samples: int = 20000,
+              readings: np.ndarray | None = None) -> float:
     """Share of decoded pixels whose stair phase contradicts their fringe order.
 
     A pixel of order ``k`` shows the local level ``k % S`` or the partition level ``k // S``
@@ -49,6 +50,10 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
         The spec of one coded axis.
     samples : int, default 20000
         About how many decoded pixels to judge.
+    readings : numpy.ndarray, optional
+        (L,) where the union levels read in ``theta`` when a response moves them
+        (:func:`~bistair.core.stair.level_readings`): each level's observed phase is then
+        taken around its reading, not its nominal phase.
 
     Returns
     -------
@@ -82,7 +87,7 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
     if th.size < 500:
         return 0.0
     levels = union_levels(spec.partitions, spec.stairs)
-    seen = observed_levels(th, np.ones(th.size), levels)
+    seen = observed_levels(th, np.ones(th.size), levels if readings is None else readings)
     near = np.abs(wrap(th - seen[nearest_level(th, seen)]))  # the least distance to a level
     local = nearest_level(stair_level_phase(np.arange(spec.stairs), spec.stairs), levels)
     part = nearest_level(stair_level_phase(np.arange(spec.partitions), spec.partitions), levels)
