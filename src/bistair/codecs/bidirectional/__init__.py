@@ -390,7 +390,7 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
     def regions() -> np.ndarray:
         """Fringe regions, cut where the stair code says two surfaces meet."""
         edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
-        if not compiled:
+        if not (compiled and GATHER):
             return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise,
                                   boundaries=edges, sign=direction)[0]
         # the final numbering writes the labels and sums the stair values per (region,
@@ -490,6 +490,10 @@ def thin_band_doubt(evidence: np.ndarray, group_height: float,
     return out
 
 
+# the first evidence reads the (region, row) stair sums gathered in the labelling's final
+# scan (:func:`.profiles.relabel_stair_profiles`), not in a scan of their own (the same
+# sums; False: as bistair did before, for the tests' comparison)
+GATHER = True
 MIN_BAND_PX = 4.0  # partition bands thinner than this (camera pixels) are read with doubt
 THIN_DOUBT = 0.4  # below the resolve stage's min_score: faint
 
