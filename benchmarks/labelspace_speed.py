@@ -9,8 +9,10 @@ final numbering, the four maps). Then, in interleaved rounds: the final numberin
 (region, row) stair sums as the decode at the branch point ran them (``relabel``, then
 ``label_stair_sums``, a scan of its own) and as it runs them now (``relabel_stair_sums``,
 gathered in the numbering's scan), each on a fresh copy of the provisional labels (the
-copy timed alone too). One kernel thread and process CPU time by default, or ``--wall``
-on every core; the minimum over the rounds, in ms and ns a pixel.
+copy timed alone too); the band runs' transitions dropped by the NumPy of the branch point
+(``tests/support/labelspace_before.py``) and by the compiled pass, on a copy of the runs
+the decode's first band analysis cut. One kernel thread and process CPU time by default,
+or ``--wall`` on every core; the minimum over the rounds, in ms and ns a pixel.
 
     python benchmarks/labelspace_speed.py [--size 1.3|12] [--rounds 8] [--wall] [--decode]
 
@@ -21,6 +23,7 @@ each checkout on ``PYTHONPATH`` for a before / after pair.
 from __future__ import annotations
 
 import argparse
+import sys
 import time
 from pathlib import Path
 
@@ -28,6 +31,8 @@ import cv2
 import numpy as np
 
 import bistair
+from bistair.codecs.bidirectional import bands
+from bistair.codecs.bidirectional.bands import Runs
 from bistair.core.jit import set_threads
 from bistair.core.memory import keep_freed_memory
 from bistair.evaluation.speed import CASES, opencv_floor, speed_captures
@@ -57,35 +62,50 @@ def rounds(jobs: dict, count: int, clock) -> dict[str, float]:
     return best
 
 
-def decode_inputs(frames: np.ndarray, spec) -> tuple:
-    """The arguments of the decode's ``relabel_stair_profiles`` (the labels copied)."""
+def decode_inputs(frames: np.ndarray, spec) -> tuple[tuple, Runs]:
+    """The arguments of the decode's ``relabel_stair_profiles`` (the labels copied) and the
+    runs its first band analysis hands ``bands._drop_transitions``."""
     from bistair.codecs import bidirectional
 
     seen: list[tuple] = []
-    gathered = bidirectional.relabel_stair_profiles
+    runs: list[Runs] = []
+    gathered, drop = bidirectional.relabel_stair_profiles, bands._drop_transitions
 
     def watch(labels, *args):
         if not seen:
             seen.append((labels.copy(), *args))
         return gathered(labels, *args)
 
-    bidirectional.relabel_stair_profiles = watch
+    def watch_runs(r: Runs) -> Runs:
+        if not runs:
+            runs.append(copied(r))
+        return drop(r)
+
+    bidirectional.relabel_stair_profiles, bands._drop_transitions = watch, watch_runs
     try:
         bistair.decode(frames, spec)
     finally:
-        bidirectional.relabel_stair_profiles = gathered
-    return seen[0]
+        bidirectional.relabel_stair_profiles, bands._drop_transitions = gathered, drop
+    return seen[0], runs[0]
+
+
+def copied(runs: Runs) -> Runs:
+    return Runs(**{k: np.array(v, copy=True) for k, v in runs.__dict__.items()})
 
 
 def cases(frames: np.ndarray, spec) -> dict:
     from bistair.codecs.bidirectional.profiles_jit import label_stair_sums, relabel_stair_sums
     from bistair.core.regions_jit import relabel
 
-    labels, roots, remap, phi, theta, stair_mod, mod, n = decode_inputs(frames, spec)
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from support.labelspace_before import drop_transitions  # the oracle, in tests/support
+
+    (labels, roots, remap, phi, theta, stair_mod, mod, n), runs = decode_inputs(frames, spec)
     final = labels.copy()
     relabel(final, roots, remap)
     h, w = labels.shape
-    print(f"{h}x{w}: {n} regions, {int(labels.max())} provisional labels")
+    print(f"{h}x{w}: {n} regions, {int(labels.max())} provisional labels, "
+          f"{runs.uid.size} band runs")
 
     def old() -> None:
         lab = labels.copy()
@@ -101,6 +121,9 @@ def cases(frames: np.ndarray, spec) -> dict:
         "old both (+ the copy)": old,
         "new relabel_stair_sums (+ copy)": lambda: relabel_stair_sums(
             labels.copy(), roots, remap, phi, theta, stair_mod, mod, n),
+        "copy of the runs": lambda: copied(runs),
+        "old _drop_transitions (+ copy)": lambda: drop_transitions(copied(runs)),
+        "new _drop_transitions (+ copy)": lambda: bands._drop_transitions(copied(runs)),
     }
 
 

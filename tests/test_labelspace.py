@@ -10,10 +10,12 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from support.labelspace_before import relabel_then_stair_sums
+from support.labelspace_before import drop_transitions, relabel_then_stair_sums
 
 import bistair
 from bistair.codecs import bidirectional
+from bistair.codecs.bidirectional import bands
+from bistair.codecs.bidirectional.bands import Runs
 from bistair.codecs.bidirectional.profiles_jit import relabel_stair_sums
 from bistair.core.jit import set_threads
 
@@ -95,3 +97,58 @@ def test_a_decode_reads_the_gathered_sums_as_it_read_its_own(scene, noise, monke
     assert np.array_equal(new.order, old.order)
     assert np.array_equal(new.phase, old.phase, equal_nan=True)
     assert new.info == old.info
+
+
+def copied(runs: Runs) -> Runs:
+    return Runs(**{k: np.array(v, copy=True) for k, v in runs.__dict__.items()})
+
+
+def assert_same_runs(got: Runs, want: Runs) -> None:
+    for key, value in want.__dict__.items():
+        have = getattr(got, key)
+        assert have.dtype == value.dtype and np.array_equal(have, value), key
+
+
+@PROPERTY
+@given(n=st.integers(0, 40), seed=st.integers(0, 2**16), levels=st.integers(1, 4))
+def test_transitions_are_dropped_as_numpy_dropped_them(n, seed, levels):
+    """Runs of few levels (neighbours alike or not), short and fractional lengths, phases
+    across the wrap, ragged ends and bounded runs, the first and last runs among them."""
+    rng = np.random.default_rng(seed)
+    theta = rng.choice([-np.pi, -3.0, -1.0, 0.0, 0.5, 3.0, np.pi - 1e-12], n)
+    theta = np.where(rng.random(n) < 0.5, rng.uniform(-np.pi, np.pi, n), theta)
+    runs = Runs(region=np.sort(rng.integers(1, 4, n)), y0=np.arange(n), y1=np.arange(n) + 1,
+                length=rng.choice([0.5, 1.0, 2.0, 2.5, 3.0, 7.0, 10.0, 25.0], n)
+                * rng.choice([1.0, 1.0 + 1e-9], n),
+                theta=theta, weight=rng.random(n),
+                uid=rng.integers(0, levels, n).astype(np.int32),
+                top_ok=rng.random(n) < 0.8, bottom_ok=rng.random(n) < 0.8,
+                misfit=rng.random(n))
+    runs.top_ok[:1] = False  # (as row_runs makes them: no run above the first)
+    runs.bottom_ok[-1:] = False
+    assert_same_runs(bands._drop_transitions(copied(runs)), drop_transitions(copied(runs)))
+
+
+@pytest.mark.parametrize(("scene", "noise"), RENDERS[:3], ids=[f"{s}-{n}" for s, n in
+                                                                RENDERS[:3]])
+def test_transitions_of_decoded_renders(scene, noise, monkeypatch):
+    """The runs each band analysis of a decode cuts, dropped as before, and the decode
+    itself the same with the NumPy passes."""
+    from test_regions_jit import render
+
+    images, spec = render(scene, "bidirectional", noise)
+    seen = []
+    compiled = bands._drop_transitions
+
+    def watch(runs):
+        seen.append(copied(runs))
+        return compiled(runs)
+
+    monkeypatch.setattr(bands, "_drop_transitions", watch)
+    new = bistair.decode(images, spec, force=True)
+    assert seen and sum(r.uid.size for r in seen) > 200
+    for runs in seen:
+        assert_same_runs(compiled(copied(runs)), drop_transitions(copied(runs)))
+    monkeypatch.setattr(bands, "_drop_transitions", drop_transitions)
+    old = bistair.decode(images, spec, force=True)
+    assert np.array_equal(new.order, old.order) and new.info == old.info

@@ -555,7 +555,8 @@ def relabel_stair_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
     """
     h = labels.shape[0]
     bands = row_bands(h)
-    starts, entries, counts, sums = [np.zeros(1, np.int64)], [], [], []
+    starts, entries = [np.zeros(1, np.int64)], [np.zeros(0, np.int32)]
+    counts, sums = [np.zeros(0, np.int64)], [np.zeros((5, 0))]
     offset = 0
     for y0 in bands:
         rows = slice(y0, y0 + bands.step)
