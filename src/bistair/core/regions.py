@@ -370,15 +370,45 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     (3, [1, 1, 2, 2, 3])
     """
     lab = label_fringes(phi, valid, cut, phase_noise, boundaries, sign)
-    n = lab.n
-    remap = np.arange(n + 1, dtype=np.int32)
-    if min_size > 1:  # (every region has a pixel)
-        kept = lab.size >= min_size
-        kept[0] = False
-        remap = np.where(kept, np.cumsum(kept), 0).astype(np.int32)
-        n = int(kept.sum())
+    remap, n = kept_regions(lab, min_size)
     relabel(lab.labels, lab.roots, remap)
     return lab.labels, n
+
+
+def kept_regions(lab: Labelling, min_size: int = MIN_REGION) -> tuple[np.ndarray, int]:
+    """The final number of each region of :func:`label_fringes`: regions of at least
+    ``min_size`` pixels numbered ``1..n`` in their order, the others 0 (what
+    :func:`fringe_regions` writes through :func:`~bistair.core.regions_jit.relabel`).
+
+    Parameters
+    ----------
+    lab : Labelling
+        From :func:`label_fringes`.
+    min_size : int
+        Smallest region kept, in pixels.
+
+    Returns
+    -------
+    remap : (lab.n + 1,) int32 array
+        The final number of each region (0: dropped).
+    n : int
+        Regions kept.
+
+    Examples
+    --------
+    >>> x = np.arange(50.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (4, 1)).astype(np.float32)
+    >>> lab = label_fringes(phi, np.ones(phi.shape, bool))
+    >>> lab.size.tolist(), [a.tolist() if hasattr(a, "tolist") else a
+    ...                     for a in kept_regions(lab, 100)]
+    ([0, 120, 80], [[0, 1, 0], 1])
+    """
+    n = lab.n
+    if min_size <= 1:  # (every region has a pixel)
+        return np.arange(n + 1, dtype=np.int32), n
+    kept = lab.size >= min_size
+    kept[0] = False
+    return np.where(kept, np.cumsum(kept), 0).astype(np.int32), int(kept.sum())
 
 
 def core_weight(phi: np.ndarray) -> np.ndarray:

@@ -777,9 +777,9 @@ def relabel(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray) -> None:
     """The final labels in place: ``remap[roots[labels]]`` (``remap``: the number each
     region keeps, 0 for one dropped), row by row on every core.
 
-    **The hook for sums per (region, row)** (bidirectional's stair sums,
-    :func:`bistair.codecs.bidirectional.profiles_jit.label_stair_sums`, which reads the
-    final labels in another full scan today): this is the last pass over the labels, and
+    **The hook for sums per (region, row)** (bidirectional's stair sums are gathered
+    there: :func:`bistair.codecs.bidirectional.profiles_jit.relabel_sums`, which writes
+    the final labels as this does, tile by tile): this is the last pass over the labels, and
     it visits each row's pixels in raster order with their final label. A kernel that
     wants per-(label, row) sums of other per-pixel values runs its own loop over tiles of
     rows, calls :func:`_relabel_rows` for the tile, then adds its values pixel by pixel

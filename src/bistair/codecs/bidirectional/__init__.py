@@ -47,7 +47,13 @@ import numpy as np
 from ...core.captures import Prepared
 from ...core.checks import refuse, stair_misfit, wrap_steps
 from ...core.measure import FringeSet
-from ...core.regions import core_weight, fringe_direction, fringe_regions
+from ...core.regions import (
+    core_weight,
+    fringe_direction,
+    fringe_regions,
+    kept_regions,
+    label_fringes,
+)
 from ...core.resolve import orders_from_regions
 from ...core.stair import stair_level_phase, stair_pair
 from ...core.stair_jit import pair_phase, quantize32
@@ -68,6 +74,7 @@ from .paper import paper_orders
 from .profiles import (
     RowProfiles,
     profile_centroids,
+    relabel_stair_profiles,
     row_profiles,
     stair_row_profiles,
     stair_values,
@@ -355,8 +362,13 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
     # stair phase noise: the pair's two frames against the fringes' average
     noise_scale = fs.noise * np.sqrt(2.0)
     maps = (fs.phi, theta, stair_mod, fs.mod)
-    if np.ndim(noise_scale) == 0 and all(m.dtype == np.float32 for m in maps):
+    compiled = np.ndim(noise_scale) == 0 and all(m.dtype == np.float32 for m in maps)
+    gathered: list[tuple[np.ndarray, RowProfiles]] = []  # the labelling's own sums, once
+    if compiled:
         def profiles(labels: np.ndarray) -> RowProfiles:  # values summed, never stored
+            if gathered and gathered[0][0] is labels:
+                return gathered.pop()[1]
+            gathered.clear()
             return stair_row_profiles(labels, fs.phi, theta, stair_mod, fs.mod)
 
         def stair_noise_map() -> np.ndarray:
@@ -378,8 +390,17 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
     def regions() -> np.ndarray:
         """Fringe regions, cut where the stair code says two surfaces meet."""
         edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
-        return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise, boundaries=edges,
-                              sign=direction)[0]
+        if not (compiled and GATHER):
+            return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise,
+                                  boundaries=edges, sign=direction)[0]
+        # the final numbering writes the labels and sums the stair values per (region,
+        # row) in one scan: the first evidence reads those sums
+        lab = label_fringes(fs.phi, fs.valid, phase_noise=phase_noise, boundaries=edges,
+                            sign=direction)
+        remap, n = kept_regions(lab)
+        gathered.append((lab.labels, relabel_stair_profiles(
+            lab.labels, lab.roots, remap, fs.phi, theta, stair_mod, fs.mod, n)))
+        return lab.labels
 
     levels = union_levels(spec.partitions, spec.stairs)
     doubt = np.zeros(levels.size, bool)  # the levels whose rows read too far from them
@@ -469,6 +490,10 @@ def thin_band_doubt(evidence: np.ndarray, group_height: float,
     return out
 
 
+# the first evidence reads the (region, row) stair sums gathered in the labelling's final
+# scan (:func:`.profiles.relabel_stair_profiles`), not in a scan of their own (the same
+# sums; False: as bistair did before, for the tests' comparison)
+GATHER = True
 MIN_BAND_PX = 4.0  # partition bands thinner than this (camera pixels) are read with doubt
 THIN_DOUBT = 0.4  # below the resolve stage's min_score: faint
 

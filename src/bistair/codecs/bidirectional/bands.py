@@ -19,7 +19,7 @@ import numpy as np
 
 from ...core.phase import TWO_PI, wrap
 from ...core.stair import half_gaps, stair_level_phase
-from .bands_jit import band_reads, band_runs, band_sums, nearest_levels
+from .bands_jit import band_reads, band_runs, band_sums, nearest_levels, transitions
 from .profiles import RowProfiles
 
 
@@ -225,31 +225,12 @@ def _drop_transitions(runs: Runs) -> Runs:
     1-2 row run is its ragged edge, and the band next to it is then cut by the edge, not
     bounded by another band.
     """
-    n = runs.uid.size
-    if n < 2:
+    if runs.uid.size < 2:
         return runs
-    prev_uid = np.r_[-1, runs.uid[:-1]]
-    next_uid = np.r_[runs.uid[1:], -1]
-    prev_len = np.r_[0.0, runs.length[:-1]]
-    next_len = np.r_[runs.length[1:], 0.0]
-    to_here = wrap(runs.theta - np.r_[runs.theta[:1], runs.theta[:-1]])
-    to_next = wrap(np.r_[runs.theta[1:], runs.theta[-1:]] - np.r_[runs.theta[:1],
-                                                                 runs.theta[:-1]])
-    between = (to_here * to_next > 0) & (np.abs(to_here) < np.abs(to_next))
-    short = (runs.length <= 2.0) | (between & (runs.length <= 0.4 * np.minimum(prev_len,
-                                                                                next_len)))
-    inner = short & runs.top_ok & runs.bottom_ok & (prev_uid != next_uid)
-    short = runs.length <= 2.0
-    top_end = short & ~runs.top_ok & runs.bottom_ok
-    bottom_end = short & runs.top_ok & ~runs.bottom_ok
-    drop = inner | top_end | bottom_end
-    if not drop.any():
+    # compiled (bands_jit.transitions): the NumPy it replaced is tests/support's oracle
+    drop, length, top_ok, bottom_ok, some = transitions(runs.uid, runs.length, runs.theta,
+                                                        runs.top_ok, runs.bottom_ok)
+    if not some:
         return runs
-    length = runs.length.copy()
-    j = np.flatnonzero(inner)
-    np.add.at(length, j - 1, runs.length[j] / 2)
-    np.add.at(length, j + 1, runs.length[j] / 2)
-    runs.length = length
-    runs.top_ok = runs.top_ok & ~np.r_[False, top_end[:-1]]
-    runs.bottom_ok = runs.bottom_ok & ~np.r_[bottom_end[1:], False]
+    runs.length, runs.top_ok, runs.bottom_ok = length, top_ok, bottom_ok
     return runs.take(~drop)

@@ -433,3 +433,97 @@ def _group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
             r = b - diff * (1.0 - t)
         out[g] = r
     return out
+
+
+@_numba_inline
+def _wrapped(x: float) -> float:
+    """``(x + pi) % 2pi - pi`` in float64, as NumPy computes it (:func:`_wrapped_abs`)."""
+    a = x + math.pi
+    if 0.0 <= a < TWO_PI:
+        m = a
+    elif TWO_PI <= a < 2.0 * TWO_PI:
+        m = a - TWO_PI
+    elif -TWO_PI < a < 0.0:
+        m = a + TWO_PI
+    else:
+        m = a % TWO_PI
+    return m - math.pi
+
+
+@kernel()
+def transitions(uid: np.ndarray, length: np.ndarray, theta: np.ndarray, top_ok: np.ndarray,
+                bottom_ok: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool]:
+    """The runs of :func:`bistair.codecs.bidirectional.bands.row_runs` that are not bands
+    (:func:`bistair.codecs.bidirectional.bands._drop_transitions` says which) and what
+    dropping them leaves: ``(drop, length, top_ok, bottom_ok, any)``, an inner transition's
+    length given half to each neighbour (the one above first, then the one below, as two
+    ``np.add.at`` add them), the band next to a dropped ragged end no longer bounded there.
+    The same float64 values as the NumPy it replaced (``tests/support/labelspace_before.py``).
+
+    Parameters
+    ----------
+    uid : (n,) int32 array
+        Stair level of each run.
+    length, theta : (n,) float64 arrays
+        Rows and circular mean stair phase of each run.
+    top_ok, bottom_ok : (n,) bool arrays
+        Bounded above / below by another run of the same region.
+
+    Returns
+    -------
+    drop : (n,) bool array
+    length : (n,) float64 array
+    top_ok, bottom_ok : (n,) bool arrays
+    any : bool
+        Whether any run is dropped (else the other arrays are the inputs' values).
+
+    Examples
+    --------
+    >>> uid, length = np.int32([1, 2, 3]), np.array([10.0, 2.0, 10.0])
+    >>> ok = np.array([False, True, True]), np.array([True, True, False])
+    >>> drop, length, top, bottom, some = transitions(uid, length, np.array([0.0, 0.5, 1.0]),
+    ...                                               *ok)
+    >>> drop.tolist(), length.tolist(), some
+    ([False, True, False], [11.0, 2.0, 11.0], True)
+    """
+    n = uid.size
+    drop = np.zeros(n, np.bool_)
+    inner = np.zeros(n, np.bool_)
+    top_end = np.zeros(n, np.bool_)
+    bottom_end = np.zeros(n, np.bool_)
+    some = False
+    for i in range(n):
+        prev_uid = uid[i - 1] if i > 0 else -1
+        next_uid = uid[i + 1] if i < n - 1 else -1
+        prev_len = length[i - 1] if i > 0 else 0.0
+        next_len = length[i + 1] if i < n - 1 else 0.0
+        prev_theta = theta[i - 1] if i > 0 else theta[0]
+        next_theta = theta[i + 1] if i < n - 1 else theta[n - 1]
+        to_here = _wrapped(theta[i] - prev_theta)
+        to_next = _wrapped(next_theta - prev_theta)
+        between = to_here * to_next > 0 and abs(to_here) < abs(to_next)
+        short = length[i] <= 2.0
+        inner[i] = ((short or (between and length[i] <= 0.4 * min(prev_len, next_len)))
+                    and top_ok[i] and bottom_ok[i] and prev_uid != next_uid)
+        top_end[i] = short and not top_ok[i] and bottom_ok[i]
+        bottom_end[i] = short and top_ok[i] and not bottom_ok[i]
+        drop[i] = inner[i] or top_end[i] or bottom_end[i]
+        some = some or drop[i]
+    out = length.copy()
+    top = top_ok.copy()
+    bottom = bottom_ok.copy()
+    if not some:
+        return drop, out, top, bottom, False
+    for j in range(n):  # as np.add.at(length, j - 1, ...): index -1 is the last run
+        if inner[j]:
+            out[j - 1 if j > 0 else n - 1] += length[j] / 2
+    for j in range(n):
+        if inner[j]:
+            if j + 1 >= n:
+                raise IndexError("index out of bounds")
+            out[j + 1] += length[j] / 2
+    for i in range(1, n):
+        top[i] = top[i] and not top_end[i - 1]
+        bottom[i - 1] = bottom[i - 1] and not bottom_end[i]
+    return drop, out, top, bottom, True

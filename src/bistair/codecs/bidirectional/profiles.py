@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .profiles_jit import label_row_sums, label_stair_sums
+from .profiles_jit import label_row_sums, label_stair_sums, relabel_stair_sums
 
 
 @dataclass
@@ -140,6 +140,51 @@ def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     return _profiles(labels.shape[0], *label_stair_sums(labels, phi, theta, stair_mod, mod,
                                                         int(labels.max())))
 
+
+
+def relabel_stair_profiles(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
+                           phi: np.ndarray, theta: np.ndarray, stair_mod: np.ndarray,
+                           mod: np.ndarray, n_labels: int) -> RowProfiles:
+    """The final fringe regions written in place (``remap[roots[labels]]``, what
+    :func:`~bistair.core.regions.fringe_regions` writes) and :func:`stair_row_profiles` of
+    them, gathered in the same scan
+    (:func:`~bistair.codecs.bidirectional.profiles_jit.relabel_stair_sums`): the same
+    profiles, bit for bit, without a scan of their own.
+
+    Parameters
+    ----------
+    labels : numpy.ndarray
+        (H, W) int32 provisional labels (:func:`~bistair.core.regions.label_fringes`),
+        changed in place to the final ones.
+    roots, remap : numpy.ndarray
+        The region of each provisional label and the final number of each region
+        (:func:`~bistair.core.regions.kept_regions`).
+    phi, theta, stair_mod, mod : numpy.ndarray
+        (H, W) float32 maps, as :func:`stair_row_profiles`.
+    n_labels : int
+        The number of regions kept.
+
+    Returns
+    -------
+    RowProfiles
+        :func:`stair_row_profiles` of the final labels.
+
+    Examples
+    --------
+    >>> from dataclasses import astuple
+    >>> from bistair.core.regions import kept_regions, label_fringes
+    >>> x = np.arange(60.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (8, 1)).astype(np.float32)
+    >>> theta, ones = 0 * phi + 1, np.ones(phi.shape, np.float32)
+    >>> lab = label_fringes(phi, ones > 0)
+    >>> remap, n = kept_regions(lab)
+    >>> got = relabel_stair_profiles(lab.labels, lab.roots, remap, phi, theta, ones, ones, n)
+    >>> want = stair_row_profiles(lab.labels, phi, theta, ones, ones)
+    >>> n, all(np.array_equal(u, v) for u, v in zip(astuple(got), astuple(want)))
+    (2, True)
+    """
+    return _profiles(labels.shape[0], *relabel_stair_sums(labels, roots, remap, phi, theta,
+                                                          stair_mod, mod, n_labels))
 
 
 def _profiles(h: int, keys: np.ndarray, count: np.ndarray, sums: np.ndarray) -> RowProfiles:

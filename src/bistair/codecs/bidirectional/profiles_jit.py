@@ -25,13 +25,11 @@ import numpy as np
 
 from ...core.jit import _fmax, _fmin, _numba_called, _numba_inline, kernel
 from ...core.memory import row_bands
+from ...core.regions_jit import TILE
 
 prange = range  # numba's prange once the first kernel of this module compiles
 BLOCK = 32  # rows per task of the parallel loops
 TWO_PI = 2.0 * math.pi
-
-
-BLOCK = 32  # rows per task of the parallel loops
 
 
 @_numba_called
@@ -372,3 +370,204 @@ def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
         stair_sums(labels[rows], phi[rows], np.cos(t), np.sin(t), stair_mod[rows], mod[rows],
                    n_labels, start[y0:y0 + bands.step + 1], entry, count, acc)
     return label_major(start, entry, count, acc, n_labels)
+
+
+@_numba_called
+def _relabel_count(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, n_labels: int,
+                   y0: int, y1: int, count: np.ndarray) -> None:
+    """Rows ``y0 .. y1-1``: the final labels ``remap[roots[labels]]`` written in place (as
+    :func:`bistair.core.regions_jit.relabel` writes them, a run of one label looked up
+    once) and each row's distinct final labels (> 0) counted into ``count[y + 1]``."""
+    w = labels.shape[1]
+    stamp = np.zeros(n_labels + 1, np.int32)  # the row (+ 1) a label was last counted in
+    for y in range(y0, y1):
+        row = labels[y]
+        mark = np.int32(y + 1)
+        last = np.int32(0)
+        final = np.int32(0)
+        m = 0
+        for x in range(w):
+            lab = row[x]
+            if lab != last:
+                last = lab
+                final = remap[roots[lab]]
+                if final > 0 and stamp[final] != mark:
+                    stamp[final] = mark
+                    m += 1
+            row[x] = final
+        count[y + 1] = m
+
+
+@_numba_called
+def _stair_run_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
+                    sin_t: np.ndarray, stair_mod: np.ndarray, mod: np.ndarray, n_labels: int,
+                    y0: int, y1: int, start: np.ndarray, entry: np.ndarray,
+                    count: np.ndarray, acc: np.ndarray) -> None:
+    """Rows ``y0 .. y1-1`` (final labels): each row's labels in order of first appearance
+    into ``entry[start[y]:]``, their pixels into ``count`` and the five stair values
+    (:func:`_stair_values`, made for the row in a vector loop) added into ``acc``, pixel by
+    pixel in raster order (a run of one label added in registers: the same float64 sums
+    as one slot added to pixel by pixel)."""
+    w = labels.shape[1]
+    slot = np.empty(n_labels + 1, np.int64)
+    stamp = np.zeros(n_labels + 1, np.int32)
+    vc = np.empty(w, np.float32)
+    vs = np.empty(w, np.float32)
+    vw = np.empty(w, np.float32)
+    vr = np.empty(w, np.float32)
+    for y in range(y0, y1):
+        p, c, s, sm, m = phi[y], cos_t[y], sin_t[y], stair_mod[y], mod[y]
+        for x in range(w):
+            vc[x], vs[x], vw[x], vr[x] = _stair_values(p[x], c[x], s[x], sm[x], m[x])
+        row = labels[y]
+        mark = np.int32(y + 1)
+        nxt = start[y]
+        x = 0
+        while x < w:
+            lab = row[x]
+            if lab == 0:
+                x += 1
+                continue
+            if stamp[lab] != mark:
+                stamp[lab] = mark
+                slot[lab] = nxt
+                entry[nxt] = lab
+                nxt += 1
+            i = slot[lab]
+            a0, a1, a2, a3, a4 = acc[0, i], acc[1, i], acc[2, i], acc[3, i], acc[4, i]
+            k = count[i]
+            while x < w and row[x] == lab:
+                a0 += np.float64(vc[x])
+                a1 += np.float64(vs[x])
+                a2 += np.float64(vw[x])
+                a3 += np.float64(vr[x])
+                a4 += np.float64(np.float32(x))
+                k += 1
+                x += 1
+            acc[0, i], acc[1, i], acc[2, i], acc[3, i], acc[4, i] = a0, a1, a2, a3, a4
+            count[i] = k
+
+
+@kernel(parallel=True)
+def relabel_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, phi: np.ndarray,
+                 cos_t: np.ndarray, sin_t: np.ndarray, stair_mod: np.ndarray,
+                 mod: np.ndarray, n_labels: int
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The final labels of a band of rows written in place
+    (:func:`bistair.core.regions_jit.relabel`, the hook its docstring describes) and, in
+    the same visit of each tile of rows, the five values of
+    :func:`bistair.codecs.bidirectional.profiles.stair_values` summed per (label, row):
+    ``(start (R+1,), entry (K,), count (K,), acc (5, K))``, row ``y``'s labels in order of
+    first appearance at ``entry[start[y]:start[y+1]]`` (as :func:`row_entries` lists
+    them), float64 sums added pixel by pixel in raster order (as :func:`stair_sums`).
+
+    Parameters
+    ----------
+    labels : (R, W) int32 array
+        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        place to the final ones.
+    roots : int32 array
+        The region of each provisional label.
+    remap : (regions+1,) int32 array
+        The final number of each region (0: dropped).
+    phi, cos_t, sin_t, stair_mod, mod : (R, W) float32 arrays
+        Wrapped phase, cosine and sine of the stair phase, modulation of the stair pair
+        and of the fringes.
+    n_labels : int
+        The highest final label.
+
+    Returns
+    -------
+    start : (R+1,) int64 array
+    entry : (K,) int32 array
+    count : (K,) int64 array
+    acc : (5, K) float64 array
+
+    Examples
+    --------
+    >>> one = np.ones((1, 4), np.float32)
+    >>> labels = np.int32([[5, 5, 0, 7]])
+    >>> roots = np.zeros(8, np.int32)
+    >>> roots[5], roots[7] = 1, 2
+    >>> start, entry, count, acc = relabel_sums(labels, roots, np.int32([0, 2, 1]),
+    ...                                         np.pi * one, one, 0 * one, one, one, 2)
+    >>> labels.tolist(), start.tolist(), entry.tolist(), count.tolist(), acc[4].tolist()
+    ([[2, 2, 0, 1]], [0, 2], [2, 1], [2, 1], [1.0, 3.0])
+    """
+    h = labels.shape[0]
+    tiles = (h + TILE - 1) // TILE
+    start = np.zeros(h + 1, np.int64)
+    for t in prange(tiles):
+        _relabel_count(labels, roots, remap, n_labels, t * TILE, min(t * TILE + TILE, h),
+                       start)
+    for y in range(h):
+        start[y + 1] += start[y]
+    k = start[h]
+    entry = np.empty(k, np.int32)
+    count = np.zeros(k, np.int64)
+    acc = np.zeros((5, k), np.float64)
+    for t in prange(tiles):
+        _stair_run_sums(labels, phi, cos_t, sin_t, stair_mod, mod, n_labels, t * TILE,
+                        min(t * TILE + TILE, h), start, entry, count, acc)
+    return start, entry, count, acc
+
+
+def relabel_stair_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
+                       phi: np.ndarray, theta: np.ndarray, stair_mod: np.ndarray,
+                       mod: np.ndarray, n_labels: int
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The final labels written in place (``remap[roots[labels]]``) and
+    :func:`label_stair_sums` of them, gathered as they are written: a band of rows at a
+    time (:func:`relabel_sums`, the cosine and sine of the band's stair phase from NumPy),
+    no scan of the labels of its own. Returns ``(keys, counts, sums (5, K))``, ``keys =
+    label * H + row`` ascending, float64 sums in raster order: what
+    :func:`label_stair_sums` gives on the final labels, bit for bit.
+
+    Parameters
+    ----------
+    labels : (H, W) int32 array
+        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        place to the final ones.
+    roots : int32 array
+        The region of each provisional label.
+    remap : (regions+1,) int32 array
+        The final number of each region (0: dropped).
+    phi, theta, stair_mod, mod : (H, W) float32 arrays
+        Wrapped phase, stair phase and the modulations of the stair pair and the fringes.
+    n_labels : int
+        The highest final label.
+
+    Returns
+    -------
+    keys : (K,) int64 array
+    counts : (K,) int64 array
+    sums : (5, K) float64 array
+
+    Examples
+    --------
+    >>> one = np.ones((2, 3), np.float32)
+    >>> labels = np.int32([[3, 3, 0], [0, 3, 4]])
+    >>> roots = np.int32([0, 0, 0, 1, 2])
+    >>> keys, counts, sums = relabel_stair_sums(labels, roots, np.int32([0, 1, 2]),
+    ...                                         np.pi * one, 0 * one, one, one, 2)
+    >>> labels.tolist(), keys.tolist(), counts.tolist(), sums[4].tolist()
+    ([[1, 1, 0], [0, 1, 2]], [2, 3, 5], [2, 1, 1], [1.0, 1.0, 2.0])
+    """
+    h = labels.shape[0]
+    bands = row_bands(h)
+    starts, entries = [np.zeros(1, np.int64)], [np.zeros(0, np.int32)]
+    counts, sums = [np.zeros(0, np.int64)], [np.zeros((5, 0))]
+    offset = 0
+    for y0 in bands:
+        rows = slice(y0, y0 + bands.step)
+        t = theta[rows]
+        start, entry, count, acc = relabel_sums(labels[rows], roots, remap, phi[rows],
+                                                np.cos(t), np.sin(t), stair_mod[rows],
+                                                mod[rows], n_labels)
+        starts.append(start[1:] + offset)
+        offset += int(start[-1])
+        entries.append(entry)
+        counts.append(count)
+        sums.append(acc)
+    return label_major(np.concatenate(starts), np.concatenate(entries),
+                       np.concatenate(counts), np.concatenate(sums, axis=1), n_labels)

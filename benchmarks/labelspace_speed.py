@@ -1,0 +1,160 @@
+"""Bidirectional's label space, old passes against new, with the OpenCV floor of a 4-step
+decode in the same rounds (issue 32 part C).
+
+The inputs are the decode's own: one default (bidirectional) decode of the speed scene
+(:mod:`bistair.evaluation.speed`, as ``decode_speed.py`` and ``bistair bench`` render it;
+kept in /tmp between runs) is run with
+``relabel_stair_profiles`` watched and its arguments kept (provisional labels, roots, the
+final numbering, the four maps). Then, in interleaved rounds: the final numbering and the
+(region, row) stair sums as the decode at the branch point ran them (``relabel``, then
+``label_stair_sums``, a scan of its own) and as it runs them now (``relabel_stair_sums``,
+gathered in the numbering's scan), each on a fresh copy of the provisional labels (the
+copy timed alone too); the band runs' transitions dropped by the NumPy of the branch point
+(``tests/support/labelspace_before.py``) and by the compiled pass, on a copy of the runs
+the decode's first band analysis cut. One kernel thread and process CPU time by default,
+or ``--wall`` on every core; the minimum over the rounds, in ms and ns a pixel.
+
+    python benchmarks/labelspace_speed.py [--size 1.3|12] [--rounds 8] [--wall] [--decode]
+
+``--decode`` times whole default decodes instead, interleaved with the floor: run it with
+each checkout on ``PYTHONPATH`` for a before / after pair.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+import bistair
+from bistair.codecs.bidirectional import bands
+from bistair.codecs.bidirectional.bands import Runs
+from bistair.core.jit import set_threads
+from bistair.core.memory import keep_freed_memory
+from bistair.evaluation.speed import CASES, opencv_floor, speed_captures
+
+SIZES = {"1.3": (1024, 1280), "12": (3000, 4000)}
+
+
+def scene(size: str) -> tuple[np.ndarray, bistair.spec.BaseSpec]:
+    """The speed scene's captures for the default decoder, kept in /tmp between runs."""
+    spec = CASES[0].spec()
+    path = Path(f"/tmp/bistair_labelspace_speed_{size}.npy")
+    if path.exists():
+        return np.load(path), spec
+    frames = speed_captures(spec, SIZES[size])
+    np.save(path, frames)
+    return frames, spec
+
+
+def rounds(jobs: dict, count: int, clock) -> dict[str, float]:
+    """The least time of each job over ``count`` interleaved rounds."""
+    best = {k: np.inf for k in jobs}
+    for _ in range(count):
+        for key, job in jobs.items():
+            t0 = clock()
+            job()
+            best[key] = min(best[key], clock() - t0)
+    return best
+
+
+def decode_inputs(frames: np.ndarray, spec) -> tuple[tuple, Runs]:
+    """The arguments of the decode's ``relabel_stair_profiles`` (the labels copied) and the
+    runs its first band analysis hands ``bands._drop_transitions``."""
+    from bistair.codecs import bidirectional
+
+    seen: list[tuple] = []
+    runs: list[Runs] = []
+    gathered, drop = bidirectional.relabel_stair_profiles, bands._drop_transitions
+
+    def watch(labels, *args):
+        if not seen:
+            seen.append((labels.copy(), *args))
+        return gathered(labels, *args)
+
+    def watch_runs(r: Runs) -> Runs:
+        if not runs:
+            runs.append(copied(r))
+        return drop(r)
+
+    bidirectional.relabel_stair_profiles, bands._drop_transitions = watch, watch_runs
+    try:
+        bistair.decode(frames, spec)
+    finally:
+        bidirectional.relabel_stair_profiles, bands._drop_transitions = gathered, drop
+    return seen[0], runs[0]
+
+
+def copied(runs: Runs) -> Runs:
+    return Runs(**{k: np.array(v, copy=True) for k, v in runs.__dict__.items()})
+
+
+def cases(frames: np.ndarray, spec) -> dict:
+    from bistair.codecs.bidirectional.profiles_jit import label_stair_sums, relabel_stair_sums
+    from bistair.core.regions_jit import relabel
+
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from support.labelspace_before import drop_transitions  # the oracle, in tests/support
+
+    (labels, roots, remap, phi, theta, stair_mod, mod, n), runs = decode_inputs(frames, spec)
+    final = labels.copy()
+    relabel(final, roots, remap)
+    h, w = labels.shape
+    print(f"{h}x{w}: {n} regions, {int(labels.max())} provisional labels, "
+          f"{runs.uid.size} band runs")
+
+    def old() -> None:
+        lab = labels.copy()
+        relabel(lab, roots, remap)
+        label_stair_sums(lab, phi, theta, stair_mod, mod, n)
+
+    return {
+        "floor": lambda: opencv_floor(frames),
+        "copy of the labels": lambda: labels.copy(),
+        "old relabel (+ the copy)": lambda: relabel(labels.copy(), roots, remap),
+        "old label_stair_sums": lambda: label_stair_sums(final, phi, theta, stair_mod, mod,
+                                                         n),
+        "old both (+ the copy)": old,
+        "new relabel_stair_sums (+ copy)": lambda: relabel_stair_sums(
+            labels.copy(), roots, remap, phi, theta, stair_mod, mod, n),
+        "copy of the runs": lambda: copied(runs),
+        "old _drop_transitions (+ copy)": lambda: drop_transitions(copied(runs)),
+        "new _drop_transitions (+ copy)": lambda: bands._drop_transitions(copied(runs)),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", default="1.3", choices=sorted(SIZES))
+    parser.add_argument("--rounds", type=int, default=8)
+    parser.add_argument("--wall", action="store_true",
+                        help="every core, wall time (else one thread, CPU time)")
+    parser.add_argument("--decode", action="store_true", help="time whole default decodes")
+    args = parser.parse_args()
+    keep_freed_memory()
+    threads = set_threads(None if args.wall else 1)
+    cv2.setNumThreads(threads)
+    clock = time.perf_counter if args.wall else time.process_time
+    frames, spec = scene(args.size)
+    if args.decode:
+        jobs = {"floor": lambda: opencv_floor(frames),
+                "default decode": lambda: bistair.decode(frames, spec)}
+    else:
+        jobs = cases(frames, spec)
+    for job in jobs.values():  # compiled and warm
+        job()
+    best = rounds(jobs, args.rounds, clock)
+    px = frames.shape[1] * frames.shape[2]
+    print(f"bistair {Path(bistair.__file__).parents[1]}, {args.size} MP, {threads} thread(s), "
+          f"{'wall' if args.wall else 'CPU'} time, min of {args.rounds} rounds")
+    for key, t in best.items():
+        print(f"  {key:32s} {1e3 * t:8.2f} ms {1e9 * t / px:7.2f} ns/px "
+              f"{t / best['floor']:7.2f} x floor")
+
+
+if __name__ == "__main__":
+    main()
