@@ -37,7 +37,9 @@ from bistair.core.sample import set_noise, take_sample
 from bistair.core.stair_jit import quantize32
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import decode_speed  # noqa: E402
+from bistair.evaluation.speed import CASES, opencv_floor, speed_captures  # noqa: E402
+
+SIZES = {"1.3": (1024, 1280), "12": (3000, 4000)}
 
 
 def load_before(src: str):
@@ -103,14 +105,14 @@ def main() -> None:
 
 def run(key: str, rounds: int, old) -> None:
     """Time the stages at one size and print the table."""
-    spec = decode_speed.spec_of(decode_speed.CASES[0][1])
-    frames = decode_speed.captures(spec, decode_speed.SIZES[key])
+    spec = CASES[0].spec()
+    frames = speed_captures(spec, SIZES[key])
     _, cols = get_codec(spec.method)._columns(frames, spec)
     fs = measure(cols, 0, spec.steps, pair=spec.steps)
     noise, threshold = fs.noise, fs.threshold
     lowest = max(0.005, 2.0 * noise)
     stages = {
-        "floor (OpenCV 4-step pass)": lambda: decode_speed.opencv_floor(frames),
+        "floor (OpenCV 4-step pass)": lambda: opencv_floor(frames),
         "pass 0: noise (set_noise)": lambda: set_noise(cols, 0, spec.steps),
         "pass 0: the sample (take_sample)": lambda: take_sample(
             cols, 0, spec.steps, spec.steps, lowest, threshold),

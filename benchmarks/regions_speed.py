@@ -31,7 +31,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-import decode_speed  # noqa: E402
+from bistair.evaluation.speed import CASES, opencv_floor, speed_captures  # noqa: E402
+
+SIZES = {"1.3": (1024, 1280), "12": (3000, 4000)}
 
 import bistair  # noqa: E402
 from bistair.core import measure, regions  # noqa: E402
@@ -42,11 +44,11 @@ from bistair.core.memory import keep_freed_memory  # noqa: E402
 
 def scene(size: str) -> tuple[np.ndarray, bistair.spec.BaseSpec]:
     """``decode_speed.py``'s default scene, kept in /tmp between runs."""
-    spec = decode_speed.spec_of(decode_speed.CASES[0][1])
+    spec = CASES[0].spec()
     path = Path(f"/tmp/bistair_regions_speed_{size}.npy")
     if path.exists():
         return np.load(path), spec
-    frames = decode_speed.captures(spec, decode_speed.SIZES[size])
+    frames = speed_captures(spec, SIZES[size])
     np.save(path, frames)
     return frames, spec
 
@@ -105,7 +107,7 @@ def cases(frames: np.ndarray, spec) -> dict:
           f"{n_cc - 1} components, {n_old} regions; coherent labelling: weak "
           f"{weak.mean():.2f}, {c_n} regions")
     return {
-        "floor": lambda: decode_speed.opencv_floor(frames),
+        "floor": lambda: opencv_floor(frames),
         "old period_jump_links": lambda: old.period_jump_links(fphi, fvalid, noise, 3, 0.3),
         "old fringe_links": lambda: old.fringe_links(fphi, fvalid, cut, sign, noise, jv, jh),
         "new link_bits (both)": lambda: new.link_bits(fphi, fvalid, noise, cut, sign, 0.3,
@@ -142,7 +144,7 @@ def rounds(jobs: dict, count: int, clock) -> dict[str, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", default="1.3", choices=sorted(decode_speed.SIZES))
+    parser.add_argument("--size", default="1.3", choices=sorted(SIZES))
     parser.add_argument("--rounds", type=int, default=8)
     parser.add_argument("--wall", action="store_true",
                         help="every core, wall time (else one thread, CPU time)")
@@ -154,7 +156,7 @@ def main() -> None:
     clock = time.perf_counter if args.wall else time.process_time
     frames, spec = scene(args.size)
     if args.decode:
-        jobs = {"floor": lambda: decode_speed.opencv_floor(frames),
+        jobs = {"floor": lambda: opencv_floor(frames),
                 "default decode": lambda: bistair.decode(frames, spec)}
         bistair.decode(frames, spec)
     else:
