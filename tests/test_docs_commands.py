@@ -153,6 +153,7 @@ def test_the_pages_run_in_reading_order():
 def test_commands_print_what_the_docs_show(path, work):
     env = {**os.environ, "BISTAIR_PROGRESS_DELAY": "3600", "COLUMNS": "100",
            "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    mismatches = []  # every output the page shows otherwise, said at the end of the page
     for start, skip, language, lines in blocks(path):
         if skip is not None:
             print(f"{path.name}:{start}: not run ({skip})")
@@ -174,11 +175,11 @@ def test_commands_print_what_the_docs_show(path, work):
             # now, as in a checkout whose numba cache is cold, says so in a line of its own
             printed = [line for line in proc.stdout.splitlines()
                        if line.strip() and line != f"bistair: {COMPILE_NOTICE}"]
-            if expected:
-                assert printed_as_shown([e.strip() for e in expected],
-                                        [g.strip() for g in printed]), \
-                    f"{where}\nshown:\n" + "\n".join(expected) + "\nprinted:\n" + \
-                    "\n".join(printed)
+            if expected and not printed_as_shown([e.strip() for e in expected],
+                                                 [g.strip() for g in printed]):
+                mismatches.append(f"{where}\nshown:\n" + "\n".join(expected) +
+                                  "\nprinted:\n" + "\n".join(printed))
+    assert not mismatches, "\n\n".join(mismatches)
 
 
 def test_the_parser_reads_commands_outputs_and_continuations():
