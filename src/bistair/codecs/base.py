@@ -55,6 +55,7 @@ from ..core.checks import (
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
 from ..core.result import AxesResult, DecodeResult, result_from_orders
+from ..core.sample import Sample
 from ..errors import BistairError
 from ..spec import AXES, BaseSpec, PeriodSpec
 
@@ -317,8 +318,10 @@ class Codec:
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         fs = self.measure_columns(cols, spec, min_modulation)
-        refuse(shift_order_problem(cols, fs.valid, spec))
-        turned = axis_problem(fs.phi, fs.valid, spec.orientation)
+        turned = None
+        if fs.sample is not None:  # (a Gray code alone has no phase to judge)
+            refuse(shift_order_problem(fs.sample, spec))
+            turned = axis_problem(fs.sample, spec.orientation)
         if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
             refuse(turned)
 
@@ -372,25 +375,25 @@ class Codec:
         return result
 
 
-def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
-                        samples: int = 20000) -> str | None:
+def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) -> str | None:
     """A one-line reason to refuse when two frames of an N-step set look swapped
-    (:func:`~bistair.core.checks.swapped_frames`, on a subsample of the valid pixels).
+    (:func:`~bistair.core.checks.swapped_frames`), judged on pass 0's sample: its strong
+    pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
 
     Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
-    or more steps is checked; captures with fewer than 500 valid pixels are not judged.
+    or more steps is checked; with fewer than 500 strong pixels in the sample nothing is
+    said.
 
     Parameters
     ----------
-    cols : Prepared
-        The method's frames in method order, column layout.
-    valid : numpy.ndarray
-        (H, W) bool, the pixels to judge (the stage-1 validity).
+    sample : Sample
+        Pass 0's sample of the captures (``FringeSet.sample``), column layout, its
+        ``values`` the method's frames in method order.
     spec : BaseSpec
         The spec whose ``method_frames`` name the frames and whose ``shift_sign`` gives the
         direction of the shifts.
     samples : int, default 20000
-        About how many valid pixels to use.
+        At most how many strong pixels to use.
 
     Returns
     -------
@@ -401,13 +404,13 @@ def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
     --------
     >>> from bistair.codecs import encode, make_spec
     >>> from bistair.core.captures import prepare
-    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> spec = make_spec("graycode", width=240, height=256, period=30)
     >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
-    >>> shift_order_problem(cols, measure_shifts(cols, spec).valid, spec) is None
+    >>> shift_order_problem(measure_shifts(cols, spec).sample, spec) is None
     True
     >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
     >>> swapped = prepare(images, spec.frame_count, spec.method)
-    >>> shift_order_problem(swapped, measure_shifts(swapped, spec).valid, spec).split(":")[0]
+    >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
     'frames shift-0 and shift-1 look swapped'
     """
     names = spec.method_frames()
@@ -415,15 +418,15 @@ def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
     for i, name in enumerate(names):
         if "shift-" in name:
             sets.setdefault(name.rsplit("shift-", 1)[0], []).append(i)
-    idx = np.flatnonzero(valid)
-    idx = idx[:: max(1, idx.size // samples)]
-    if idx.size < 500:
+    r, c = np.nonzero(sample.strong)
+    if r.size < 500:
         return None
-    r, c = np.unravel_index(idx, valid.shape)
+    step = max(1, -(-r.size // samples))
+    r, c = r[::step], c[::step]
     for members in sets.values():
         if len(members) < 4:
             continue
-        values = np.stack([np.asarray(cols.frames.raw[m][r, c], np.float64) for m in members])
+        values = sample.values[members][:, r, c].astype(np.float64)
         pair = swapped_frames(values, spec.shift_sign)
         if pair is not None:
             a, b = (names[members[i]] for i in pair)
