@@ -201,17 +201,17 @@ def speed(size: str, count: int) -> None:
     import time
 
     import cv2
-    import decode_speed
-    import regions_speed
 
     from bistair.codecs.base import shift_order_problem
     from bistair.core.checks import axis_problem
     from bistair.core.jit import set_threads
     from bistair.core.memory import keep_freed_memory
+    from bistair.evaluation.speed import CASES, opencv_floor, speed_captures
 
     keep_freed_memory()
     cv2.setNumThreads(set_threads(1))
-    frames, spec = regions_speed.scene(size)
+    spec = CASES[0].spec()  # the default decode's
+    frames = speed_captures(spec, {"1.3": (1024, 1280), "12": (3000, 4000)}[size])
     codec = REGISTRY[spec.method]
     _, cols = codec._columns(frames, spec)
     fs = codec.measure_columns(cols, spec, None)
@@ -229,7 +229,7 @@ def speed(size: str, count: int) -> None:
         t = theta[::4, ::4][fs.valid[::4, ::4]][:20000]
         return stair_misfit(t, np.ones(t.size, bool), levels)
 
-    jobs = {"floor": lambda: decode_speed.opencv_floor(frames),
+    jobs = {"floor": lambda: opencv_floor(frames),
             "shift order before": old_shift,
             "shift order after": lambda: shift_order_problem(fs.sample, spec),
             "axis before": lambda: old_axis(fs.phi, fs.valid),
@@ -237,7 +237,12 @@ def speed(size: str, count: int) -> None:
             "stair misfit before": old_misfit,
             "stair misfit after": lambda: stair_misfit(*stair_sample(fs.sample, theta,
                                                                      fs.valid), levels)}
-    best = regions_speed.rounds(jobs, count, time.process_time)
+    best = {k: np.inf for k in jobs}
+    for _ in range(count):
+        for key, job in jobs.items():
+            t0 = time.process_time()
+            job()
+            best[key] = min(best[key], time.process_time() - t0)
     h, w = fs.phi.shape
     print(f"{h}x{w}, one thread, process CPU time, min of {count} rounds")
     for key, value in best.items():
@@ -252,7 +257,6 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=8)
     args = parser.parse_args()
     if args.speed:
-        sys.path.insert(0, str(Path(__file__).resolve().parent))
         speed(args.speed, args.rounds)
         return
     both = not (args.real or args.mismatch)

@@ -87,3 +87,27 @@ def test_stair_misfit_judged_on_the_sample(scene):
     fs = REGISTRY["bidirectional"].measure_columns(cols, other, None)
     assert stair_misfit(*stair_sample(fs.sample, fs.stair[0], fs.valid),
                         union_levels(other.partitions, other.stairs)) > 0.7
+
+
+def test_refusals_of_the_sample_come_before_pass_1(scene, monkeypatch):
+    """Swapped shift frames and a turned camera are refused from pass 0's sample alone: the
+    pass over every pixel never runs."""
+    from bistair.core import measure
+
+    def no_full_pass(*args, **kwargs):
+        raise AssertionError("pass 1 ran")
+
+    rig, imaging, traced = scene
+    width, height = rig.projector.size
+    spec = bistair.make_spec("bidirectional", width=width, height=height, gamma=imaging.gamma,
+                             **REGISTRY["bidirectional"].comparable(width, height, 30, 4))
+    images = expose(traced, bistair.encode(spec), imaging)
+    monkeypatch.setattr(measure, "front_end", no_full_pass)
+    swapped = images.copy()
+    swapped[[0, 1]] = swapped[[1, 0]]
+    with pytest.raises(bistair.BistairError, match="shift-0 and shift-1 look swapped"):
+        bistair.decode(swapped, spec)
+    with pytest.raises(bistair.BistairError, match="is orientation columns"):
+        bistair.decode(images, spec.replace(orientation="rows"))
+    with pytest.raises(AssertionError, match="pass 1 ran"):  # a right capture goes on
+        bistair.decode(images, spec)

@@ -48,6 +48,7 @@ from ..core.checks import (
     jump_problem,
     outside_problem,
     refuse,
+    sample_checks,
     sparse_problem,
     swapped_frames,
     wrap_steps,
@@ -317,13 +318,19 @@ class Codec:
         :func:`~bistair.core.checks.refuse`)."""
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
-        fs = self.measure_columns(cols, spec, min_modulation)
-        turned = None
-        if fs.sample is not None:  # (a Gray code alone has no phase to judge)
-            refuse(shift_order_problem(fs.sample, spec))
-            turned = axis_problem(fs.sample, spec.orientation)
-        if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
-            refuse(turned)
+        axis: list[str | None] = [None]
+
+        def on_sample(sample: Sample) -> None:
+            """The checks of pass 0's sample, before pass 1 (a Gray code alone, with no
+            phase, has no sample: nothing to judge)."""
+            refuse(shift_order_problem(sample, spec))
+            axis[0] = axis_problem(sample, spec.orientation)
+            if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
+                refuse(axis[0])
+
+        with sample_checks(on_sample):
+            fs = self.measure_columns(cols, spec, min_modulation)
+        turned = axis[0]
 
         def judge(problem: str | None) -> None:
             """Refuse for ``problem``, naming a turned axis too (the likelier cause)."""

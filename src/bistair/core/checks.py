@@ -24,7 +24,7 @@ Examples
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass
 
@@ -38,6 +38,8 @@ from .stair import half_gaps
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 _FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
+_ON_SAMPLE: ContextVar[Callable[[Sample], None] | None] = ContextVar("bistair_on_sample",
+                                                                     default=None)
 
 
 def refuse(problem: str | None) -> None:
@@ -107,6 +109,55 @@ def forcing(force: bool = True) -> Iterator[list[str]]:
         yield forced
     finally:
         _FORCED.reset(token)
+
+
+@contextlib.contextmanager
+def sample_checks(judge: Callable[[Sample], None]) -> Iterator[None]:
+    """Within the block, the first capture measured with a sample (pass 0 of
+    :func:`bistair.core.measure.measure`, ``check=True``) is given to ``judge`` before its
+    pass over every pixel: the refusals that need only the sample come before any full
+    pass.
+
+    Parameters
+    ----------
+    judge : callable
+        Called once with the :class:`~bistair.core.sample.Sample`; it refuses through
+        :func:`refuse`.
+
+    Yields
+    ------
+    None
+
+    Examples
+    --------
+    >>> seen = []
+    >>> with sample_checks(seen.append):
+    ...     judge_sample("a sample")
+    ...     judge_sample("another")  # only the first
+    >>> judge_sample("outside"); seen
+    ['a sample']
+    """
+    token = _ON_SAMPLE.set(judge)
+    try:
+        yield
+    finally:
+        _ON_SAMPLE.reset(token)
+
+
+def judge_sample(sample: Sample) -> None:
+    """Give pass 0's sample to the checks of :func:`sample_checks`, if any are waiting
+    (the first sample of the block only); called by :func:`bistair.core.measure.measure`
+    between pass 0 and pass 1.
+
+    Parameters
+    ----------
+    sample : Sample
+        Pass 0's sample of the capture.
+    """
+    judge = _ON_SAMPLE.get()
+    if judge is not None:
+        _ON_SAMPLE.set(None)  # (the block's own token restores what was outside it)
+        judge(sample)
 
 
 @dataclass(frozen=True)
