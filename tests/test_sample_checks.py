@@ -111,3 +111,29 @@ def test_refusals_of_the_sample_come_before_pass_1(scene, monkeypatch):
         bistair.decode(images, spec.replace(orientation="rows"))
     with pytest.raises(AssertionError, match="pass 1 ran"):  # a right capture goes on
         bistair.decode(images, spec)
+
+
+def test_stair_fit_on_a_fixed_grid(scene):
+    """The stair fit's pixels come from a fixed grid (every m-th pixel, m prime to the
+    width), and it still accepts the right spec and refuses one more partition (the
+    figures: 0.004 and 0.21, before on a scan of the decoded pixels 0.004 and 0.21)."""
+    from bistair.codecs.bidirectional.stairs import grid_sample
+
+    valid = np.ones((384, 480), bool)
+    order = np.zeros((384, 480), np.int32)
+    order[:, ::2] = -1
+    idx = grid_sample(valid, order, 1000)
+    step = np.diff(idx)
+    assert idx.size <= 1000 and np.all(order.ravel()[idx] >= 0)
+    assert np.unique(idx // 480).size > 300  # spread over the rows, no band left out
+    assert np.all(step == step[0])  # a fixed grid: evenly spaced
+    rig, imaging, traced = scene
+    width, height = rig.projector.size
+    spec = bistair.make_spec("bidirectional", width=width, height=height, gamma=imaging.gamma,
+                             **REGISTRY["bidirectional"].comparable(width, height, 30, 4))
+    images = expose(traced, bistair.encode(spec), imaging)
+    right = bistair.decode(images, spec)
+    assert right.info["stair_misfit"] < 0.05
+    wrong = bistair.decode(images, spec.replace(partitions=spec.partitions + 1), force=True)
+    assert wrong.info["stair_misfit"] > 0.15
+    assert any("stair phase is nearer a level" in f for f in wrong.info["forced"])

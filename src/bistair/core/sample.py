@@ -32,9 +32,11 @@ What each check of the whole capture reads from it:
   along the rows and ``wrap(phi[2::3] - phi[0::3]) / 2`` down the columns, where both
   pixels are ``strong``;
 - stair misfit (:func:`bistair.core.checks.stair_sample`): ``theta[strong]``;
-- still on the full maps (to come): the phase convention (the code of the column pairs
-  cannot tell a step between runs of two equal codes from a flicker), the stair fit (the
-  orders at ``np.ix_(rows, cols)`` against ``theta``, taken where the orders are written).
+- the stair fit needs the orders: it judges a fixed grid of its own once they are made
+  (:func:`bistair.codecs.bidirectional.stairs.grid_sample`; this grid's rows every 16
+  rows could fall on one kind of a code's bands of rows);
+- still on the full maps: the phase convention (the code of the column pairs cannot
+  tell a step between runs of two equal codes from a flicker).
 
 Examples
 --------
