@@ -229,7 +229,34 @@ def speed(size: str, count: int) -> None:
         t = theta[::4, ::4][fs.valid[::4, ::4]][:20000]
         return stair_misfit(t, np.ones(t.size, bool), levels)
 
+    from bistair.codecs import bidirectional
+    from bistair.codecs.bidirectional import stairs
+    from bistair.codecs.bidirectional.stairs_jit import decoded_sample
+
+    fit_args: list = []
+    fit = bidirectional.stair_fit
+
+    def watch_fit(*args, **kwargs):
+        fit_args.append((args, kwargs))
+        return fit(*args, **kwargs)
+
+    bidirectional.stair_fit = watch_fit
+    try:
+        bistair.decode(frames, spec)
+    finally:
+        bidirectional.stair_fit = fit
+    (f_args, f_kw), grid = fit_args[0], stairs.grid_sample
+
+    def old_fit() -> float:  # the branch point's sample: a scan of the decoded pixels
+        stairs.grid_sample = decoded_sample
+        try:
+            return fit(*f_args, **f_kw)
+        finally:
+            stairs.grid_sample = grid
+
     jobs = {"floor": lambda: opencv_floor(frames),
+            "stair fit before": old_fit,
+            "stair fit after": lambda: fit(*f_args, **f_kw),
             "shift order before": old_shift,
             "shift order after": lambda: shift_order_problem(fs.sample, spec),
             "axis before": lambda: old_axis(fs.phi, fs.valid),
