@@ -153,6 +153,10 @@ def judge_sample(sample: Sample) -> None:
     ----------
     sample : Sample
         Pass 0's sample of the capture.
+
+    Examples
+    --------
+    >>> judge_sample("a sample")  # no check waiting: nothing happens
     """
     judge = _ON_SAMPLE.get()
     if judge is not None:
