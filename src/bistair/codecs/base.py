@@ -372,9 +372,10 @@ class Codec:
         if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
-        judge(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
+        decoded = int(np.count_nonzero(result.mask))
+        judge(outside_problem(decoded, result.info.get("outside_projector", 0),
                               spec.coded_length))
-        result.info["valid_pixels"] = int(result.mask.sum())
+        result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":
             result = result.transposed()
