@@ -29,7 +29,7 @@ PATTERNS: tuple[tuple[str, tuple[str, ...]], ...] = (
         "bistair.core.checks*:*", "bistair.codecs.base:shift_order_problem",
         "bistair.codecs.base:check_convention", "bistair.codecs.graycode:_second_period_check",
         "bistair.codecs.bidirectional.stairs:stair_fit",
-        "bistair.codecs.bidirectional.stairs_jit:decoded_sample",
+        "bistair.codecs.bidirectional.stairs:grid_sample",
         "bistair.codecs.bidirectional.stairs_jit:stair_agreement",
         "bistair.core.captures:check_*")),
     ("labelling and links: fringe regions, stair edges", (

@@ -48,6 +48,7 @@ from ..core.checks import (
     jump_problem,
     outside_problem,
     refuse,
+    sample_checks,
     sparse_problem,
     swapped_frames,
     wrap_steps,
@@ -55,6 +56,7 @@ from ..core.checks import (
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
 from ..core.result import AxesResult, DecodeResult, result_from_orders
+from ..core.sample import Sample
 from ..errors import BistairError
 from ..spec import AXES, BaseSpec, PeriodSpec
 
@@ -316,11 +318,19 @@ class Codec:
         :func:`~bistair.core.checks.refuse`)."""
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
-        fs = self.measure_columns(cols, spec, min_modulation)
-        refuse(shift_order_problem(cols, fs.valid, spec))
-        turned = axis_problem(fs.phi, fs.valid, spec.orientation)
-        if self.aligned:  # a per-pixel code decodes a turned camera's images too: a warning
-            refuse(turned)
+        axis: list[str | None] = [None]
+
+        def on_sample(sample: Sample) -> None:
+            """The checks of pass 0's sample, before pass 1 (a Gray code alone, with no
+            phase, has no sample: nothing to judge)."""
+            refuse(shift_order_problem(sample, spec))
+            axis[0] = axis_problem(sample, spec.orientation)
+            if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
+                refuse(axis[0])
+
+        with sample_checks(on_sample):
+            fs = self.measure_columns(cols, spec, min_modulation)
+        turned = axis[0]
 
         def judge(problem: str | None) -> None:
             """Refuse for ``problem``, naming a turned axis too (the likelier cause)."""
@@ -362,9 +372,10 @@ class Codec:
         if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
-        judge(outside_problem(int(result.mask.sum()), result.info.get("outside_projector", 0),
+        decoded = int(np.count_nonzero(result.mask))
+        judge(outside_problem(decoded, result.info.get("outside_projector", 0),
                               spec.coded_length))
-        result.info["valid_pixels"] = int(result.mask.sum())
+        result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":
             result = result.transposed()
@@ -372,25 +383,25 @@ class Codec:
         return result
 
 
-def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
-                        samples: int = 20000) -> str | None:
+def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) -> str | None:
     """A one-line reason to refuse when two frames of an N-step set look swapped
-    (:func:`~bistair.core.checks.swapped_frames`, on a subsample of the valid pixels).
+    (:func:`~bistair.core.checks.swapped_frames`), judged on pass 0's sample: its strong
+    pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
 
     Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
-    or more steps is checked; captures with fewer than 500 valid pixels are not judged.
+    or more steps is checked; with fewer than 500 strong pixels in the sample nothing is
+    said.
 
     Parameters
     ----------
-    cols : Prepared
-        The method's frames in method order, column layout.
-    valid : numpy.ndarray
-        (H, W) bool, the pixels to judge (the stage-1 validity).
+    sample : Sample
+        Pass 0's sample of the captures (``FringeSet.sample``), column layout, its
+        ``values`` the method's frames in method order.
     spec : BaseSpec
         The spec whose ``method_frames`` name the frames and whose ``shift_sign`` gives the
         direction of the shifts.
     samples : int, default 20000
-        About how many valid pixels to use.
+        At most how many strong pixels to use.
 
     Returns
     -------
@@ -401,13 +412,13 @@ def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
     --------
     >>> from bistair.codecs import encode, make_spec
     >>> from bistair.core.captures import prepare
-    >>> spec = make_spec("graycode", width=240, height=32, period=30)
+    >>> spec = make_spec("graycode", width=240, height=256, period=30)
     >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
-    >>> shift_order_problem(cols, measure_shifts(cols, spec).valid, spec) is None
+    >>> shift_order_problem(measure_shifts(cols, spec).sample, spec) is None
     True
     >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
     >>> swapped = prepare(images, spec.frame_count, spec.method)
-    >>> shift_order_problem(swapped, measure_shifts(swapped, spec).valid, spec).split(":")[0]
+    >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
     'frames shift-0 and shift-1 look swapped'
     """
     names = spec.method_frames()
@@ -415,15 +426,15 @@ def shift_order_problem(cols: Prepared, valid: np.ndarray, spec: BaseSpec,
     for i, name in enumerate(names):
         if "shift-" in name:
             sets.setdefault(name.rsplit("shift-", 1)[0], []).append(i)
-    idx = np.flatnonzero(valid)
-    idx = idx[:: max(1, idx.size // samples)]
-    if idx.size < 500:
+    r, c = np.nonzero(sample.strong)
+    if r.size < 500:
         return None
-    r, c = np.unravel_index(idx, valid.shape)
+    step = max(1, -(-r.size // samples))
+    r, c = r[::step], c[::step]
     for members in sets.values():
         if len(members) < 4:
             continue
-        values = np.stack([np.asarray(cols.frames.raw[m][r, c], np.float64) for m in members])
+        values = sample.values[members][:, r, c].astype(np.float64)
         pair = swapped_frames(values, spec.shift_sign)
         if pair is not None:
             a, b = (names[members[i]] for i in pair)

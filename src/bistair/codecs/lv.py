@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..core.captures import Prepared
-from ..core.checks import refuse, stair_misfit
+from ..core.checks import refuse, stair_misfit, stair_sample
 from ..core.measure import FringeSet
 from ..core.memory import row_bands
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
@@ -328,7 +328,8 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     theta = (fs.stair if fs.stair is not None else
              pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg))[0]
     codes = quantize32(theta, spec.levels, fs.valid)
-    if stair_misfit(theta, fs.valid, stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
+    if stair_misfit(*stair_sample(fs.sample, theta, fs.valid),
+                    stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
         refuse("the code phases sit halfway between the code's levels: are code-cos and "
                "code-sin swapped (or levels wrong)?")
     return CodeMap(codes, {"code_phase": theta}, cycle=spec.levels)

@@ -24,7 +24,7 @@ Examples
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass
 
@@ -33,10 +33,13 @@ import numpy as np
 from ..errors import BistairError
 from .checks_jit import code_steps, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
+from .sample import Sample, sample_grid
 from .stair import half_gaps
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 _FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
+_ON_SAMPLE: ContextVar[Callable[[Sample], None] | None] = ContextVar("bistair_on_sample",
+                                                                     default=None)
 
 
 def refuse(problem: str | None) -> None:
@@ -106,6 +109,59 @@ def forcing(force: bool = True) -> Iterator[list[str]]:
         yield forced
     finally:
         _FORCED.reset(token)
+
+
+@contextlib.contextmanager
+def sample_checks(judge: Callable[[Sample], None]) -> Iterator[None]:
+    """Within the block, the first capture measured with a sample (pass 0 of
+    :func:`bistair.core.measure.measure`, ``check=True``) is given to ``judge`` before its
+    pass over every pixel: the refusals that need only the sample come before any full
+    pass.
+
+    Parameters
+    ----------
+    judge : callable
+        Called once with the :class:`~bistair.core.sample.Sample`; it refuses through
+        :func:`refuse`.
+
+    Yields
+    ------
+    None
+
+    Examples
+    --------
+    >>> seen = []
+    >>> with sample_checks(seen.append):
+    ...     judge_sample("a sample")
+    ...     judge_sample("another")  # only the first
+    >>> judge_sample("outside"); seen
+    ['a sample']
+    """
+    token = _ON_SAMPLE.set(judge)
+    try:
+        yield
+    finally:
+        _ON_SAMPLE.reset(token)
+
+
+def judge_sample(sample: Sample) -> None:
+    """Give pass 0's sample to the checks of :func:`sample_checks`, if any are waiting
+    (the first sample of the block only); called by :func:`bistair.core.measure.measure`
+    between pass 0 and pass 1.
+
+    Parameters
+    ----------
+    sample : Sample
+        Pass 0's sample of the capture.
+
+    Examples
+    --------
+    >>> judge_sample("a sample")  # no check waiting: nothing happens
+    """
+    judge = _ON_SAMPLE.get()
+    if judge is not None:
+        _ON_SAMPLE.set(None)  # (the block's own token restores what was outside it)
+        judge(sample)
 
 
 @dataclass(frozen=True)
@@ -254,21 +310,59 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     return ("refuse" if abs(check.crossing) > np.pi / 3 else "warn", message)
 
 
-def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str,
-                 factor: float = 1.0) -> str | None:
-    """A one-line reason to refuse when the wrapped phase (column layout: the coded axis
-    along the rows) changes more than ``factor`` times as fast down the columns as along
-    the rows, i.e. the fringes run along the image's coded axis instead of across it.
+def axis_rates(sample: Sample) -> tuple[float, float] | None:
+    """How fast the wrapped phase changes along the rows and down the columns (column
+    layout: the coded axis along the rows), in rad per pixel, on pass 0's sample: the median
+    absolute wrapped difference between the two pixels of each column pair (along) and half
+    that between the first and last row of each run of three (down), where both pixels are
+    ``strong``.
 
-    The median absolute wrapped phase differences are taken on every fourth row and second
-    column; with fewer than 500 of either, nothing is said.
+    Over two rows, the phase noise weighs half as much per pixel down the columns. The
+    ratio of the two (down over along, refused above 1 by :func:`axis_problem`) is at or
+    below what the check judged before pass 0 (every fourth row against every second column
+    of the full maps) where the spec fits, and far above 1 for a turned camera: kamino's
+    axes 0.234 and 0.238 (were 0.245 and 0.293), CFPE 0.073 (0.148), the rendered scene of
+    tests/test_spec_mismatch.py 0.047 (0.048); there, two shift frames swapped 0.52
+    (0.75), the wrong orientation 11 (42) (``benchmarks/sample_checks.py``).
 
     Parameters
     ----------
-    phi : (H, W) float array
-        Wrapped phase in ``[0, 2*pi)``, in the column layout.
-    valid : (H, W) bool array
-        Pixels whose phase counts.
+    sample : Sample
+        Pass 0's sample of the capture (:func:`bistair.core.sample.take_sample`).
+
+    Returns
+    -------
+    (along, down) : tuple of float, or None
+        ``None`` with fewer than 500 differences either way.
+
+    Examples
+    --------
+    >>> from bistair.core.sample import sample_grid
+    >>> rows, cols = sample_grid(256, 512)
+    >>> phi = ((2 * np.pi * cols / 16) % (2 * np.pi))[None].repeat(rows.size, 0)
+    >>> ok = np.ones(phi.shape, bool)
+    >>> s = Sample(rows, cols, phi[None], 1.0, phi.astype(np.float32), phi, phi, ok, ok, ~ok)
+    >>> [round(r, 3) for r in axis_rates(s)]
+    [0.393, 0.0]
+    """
+    phi, ok = sample.blocks(sample.phi), sample.blocks(sample.strong)
+    along = np.abs(wrap(phi[..., 1] - phi[..., 0]))[ok[..., 1] & ok[..., 0]]
+    down = np.abs(wrap(phi[:, 2] - phi[:, 0]))[ok[:, 2] & ok[:, 0]]
+    if min(along.size, down.size) < 500:
+        return None
+    return float(np.median(along)), float(np.median(down)) / 2.0
+
+
+def axis_problem(sample: Sample, orientation: str, factor: float = 1.0) -> str | None:
+    """A one-line reason to refuse when the wrapped phase (column layout: the coded axis
+    along the rows) changes more than ``factor`` times as fast down the columns as along
+    the rows (:func:`axis_rates`, per pixel, on pass 0's sample), i.e. the fringes run along
+    the image's coded axis instead of across it.
+
+    Parameters
+    ----------
+    sample : Sample
+        Pass 0's sample of the capture, column layout.
     orientation : str
         The spec's orientation, ``"columns"`` or ``"rows"`` (for the message).
     factor : float
@@ -281,19 +375,18 @@ def axis_problem(phi: np.ndarray, valid: np.ndarray, orientation: str,
 
     Examples
     --------
-    >>> x = np.arange(128.0)
-    >>> phi = np.tile((2 * np.pi * x / 16) % (2 * np.pi), (64, 1)).astype(np.float32)
+    >>> from bistair.core.sample import sample_grid
+    >>> rows, cols = sample_grid(256, 512)
+    >>> phi = ((2 * np.pi * rows / 16) % (2 * np.pi))[:, None].repeat(cols.size, 1)
     >>> ok = np.ones(phi.shape, bool)
-    >>> axis_problem(phi, ok, "columns") is None, axis_problem(phi.T, ok.T, "columns")[:34]
-    (True, 'the phase changes down the image (')
+    >>> s = Sample(rows, cols, phi[None], 1.0, phi.astype(np.float32), phi, phi, ok, ok, ~ok)
+    >>> axis_problem(s, "columns")[:34]
+    'the phase changes down the image ('
     """
-    sub = (slice(None, None, 4), slice(None, None, 2))
-    p, v = phi[sub], valid[sub]
-    along = np.abs(wrap(np.diff(p, axis=1)))[v[:, 1:] & v[:, :-1]]
-    across = np.abs(wrap(np.diff(p, axis=0)))[v[1:] & v[:-1]]
-    if min(along.size, across.size) < 500:
+    rates = axis_rates(sample)
+    if rates is None:
         return None
-    a, c = float(np.median(along)), float(np.median(across))
+    a, c = rates
     if c <= factor * a:
         return None
     axis, other = ("x", "rows") if orientation == "columns" else ("y", "columns")
@@ -549,7 +642,8 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     """Median distance of the stair phases from the nearest level, in halves of that
     level's distance to its neighbour (0: on the levels, 1: halfway between two).
 
-    The median is taken over at most 20000 valid pixels on every fourth row and column.
+    The median is taken over at most 20000 of the valid pixels (evenly spaced): a check of
+    the whole capture passes pass 0's sample (``sample.theta``, ``sample.strong``).
 
     Parameters
     ----------
@@ -571,12 +665,44 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     >>> round(stair_misfit(np.array([[0.1, 1.0, -2.0]]), np.ones((1, 3), bool), lv), 2)
     0.1
     """
-    t = theta[::4, ::4][valid[::4, ::4]][:20000].astype(np.float64)  # plenty for a median
+    t = theta[valid]
+    t = t[:: max(1, -(-t.size // 20000))].astype(np.float64)  # plenty for a median
     if t.size == 0:
         return 0.0
     d = np.abs(wrap(t[:, None] - levels[None, :]))
     nearest = d.argmin(axis=1)
     return float(np.median(d[np.arange(t.size), nearest] / half_gaps(levels)[nearest]))
+
+
+def stair_sample(sample: Sample | None, theta: np.ndarray, valid: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The stair phases :func:`stair_misfit` judges and the pixels that count: pass 0's
+    sample's (``theta``, ``strong``) where it read the pair, else the maps' on the same grid
+    (:func:`~bistair.core.sample.sample_grid`), never a scan of the image for a sample.
+
+    Parameters
+    ----------
+    sample : Sample or None
+        Pass 0's sample of the capture (``FringeSet.sample``).
+    theta : (H, W) float array
+        The stair phase of every pixel.
+    valid : (H, W) bool array
+        The pixels whose stair phase counts.
+
+    Returns
+    -------
+    theta, valid : (R, C) arrays
+
+    Examples
+    --------
+    >>> theta, ok = stair_sample(None, np.zeros((40, 20)), np.ones((40, 20), bool))
+    >>> theta.shape, bool(ok.all())
+    ((6, 6), True)
+    """
+    if sample is not None and sample.theta is not None:
+        return sample.theta, sample.strong
+    rows, cols = sample_grid(*theta.shape)
+    return theta[np.ix_(rows, cols)], valid[np.ix_(rows, cols)]
 
 
 def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
+from .checks import judge_sample
 from .measure_jit import fit_residual_energy, front_end, keep_coherent, phase_noise
 from .phase import shifts_of
 from .phase_jit import offset_parts, shift_weights
@@ -159,7 +160,8 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
 
     Two passes: pass 0 (:mod:`bistair.core.sample`) takes the camera noise from a sparse
     grid (:func:`~bistair.core.sample.set_noise`), hence the thresholds, and with ``check``
-    the set's :class:`~bistair.core.sample.Sample` for the checks of the whole capture;
+    the set's :class:`~bistair.core.sample.Sample` for the checks of the whole capture
+    (those waiting in :func:`~bistair.core.checks.sample_checks` judge it at once);
     pass 1 (:func:`~bistair.core.measure_jit.front_end`) measures every pixel in tiles of
     rows, each frame read once: phase, average, modulation, validity, the phase noise and
     the pair's stair phase.
@@ -240,6 +242,8 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         max(0.005, 2.0 * noise)
     sample = None if not check else take_sample(prepared, start, steps, pair, lowest,
                                                 threshold, shift_sign, phase_offset)
+    if sample is not None:  # the checks that need only the sample refuse before pass 1
+        judge_sample(sample)
     contrast = prepared.white is not None and prepared.black is not None
     none = np.zeros((1, 1), np.float32)
     raw, first, cos_frame = kernel_view(prepared, start, steps, pair)

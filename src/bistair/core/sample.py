@@ -23,17 +23,20 @@ rows: ``a[:, 1::2] - a[:, 0::2]``) and never across them (:meth:`Sample.blocks`)
 **For the checks.** :func:`bistair.core.measure.measure` keeps the sample of the set whose
 captures it judges (``check=True``: the set every codec's stage 1 measures) in
 ``FringeSet.sample``, column layout; ``Codec._decode`` lets it go once the orders are made.
-What each check of the whole capture would read (today they still find their own
-samples in the full maps):
+What each check of the whole capture reads from it:
 
-- shift order: ``values[frames_of_a_set][:, strong]`` (every set's frames are there,
-  those of sets measured with ``check=False`` too);
-- axis: ``wrap(phi[:, 1::2] - phi[:, 0::2])`` along the rows and ``wrap(phi[1::3] -
-  phi[0::3])`` down the columns, where both pixels are ``strong``;
-- stair misfit: ``theta[strong]``;
-- phase convention: the code of the column pairs (``quantize(theta, levels)``, or a code
-  map at ``np.ix_(rows, cols)``) and ``phi`` where the pair's code steps;
-- stair fit: the orders at ``np.ix_(rows, cols)`` against ``theta``.
+- shift order (:func:`bistair.codecs.base.shift_order_problem`):
+  ``values[frames_of_a_set][:, strong]`` (every set's frames are there, those of sets
+  measured with ``check=False`` too), at most 20000 pixels;
+- axis (:func:`bistair.core.checks.axis_rates`): ``wrap(phi[:, 1::2] - phi[:, 0::2])``
+  along the rows and ``wrap(phi[2::3] - phi[0::3]) / 2`` down the columns, where both
+  pixels are ``strong``;
+- stair misfit (:func:`bistair.core.checks.stair_sample`): ``theta[strong]``;
+- the stair fit needs the orders: it judges a fixed grid of its own once they are made
+  (:func:`bistair.codecs.bidirectional.stairs.grid_sample`; this grid's rows every 16
+  rows could fall on one kind of a code's bands of rows);
+- still on the full maps: the phase convention (the code of the column pairs cannot
+  tell a step between runs of two equal codes from a flicker).
 
 Examples
 --------

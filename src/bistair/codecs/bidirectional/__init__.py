@@ -45,7 +45,7 @@ from typing import Literal
 import numpy as np
 
 from ...core.captures import Prepared
-from ...core.checks import refuse, stair_misfit, wrap_steps
+from ...core.checks import refuse, stair_misfit, stair_sample, wrap_steps
 from ...core.measure import FringeSet
 from ...core.regions import (
     core_weight,
@@ -237,7 +237,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     theta, stair_mod = fs.stair if fs.stair is not None else pair_phase(
         prepared.raw, spec.steps, prepared.scale, fs.avg)
     ks = quantize32(theta, spec.stairs, fs.valid)
-    if stair_misfit(theta, fs.valid, union_levels(spec.partitions, spec.stairs)) > 0.7:
+    if stair_misfit(*stair_sample(fs.sample, theta, fs.valid),
+                    union_levels(spec.partitions, spec.stairs)) > 0.7:
         refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
                "and stair-sin swapped (or partitions and stairs wrong)?")
     return CodeMap(ks, {"stair_phase": theta, "stair_modulation": stair_mod}, cycle=spec.stairs)

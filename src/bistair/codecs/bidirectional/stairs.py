@@ -18,7 +18,7 @@ from ...core.memory import row_bands
 from ...core.phase import TWO_PI, wrap
 from ...core.stair import stair_level_phase
 from .bands import nearest_level, observed_levels, union_levels
-from .stairs_jit import decoded_sample, stair_turns
+from .stairs_jit import stair_turns
 
 if TYPE_CHECKING:
     from . import BidirectionalSpec
@@ -49,7 +49,7 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
     spec : BidirectionalSpec
         The spec of one coded axis.
     samples : int, default 20000
-        About how many decoded pixels to judge.
+        At most how many decoded pixels to judge (:func:`grid_sample`).
     readings : numpy.ndarray, optional
         (L,) where the union levels read in ``theta`` when a response moves them
         (:func:`~bistair.core.stair.level_readings`): each level's observed phase is then
@@ -78,7 +78,7 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
     >>> round(stair_fit(fs, theta, stair_mod, np.where(order >= 0, order + 1, -1), spec), 3)
     0.583
     """
-    idx = decoded_sample(fs.valid, order, samples)
+    idx = grid_sample(fs.valid, order, samples)
     th, k = theta.ravel()[idx].astype(np.float64), order.ravel()[idx].astype(np.int64)
     sigma = fs.noise * math.sqrt(2.0) / np.maximum(stair_mod.ravel()[idx], 1e-6)
     phi = fs.phi.ravel()[idx]
@@ -97,6 +97,45 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
                      np.abs(wrap(th - seen[part[kk // spec.stairs]])))
     return float(np.mean(~inside | (own > near + np.maximum(0.05, 2.0 * sigma))))
 
+
+
+def grid_sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
+    """Flat indices of at most ``samples`` decoded pixels (valid, order >= 0) on a fixed
+    grid, never a scan of the image to find them: every ``m``-th pixel in raster order
+    (``m`` prime to the width, so that the grid walks across the columns from row to row
+    and no band of rows or columns is left out; about three times ``samples`` pixels),
+    then every ``j``-th decoded pixel of those.
+
+    Parameters
+    ----------
+    valid : (H, W) bool array
+        Valid pixels.
+    order : (H, W) int array
+        Fringe orders, -1 where not decoded.
+    samples : int
+        At most how many pixels to pick (at least 1).
+
+    Returns
+    -------
+    int64 array
+        The flat indices, ascending.
+
+    Examples
+    --------
+    >>> order = np.zeros((40, 6), np.int32)
+    >>> order[0, 3] = -1
+    >>> grid_sample(np.ones((40, 6), bool), order, 20).tolist()  # every 3rd of every 5th
+    [2, 17, 32, 47, 62, 77, 92, 107, 122, 137, 152, 167, 182, 197, 212, 227]
+    >>> grid_sample(np.ones((40, 6), bool), order, 1000).size  # all, one not decoded
+    239
+    """
+    h, w = valid.shape
+    m = max(1, h * w // (3 * max(1, int(samples))))
+    while m > 1 and math.gcd(m, w) > 1:
+        m += 1
+    grid = np.arange(m // 2, h * w, m, dtype=np.int64)
+    idx = grid[valid.ravel()[grid] & (order.ravel()[grid] >= 0)]
+    return idx[:: max(1, -(-idx.size // samples))]
 
 
 def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np.ndarray,
