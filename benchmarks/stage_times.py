@@ -40,7 +40,8 @@ PATTERNS: tuple[tuple[str, tuple[str, ...]], ...] = (
         "bistair.codecs.bidirectional.evidence*:*", "bistair.codecs.bidirectional.paper*:*",
         "bistair.codecs.bidirectional:_region_orders",
         "bistair.codecs.bidirectional:thin_band_doubt",
-        "bistair.codecs.bidirectional:level_offset", "bistair.core.split:*",
+        "bistair.codecs.bidirectional:level_offset", "bistair.codecs.bidirectional.response:*",
+        "bistair.core.split:*",
         "bistair.core.resolve:resolve_regions", "bistair.core.resolve:mode_by_label",
         "bistair.core.resolve:jump_violations", "bistair.core.resolve:drop_contradicted",
         "bistair.core.resolve:settle", "bistair.core.resolve:unanchored",
@@ -49,6 +50,7 @@ PATTERNS: tuple[tuple[str, tuple[str, ...]], ...] = (
         "bistair.codecs.multifreq_jit:*")),
     ("front end: phase, modulation, noise, validity, codes", (
         "bistair.core.captures:*", "bistair.core.phase*:*", "bistair.core.measure*:*",
+        "bistair.core.sample*:*",
         "bistair.core.stair*:*", "bistair.codecs.base:*",
         "bistair.codecs.*:measure_*", "bistair.codecs.*:code_*",
         "bistair.codecs.graycode_jit:code_bits", "bistair.codecs.graycode_alone:*")),
