@@ -10,14 +10,16 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from support.labelspace_before import drop_transitions, relabel_then_stair_sums
+from support.labelspace_before import drop_transitions, level_offsets, relabel_then_stair_sums
 
 import bistair
 from bistair.codecs import bidirectional
-from bistair.codecs.bidirectional import bands
-from bistair.codecs.bidirectional.bands import Runs
+from bistair.codecs.bidirectional import bands, response
+from bistair.codecs.bidirectional.bands import Runs, union_levels
+from bistair.codecs.bidirectional.profiles import RowProfiles
 from bistair.codecs.bidirectional.profiles_jit import relabel_stair_sums
 from bistair.core.jit import set_threads
+from bistair.core.phase import wrap
 
 PROPERTY = settings(max_examples=40, deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.too_slow])
@@ -150,5 +152,59 @@ def test_transitions_of_decoded_renders(scene, noise, monkeypatch):
     for runs in seen:
         assert_same_runs(compiled(copied(runs)), drop_transitions(copied(runs)))
     monkeypatch.setattr(bands, "_drop_transitions", drop_transitions)
+    old = bistair.decode(images, spec, force=True)
+    assert np.array_equal(new.order, old.order) and new.info == old.info
+
+
+@PROPERTY
+@given(n=st.integers(0, 300), seed=st.integers(0, 2**16),
+       stairs=st.sampled_from([(6, 6), (3, 4), (8, 8), (12, 12)]), nudge=st.booleans())
+def test_level_offsets_are_numpys(n, seed, stairs, nudge):
+    """Band rows on their levels, between two, across the wrap, at equal shares (ties in
+    the sort), with zero weights, none of band-core modulation or all, against the union
+    levels or levels read off them (as a response moves them): the same medians."""
+    rng = np.random.default_rng(seed)
+    levels = np.array(union_levels(*stairs))
+    if nudge:
+        levels = np.sort(wrap(levels + rng.normal(0, 0.05, levels.size)))
+    theta = levels[rng.integers(0, levels.size, n)] + rng.choice(
+        [0.0, 0.05, -0.05, 0.2, np.pi / levels.size], n) * (rng.random(n) < 0.7)
+    theta = np.where(rng.random(n) < 0.3, rng.uniform(-np.pi, np.pi, n), theta)
+    radius = rng.choice([1.0, 0.5, 3.0], n)
+    weight = rng.choice([0.0, 1.0, 2.5, 7.0], n) * rng.choice([1.0, rng.random()], n)
+    level = rng.choice([0.0, 0.69, 0.7, 1.0, rng.uniform(0, 2)], n)
+    one = np.ones(n)
+    prof = RowProfiles(np.arange(n), np.arange(n), radius * np.cos(theta),
+                       radius * np.sin(theta), weight, level, one, one)
+    offset, per_level = response.level_offsets(prof, levels)
+    want_offset, want_per_level = level_offsets(prof, levels)
+    assert type(offset) is float and offset == want_offset
+    assert per_level.dtype == want_per_level.dtype
+    assert np.array_equal(per_level, want_per_level)
+
+
+@pytest.mark.parametrize(("scene", "noise"), RENDERS, ids=[f"{s}-{n}" for s, n in RENDERS])
+def test_level_offsets_of_decoded_renders(scene, noise, monkeypatch):
+    """The row profiles of decodes (a response left uncompensated among them: levels
+    squeezed together) read as NumPy read them, and the decode the same with the NumPy."""
+    from test_regions_jit import render
+
+    images, spec = render(scene, "bidirectional", noise)
+    if scene == "warp0":  # a projector gamma of 2.2 the patterns do not compensate
+        images = images ** 2.2
+    seen = []
+    compiled = bidirectional.level_offsets
+
+    def watch(prof, levels):
+        seen.append((prof, levels))
+        return compiled(prof, levels)
+
+    monkeypatch.setattr(bidirectional, "level_offsets", watch)
+    new = bistair.decode(images, spec, force=True)
+    assert len(seen) == 1 and seen[0][0].region.size > 500
+    offset, per_level = compiled(*seen[0])
+    assert (offset, per_level.tolist()) == tuple(level_offsets(*seen[0])[:1]) + (
+        level_offsets(*seen[0])[1].tolist(),)
+    monkeypatch.setattr(bidirectional, "level_offsets", level_offsets)
     old = bistair.decode(images, spec, force=True)
     assert np.array_equal(new.order, old.order) and new.info == old.info

@@ -69,3 +69,31 @@ def drop_transitions(runs: Runs) -> Runs:
     runs.top_ok = runs.top_ok & ~np.r_[False, top_end[:-1]]
     runs.bottom_ok = runs.bottom_ok & ~np.r_[bottom_end[1:], False]
     return runs.take(~drop)
+
+
+def level_offsets(prof, levels: np.ndarray) -> tuple[float, np.ndarray]:
+    """``response.level_offsets`` in NumPy (main at ec6b88d): the weighted median share of
+    half a level gap the band-core rows read from their nearest level, over all of them and
+    per level."""
+    from bistair.core.stair import half_gaps
+
+    theta = np.arctan2(prof.sin, prof.cos)
+    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
+    per_level = np.zeros(levels.size)
+    if theta.size == 0 or not weight.sum() > 0:
+        return 0.0, per_level
+    nearest = np.abs(wrap(theta[:, None] - levels[None, :])).argmin(axis=1)
+    share = np.abs(wrap(theta - levels[nearest])) / half_gaps(levels)[nearest]
+    order = np.argsort(share)
+    cum = np.cumsum(weight[order])
+    offset = float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
+    grouped = order[np.argsort(nearest[order], kind="stable")]
+    cum = np.cumsum(weight[grouped])
+    first, last = (np.searchsorted(nearest[grouped], np.arange(levels.size), side=side)
+                   for side in ("left", "right"))
+    before = np.where(first > 0, cum[np.maximum(first - 1, 0)], 0.0)
+    total = np.where(last > first, cum[np.maximum(last - 1, 0)], 0.0) - before
+    seen = total > 0
+    at = np.minimum(np.searchsorted(cum, before + 0.5 * total), last - 1)
+    per_level[seen] = share[grouped][at[seen]]
+    return offset, per_level
