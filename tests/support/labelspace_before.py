@@ -97,3 +97,25 @@ def level_offsets(prof, levels: np.ndarray) -> tuple[float, np.ndarray]:
     at = np.minimum(np.searchsorted(cum, before + 0.5 * total), last - 1)
     per_level[seen] = share[grouped][at[seen]]
     return offset, per_level
+
+
+def profile_centroids(prof, n_regions: int) -> np.ndarray:
+    """``profiles.profile_centroids`` in NumPy (main at ec6b88d): three bincounts."""
+    count = np.maximum(np.bincount(prof.region, prof.count, n_regions + 1), 1)
+    rows = np.bincount(prof.region, prof.row * prof.count, n_regions + 1)
+    cols = np.bincount(prof.region, prof.col_sum, n_regions + 1)
+    return np.c_[rows / count, cols / count]
+
+
+def split_profiles(prof, n_regions: int, splits: list[tuple[int, int]]):
+    """``evidence.split_profiles`` in NumPy (main at ec6b88d): the split tails relabelled,
+    then a lexsort by region and row."""
+    from bistair.codecs.bidirectional.profiles import RowProfiles
+
+    region = prof.region.copy()
+    for old, row in sorted(splits, key=lambda s: (s[0], -s[1])):
+        n_regions += 1
+        region[(region == old) & (prof.row >= row)] = n_regions
+    order = np.lexsort((prof.row, region))
+    return RowProfiles(region[order], *(v[order] for k, v in prof.__dict__.items()
+                                        if k != "region"))
