@@ -15,9 +15,12 @@ the decode's first band analysis cut. One kernel thread and process CPU time by 
 or ``--wall`` on every core; the minimum over the rounds, in ms and ns a pixel.
 
     python benchmarks/labelspace_speed.py [--size 1.3|12] [--rounds 8] [--wall] [--decode]
+                                          [--stages]
 
-``--decode`` times whole default decodes instead, interleaved with the floor: run it with
-each checkout on ``PYTHONPATH`` for a before / after pair.
+``--decode`` times whole default decodes instead, interleaved with the floor; ``--stages``
+the label-space stages (band runs, nearest levels, level offsets, centroids, split
+profiles) on the arguments the decode gave them, each called by name: run either with each
+checkout on ``PYTHONPATH`` for a before / after pair.
 """
 
 from __future__ import annotations
@@ -127,6 +130,46 @@ def cases(frames: np.ndarray, spec) -> dict:
     }
 
 
+def stage_cases(frames: np.ndarray, spec) -> dict:
+    """The label-space stages on the arguments a default decode gave them (its first band
+    analysis; its split profiles), each called through the name the decode calls, so that
+    the same jobs time any checkout (``--stages`` under each ``PYTHONPATH``)."""
+    from bistair.codecs import bidirectional
+    from bistair.codecs.bidirectional import bands, evidence, profiles, response
+
+    names = ("row_runs", "level_offsets", "profile_centroids", "split_profiles")
+    seen: dict[str, tuple] = {}
+    kept = {name: getattr(bidirectional, name) for name in names}
+
+    def watch(name):
+        def watched(*args):
+            seen.setdefault(name, args)
+            return kept[name](*args)
+        return watched
+
+    for name in names:
+        setattr(bidirectional, name, watch(name))
+    try:
+        bistair.decode(frames, spec)
+    finally:
+        for name in names:
+            setattr(bidirectional, name, kept[name])
+    prof, levels = seen["row_runs"]
+    theta = np.arctan2(prof.sin, prof.cos)
+    print(f"{prof.region.size} (region, row) entries, {levels.size} levels, "
+          f"{len(seen.get('split_profiles', (0, 0, []))[2])} splits")
+    jobs = {
+        "floor": lambda: opencv_floor(frames),
+        "row_runs": lambda: bands.row_runs(prof, levels),
+        "nearest_level": lambda: bands.nearest_level(theta, levels),
+        "level_offsets": lambda: response.level_offsets(*seen["level_offsets"]),
+        "profile_centroids": lambda: profiles.profile_centroids(*seen["profile_centroids"]),
+    }
+    if "split_profiles" in seen:
+        jobs["split_profiles"] = lambda: evidence.split_profiles(*seen["split_profiles"])
+    return jobs
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1.3", choices=sorted(SIZES))
@@ -134,6 +177,8 @@ def main() -> None:
     parser.add_argument("--wall", action="store_true",
                         help="every core, wall time (else one thread, CPU time)")
     parser.add_argument("--decode", action="store_true", help="time whole default decodes")
+    parser.add_argument("--stages", action="store_true",
+                        help="time the label-space stages by name (any checkout)")
     args = parser.parse_args()
     keep_freed_memory()
     threads = set_threads(None if args.wall else 1)
@@ -143,6 +188,8 @@ def main() -> None:
     if args.decode:
         jobs = {"floor": lambda: opencv_floor(frames),
                 "default decode": lambda: bistair.decode(frames, spec)}
+    elif args.stages:
+        jobs = stage_cases(frames, spec)
     else:
         jobs = cases(frames, spec)
     for job in jobs.values():  # compiled and warm

@@ -10,6 +10,8 @@ from dataclasses import astuple
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from bistair.codecs.bidirectional.bands import (
     Runs,
@@ -159,6 +161,28 @@ def test_nearest_levels(levels):
     theta = np.r_[theta, np.nextafter(theta, 20), np.nextafter(theta, -20)]
     assert np.array_equal(nearest_levels(theta, levels), _nearest_before(theta, levels))
 
+
+
+@settings(max_examples=60, deadline=None, derandomize=True, database=None)
+@given(seed=st.integers(0, 2**16), m=st.integers(1, 13), gap=st.sampled_from([0.0, 1e-12,
+                                                                               1e-9, 0.3]))
+def test_nearest_levels_on_a_ring_of_levels(seed, m, gap):
+    """Levels ascending in [-pi, pi) (the union levels, the observed ones, one at -pi, two
+    close, one near pi: those searched only where they bracket a phase) or not quite (too
+    close, unsorted): the nearest level of every phase as ``argmin`` gave it, ties and
+    phases out of [-pi, pi] and NaN among them."""
+    rng = np.random.default_rng(seed)
+    levels = np.sort(rng.uniform(-np.pi, np.pi, m))
+    levels[0] = rng.choice([levels[0], -np.pi])
+    levels[-1] = rng.choice([levels[-1], np.nextafter(np.pi, 0)]) if m > 1 else levels[-1]
+    if m > 2:  # a close pair (the ring holds from 1e-9 apart)
+        levels[2] = levels[1] + gap
+        levels = levels if rng.random() < 0.8 else rng.permutation(levels)
+    mid = (levels[:, None] + levels[None, :]).ravel() / 2
+    theta = np.r_[rng.uniform(-np.pi, np.pi, 3000), rng.uniform(-9, 9, 100), levels, mid,
+                  mid + np.pi, [np.pi, -np.pi, 0.0, np.nan]]
+    theta = np.r_[theta, np.nextafter(theta, 20), np.nextafter(theta, -20)]
+    assert np.array_equal(nearest_levels(theta, levels), _nearest_before(theta, levels))
 
 
 def test_region_quantile():

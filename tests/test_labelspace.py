@@ -10,14 +10,22 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from support.labelspace_before import drop_transitions, relabel_then_stair_sums
+from support.labelspace_before import (
+    drop_transitions,
+    level_offsets,
+    profile_centroids,
+    relabel_then_stair_sums,
+    split_profiles,
+)
 
 import bistair
 from bistair.codecs import bidirectional
-from bistair.codecs.bidirectional import bands
-from bistair.codecs.bidirectional.bands import Runs
+from bistair.codecs.bidirectional import bands, evidence, profiles, response
+from bistair.codecs.bidirectional.bands import Runs, union_levels
+from bistair.codecs.bidirectional.profiles import RowProfiles
 from bistair.codecs.bidirectional.profiles_jit import relabel_stair_sums
 from bistair.core.jit import set_threads
+from bistair.core.phase import wrap
 
 PROPERTY = settings(max_examples=40, deadline=None, derandomize=True, database=None,
                     suppress_health_check=[HealthCheck.too_slow])
@@ -150,5 +158,114 @@ def test_transitions_of_decoded_renders(scene, noise, monkeypatch):
     for runs in seen:
         assert_same_runs(compiled(copied(runs)), drop_transitions(copied(runs)))
     monkeypatch.setattr(bands, "_drop_transitions", drop_transitions)
+    old = bistair.decode(images, spec, force=True)
+    assert np.array_equal(new.order, old.order) and new.info == old.info
+
+
+@PROPERTY
+@given(n=st.integers(0, 300), seed=st.integers(0, 2**16),
+       stairs=st.sampled_from([(6, 6), (3, 4), (8, 8), (12, 12)]), nudge=st.booleans())
+def test_level_offsets_are_numpys(n, seed, stairs, nudge):
+    """Band rows on their levels, between two, across the wrap, at equal shares (ties in
+    the sort), with zero weights, none of band-core modulation or all, against the union
+    levels or levels read off them (as a response moves them): the same medians."""
+    rng = np.random.default_rng(seed)
+    levels = np.array(union_levels(*stairs))
+    if nudge:
+        levels = np.sort(wrap(levels + rng.normal(0, 0.05, levels.size)))
+    theta = levels[rng.integers(0, levels.size, n)] + rng.choice(
+        [0.0, 0.05, -0.05, 0.2, np.pi / levels.size], n) * (rng.random(n) < 0.7)
+    theta = np.where(rng.random(n) < 0.3, rng.uniform(-np.pi, np.pi, n), theta)
+    radius = rng.choice([1.0, 0.5, 3.0], n)
+    weight = rng.choice([0.0, 1.0, 2.5, 7.0], n) * rng.choice([1.0, rng.random()], n)
+    level = rng.choice([0.0, 0.69, 0.7, 1.0, rng.uniform(0, 2)], n)
+    one = np.ones(n)
+    prof = RowProfiles(np.arange(n), np.arange(n), radius * np.cos(theta),
+                       radius * np.sin(theta), weight, level, one, one)
+    offset, per_level = response.level_offsets(prof, levels)
+    want_offset, want_per_level = level_offsets(prof, levels)
+    assert type(offset) is float and offset == want_offset
+    assert per_level.dtype == want_per_level.dtype
+    assert np.array_equal(per_level, want_per_level)
+
+
+def random_profiles(rng: np.random.Generator, n: int, regions: int) -> RowProfiles:
+    """Row profiles sorted by region, then row (as a decode makes them), each (region,
+    row) once: pixel counts from 1, column sums, region 0 among them."""
+    region = np.sort(rng.integers(0, regions + 1, n))
+    row = np.zeros(n, np.int64)
+    for r in np.unique(region):
+        at = np.flatnonzero(region == r)
+        row[at] = np.sort(rng.choice(4 * n + 8, at.size, replace=False))
+    count = rng.integers(1, 300, n)
+    one = np.ones(n)
+    return RowProfiles(region, row, one, one, one, one, count,
+                       count * rng.uniform(0, 1279, n))
+
+
+@PROPERTY
+@given(n=st.integers(0, 200), seed=st.integers(0, 2**16), regions=st.integers(0, 12))
+def test_profile_centroids_are_numpys(n, seed, regions):
+    """Regions without entries, region 0, one entry, many: the same centroids."""
+    prof = random_profiles(np.random.default_rng(seed), n, regions)
+    got = profiles.profile_centroids(prof, regions)
+    want = profile_centroids(prof, regions)
+    assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+@PROPERTY
+@given(n=st.integers(0, 200), seed=st.integers(0, 2**16), regions=st.integers(1, 12),
+       count=st.integers(0, 5), shuffled=st.booleans())
+def test_split_profiles_are_numpys(n, seed, regions, count, shuffled):
+    """Splits of a region once or twice (its middle then its tail), at its first row, past
+    its last, of regions without entries; the profiles out of order too (the lexsort
+    decides there): the same profiles, in the same order."""
+    rng = np.random.default_rng(seed)
+    prof = random_profiles(rng, n, regions)
+    if shuffled and n:
+        prof = RowProfiles(*(v[rng.permutation(n)] for v in prof.__dict__.values()))
+    splits = [(int(rng.integers(1, regions + 1)), int(rng.integers(0, 4 * n + 9)))
+              for _ in range(count)]
+    got = evidence.split_profiles(prof, regions, splits)
+    want = split_profiles(prof, regions, splits)
+    for key, value in want.__dict__.items():
+        have = getattr(got, key)
+        assert have.dtype == value.dtype and np.array_equal(have, value), key
+
+
+@pytest.mark.parametrize(("scene", "noise"), RENDERS, ids=[f"{s}-{n}" for s, n in RENDERS])
+def test_label_space_of_decoded_renders(scene, noise, monkeypatch):
+    """The decodes' own row profiles (a response left uncompensated among them: levels
+    squeezed together; regions split) read as NumPy read them: level offsets, centroids,
+    split profiles; and the decode the same with the NumPy."""
+    from test_regions_jit import render
+
+    images, spec = render(scene, "bidirectional", noise)
+    if scene == "warp0":  # a gamma of 2.2 nothing compensates
+        images = images ** 2.2
+    oracles = {"level_offsets": level_offsets, "profile_centroids": profile_centroids,
+               "split_profiles": split_profiles}
+    seen = {name: [] for name in oracles}
+    for name in oracles:
+        compiled = getattr(bidirectional, name)
+
+        def watch(*args, name=name, compiled=compiled):
+            seen[name].append(args)
+            return compiled(*args)
+
+        monkeypatch.setattr(bidirectional, name, watch)
+    new = bistair.decode(images, spec, force=True)
+    assert len(seen["level_offsets"]) == 1 and seen["level_offsets"][0][0].region.size > 500
+    assert seen["profile_centroids"] and (seen["split_profiles"] or scene.startswith("warp"))
+    offset, per_level = response.level_offsets(*seen["level_offsets"][0])
+    want_offset, want_per_level = level_offsets(*seen["level_offsets"][0])
+    assert offset == want_offset and np.array_equal(per_level, want_per_level)
+    for args in seen["profile_centroids"]:
+        assert np.array_equal(profiles.profile_centroids(*args), profile_centroids(*args))
+    for args in seen["split_profiles"]:
+        got, want = evidence.split_profiles(*args), split_profiles(*args)
+        assert all(np.array_equal(getattr(got, k), v) for k, v in want.__dict__.items())
+    for name, oracle in oracles.items():
+        monkeypatch.setattr(bidirectional, name, oracle)
     old = bistair.decode(images, spec, force=True)
     assert np.array_equal(new.order, old.order) and new.info == old.info

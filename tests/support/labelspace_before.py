@@ -69,3 +69,53 @@ def drop_transitions(runs: Runs) -> Runs:
     runs.top_ok = runs.top_ok & ~np.r_[False, top_end[:-1]]
     runs.bottom_ok = runs.bottom_ok & ~np.r_[bottom_end[1:], False]
     return runs.take(~drop)
+
+
+def level_offsets(prof, levels: np.ndarray) -> tuple[float, np.ndarray]:
+    """``response.level_offsets`` in NumPy (main at ec6b88d): the weighted median share of
+    half a level gap the band-core rows read from their nearest level, over all of them and
+    per level."""
+    from bistair.core.stair import half_gaps
+
+    theta = np.arctan2(prof.sin, prof.cos)
+    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
+    per_level = np.zeros(levels.size)
+    if theta.size == 0 or not weight.sum() > 0:
+        return 0.0, per_level
+    nearest = np.abs(wrap(theta[:, None] - levels[None, :])).argmin(axis=1)
+    share = np.abs(wrap(theta - levels[nearest])) / half_gaps(levels)[nearest]
+    order = np.argsort(share)
+    cum = np.cumsum(weight[order])
+    offset = float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
+    grouped = order[np.argsort(nearest[order], kind="stable")]
+    cum = np.cumsum(weight[grouped])
+    first, last = (np.searchsorted(nearest[grouped], np.arange(levels.size), side=side)
+                   for side in ("left", "right"))
+    before = np.where(first > 0, cum[np.maximum(first - 1, 0)], 0.0)
+    total = np.where(last > first, cum[np.maximum(last - 1, 0)], 0.0) - before
+    seen = total > 0
+    at = np.minimum(np.searchsorted(cum, before + 0.5 * total), last - 1)
+    per_level[seen] = share[grouped][at[seen]]
+    return offset, per_level
+
+
+def profile_centroids(prof, n_regions: int) -> np.ndarray:
+    """``profiles.profile_centroids`` in NumPy (main at ec6b88d): three bincounts."""
+    count = np.maximum(np.bincount(prof.region, prof.count, n_regions + 1), 1)
+    rows = np.bincount(prof.region, prof.row * prof.count, n_regions + 1)
+    cols = np.bincount(prof.region, prof.col_sum, n_regions + 1)
+    return np.c_[rows / count, cols / count]
+
+
+def split_profiles(prof, n_regions: int, splits: list[tuple[int, int]]):
+    """``evidence.split_profiles`` in NumPy (main at ec6b88d): the split tails relabelled,
+    then a lexsort by region and row."""
+    from bistair.codecs.bidirectional.profiles import RowProfiles
+
+    region = prof.region.copy()
+    for old, row in sorted(splits, key=lambda s: (s[0], -s[1])):
+        n_regions += 1
+        region[(region == old) & (prof.row >= row)] = n_regions
+    order = np.lexsort((prof.row, region))
+    return RowProfiles(region[order], *(v[order] for k, v in prof.__dict__.items()
+                                        if k != "region"))

@@ -75,10 +75,11 @@ def band_sums(region: np.ndarray, level: np.ndarray, theta: np.ndarray, weight: 
     c = np.zeros(m, np.float64)
     s = np.zeros(m, np.float64)
     w = np.zeros(m, np.float64)
+    ring = _level_ring(levels)
     for i in range(n):
         core[i] = level[i] >= 0.7 * q[i]
         if core[i]:
-            u = _nearest_level(theta[i], levels)
+            u = _nearest_level(theta[i], levels, ring)
             c[u] += weight[i] * math.cos(theta[i])
             s[u] += weight[i] * math.sin(theta[i])
             w[u] += weight[i]
@@ -123,8 +124,9 @@ def band_reads(region: np.ndarray, level: np.ndarray, theta: np.ndarray, core: n
     n, m = region.size, levels.size
     read = np.empty(n, np.int32)
     cores = 0
+    ring = _level_ring(levels)
     for i in range(n):
-        read[i] = _nearest_level(theta[i], levels)
+        read[i] = _nearest_level(theta[i], levels, ring)
         cores += core[i]
     group = np.empty(cores, np.int32)
     values = np.empty(cores, np.float64)
@@ -292,14 +294,50 @@ def nearest_levels(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
     [1, 1, 2, 0]
     """
     out = np.zeros(theta.size, np.int32)
+    ring = _level_ring(levels)
     for i in range(theta.size):
-        out[i] = _nearest_level(theta[i], levels)
+        out[i] = _nearest_level(theta[i], levels, ring)
     return out
 
 
+RING_GAP = 1e-9  # levels this far apart at least (radians) are searched as a ring
+
+
 @_numba_inline
-def _nearest_level(t: float, levels: np.ndarray) -> int:
-    """One phase's :func:`nearest_levels`."""
+def _level_ring(levels: np.ndarray) -> bool:
+    """Whether the levels ascend in [-pi, pi), each at least ``RING_GAP`` from the next
+    around the circle: then the nearest to a phase in [-pi, pi] is one of the two that
+    bracket it (:func:`_nearest_level`)."""
+    m = levels.size
+    if m < 2:
+        return False
+    for j in range(m):
+        if not -math.pi <= levels[j] < math.pi:  # (NaN too)
+            return False
+        if j > 0 and not levels[j] - levels[j - 1] >= RING_GAP:
+            return False
+    return levels[0] + TWO_PI - levels[m - 1] >= RING_GAP
+
+
+@_numba_inline
+def _nearest_level(t: float, levels: np.ndarray, ring: bool) -> int:
+    """One phase's :func:`nearest_levels`.
+
+    On a ring of levels (:func:`_level_ring`) a phase in [-pi, pi] is compared with the two
+    levels that bracket it only, the lower index first (ties go to it, as ``argmin``): any
+    other level lies beyond one of them, at least ``RING_GAP`` farther, far more than the
+    distances' rounding. Otherwise every level, in order.
+    """
+    if ring and -math.pi <= t <= math.pi:
+        m = levels.size
+        hi = 0
+        while hi < m and levels[hi] <= t:
+            hi += 1
+        if hi == 0 or hi == m:  # between the last level and the first, across the wrap
+            a, b = 0, m - 1
+        else:
+            a, b = hi - 1, hi
+        return a if _wrapped_abs(t - levels[a]) <= _wrapped_abs(t - levels[b]) else b
     best = 0
     low = _wrapped_abs(t - levels[0])
     if low != low:

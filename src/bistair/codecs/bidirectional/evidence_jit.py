@@ -284,3 +284,52 @@ def value_changes(uid: np.ndarray, reg: np.ndarray, solid: np.ndarray, merged: n
             out_y[k] = y0[i]
             k += 1
     return out_r[:k], out_y[:k]
+
+
+@kernel()
+def split_order(region: np.ndarray, row: np.ndarray, n_regions: int) -> np.ndarray:
+    """The order of the row profiles by region, then row, after :func:`~.evidence.
+    split_profiles` gave some of their tails new labels above ``n_regions``: a stable
+    counting sort by region, the same as ``np.lexsort((row, region))`` where the entries
+    were sorted by (region before the splits, row), each pair once; that lexsort otherwise
+    (an empty order returned: the caller sorts).
+
+    Parameters
+    ----------
+    region : (n,) int array
+        The entries' regions after the splits, in ``0 ..`` (labels above ``n_regions`` the
+        new ones).
+    row : (n,) int array
+        The entries' rows.
+    n_regions : int
+        The highest label before the splits.
+
+    Returns
+    -------
+    (n,) int64 array
+        The order, or (0,) where the rows of a region do not ascend in entry order.
+
+    Examples
+    --------
+    >>> split_order(np.array([1, 1, 3, 3, 2]), np.array([0, 1, 2, 3, 0]), 2).tolist()
+    [0, 1, 4, 2, 3]
+    """
+    n = region.size
+    m = n_regions + 1
+    for i in range(n):
+        m = max(m, region[i] + 1)
+    last = np.full(m, -1, np.int64)
+    counts = np.zeros(m + 1, np.int64)
+    for i in range(n):
+        r = region[i]
+        if row[i] <= last[r]:  # not ascending within the region: lexsort decides
+            return np.zeros(0, np.int64)
+        last[r] = row[i]
+        counts[r + 1] += 1
+    fill = np.cumsum(counts)[:-1]
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        r = region[i]
+        order[fill[r]] = i
+        fill[r] += 1
+    return order

@@ -571,3 +571,50 @@ def relabel_stair_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
         sums.append(acc)
     return label_major(np.concatenate(starts), np.concatenate(entries),
                        np.concatenate(counts), np.concatenate(sums, axis=1), n_labels)
+
+
+@kernel()
+def profile_centroids(region: np.ndarray, row: np.ndarray, count: np.ndarray,
+                      col_sum: np.ndarray, n_regions: int) -> np.ndarray:
+    """The (row, column) centroid of each region from its row profiles, in one pass: the
+    three ``np.bincount`` sums of :func:`~.profiles.profile_centroids` (pixels, row times
+    pixels, column sums; float64, added in entry order), each over at least one pixel.
+
+    Parameters
+    ----------
+    region, row, count : (n,) int arrays
+        The entries' region (at least 0), row and pixel count.
+    col_sum : (n,) float64 array
+        The entries' sums of column indices.
+    n_regions : int
+        The highest region label (more rows where an entry's region is higher, as
+        ``np.bincount``).
+
+    Returns
+    -------
+    (max(n_regions, max(region)) + 1, 2) float64 array
+        The centroids (0, 0 for a region without pixels).
+
+    Examples
+    --------
+    >>> profile_centroids(np.array([1, 1]), np.array([0, 1]), np.array([2, 2]),
+    ...                   np.array([1.0, 1.0]), 2).tolist()
+    [[0.0, 0.0], [0.5, 0.5], [0.0, 0.0]]
+    """
+    m = n_regions + 1
+    for i in range(region.size):
+        m = max(m, region[i] + 1)
+    pixels = np.zeros(m, np.float64)
+    rows = np.zeros(m, np.float64)
+    cols = np.zeros(m, np.float64)
+    for i in range(region.size):
+        r = region[i]
+        pixels[r] += np.float64(count[i])
+        rows[r] += np.float64(row[i] * count[i])
+        cols[r] += col_sum[i]
+    out = np.empty((m, 2), np.float64)
+    for r in range(m):
+        c = max(pixels[r], 1.0)
+        out[r, 0] = rows[r] / c
+        out[r, 1] = cols[r] / c
+    return out

@@ -33,8 +33,9 @@ from ...core.stair import (
     level_table,
 )
 from ...core.stair_jit import relinearize32
-from .bands import Runs, nearest_level, union_levels
+from .bands import Runs, union_levels
 from .profiles import RowProfiles
+from .response_jit import level_shares, weighted_medians
 
 if TYPE_CHECKING:
     from . import BidirectionalSpec
@@ -186,29 +187,16 @@ def level_offsets(prof: RowProfiles, levels: np.ndarray) -> tuple[float, np.ndar
     (0.127, [0.0, 0.127, 0.127, 0.255])
     """
     theta = np.arctan2(prof.sin, prof.cos)
-    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0)
-    per_level = np.zeros(levels.size)
+    weight = np.where(np.asarray(prof.level) >= 0.7, prof.weight, 0.0).astype(np.float64)
     if theta.size == 0 or not weight.sum() > 0:
-        return 0.0, per_level
-    # the nearest level's index as argmin gives it, compiled: NumPy's argmin and min over
-    # a (rows, levels) array take milliseconds along so short an axis
-    nearest = nearest_level(theta, levels)
-    share = np.abs(wrap(theta - levels[nearest])) / half_gaps(levels)[nearest]
-    order = np.argsort(share)
-    cum = np.cumsum(weight[order])
-    offset = float(share[order][np.searchsorted(cum, 0.5 * cum[-1])])
-    # per level: the rows grouped by level, each group's shares ascending; a group's
-    # weighted median is where the running weight passes half of the group's
-    grouped = order[np.argsort(nearest[order], kind="stable")]
-    cum = np.cumsum(weight[grouped])
-    first, last = (np.searchsorted(nearest[grouped], np.arange(levels.size), side=side)
-                   for side in ("left", "right"))
-    before = np.where(first > 0, cum[np.maximum(first - 1, 0)], 0.0)
-    total = np.where(last > first, cum[np.maximum(last - 1, 0)], 0.0) - before
-    seen = total > 0
-    at = np.minimum(np.searchsorted(cum, before + 0.5 * total), last - 1)
-    per_level[seen] = share[grouped][at[seen]]
-    return offset, per_level
+        return 0.0, np.zeros(levels.size)
+    # compiled (response_jit): the nearest levels and shares, then the medians of the rows
+    # in NumPy's sort of the shares; the NumPy they replaced is tests/support's oracle
+    levels = np.asarray(levels, np.float64)
+    nearest, share = level_shares(np.asarray(theta, np.float64), levels, half_gaps(levels))
+    offset, per_level = weighted_medians(np.argsort(share), share, nearest, weight,
+                                         levels.size)
+    return float(offset), per_level
 
 
 def doubtful_regions(runs: Runs, n_regions: int, doubtful: np.ndarray) -> np.ndarray:
