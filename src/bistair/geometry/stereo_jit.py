@@ -251,6 +251,32 @@ def _along(row: np.ndarray, x: float) -> float:
 
 
 @_numba_inline
+def _bridged(xs: np.ndarray, vs: np.ndarray, k: int, e: int, n: int) -> bool:
+    """Whether samples ``e - 1`` and ``e`` (``k``: the run's first) may be joined across the
+    columns between them: always beside each other; across a gap, where the step is what
+    the slope on either side (the neighbours beside each, where there are) carries over
+    the gap, within half a column's worth of it. A surface's own pixels left out (dim, at
+    a code edge) keep its slope; where the gap hides a step of two surfaces (a camera's
+    view of one object's edge, the other camera seeing a strip of the surface behind it),
+    interpolating across it would give that strip matches it has not."""
+    g = xs[e] - xs[e - 1]
+    if g <= 1:
+        return True
+    total = 0.0
+    count = 0
+    if e - 2 >= k and xs[e - 1] - xs[e - 2] == 1:
+        total += vs[e - 1] - vs[e - 2]
+        count += 1
+    if e + 1 < n and xs[e + 1] - xs[e] == 1:
+        total += vs[e + 1] - vs[e]
+        count += 1
+    if count == 0:
+        return True  # no slope beside it: judged by the jump alone
+    slope = total / count
+    return abs(vs[e] - vs[e - 1] - g * slope) <= 0.5 * abs(slope) * g
+
+
+@_numba_inline
 def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray,
           begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
           hints: np.ndarray) -> int:
@@ -270,7 +296,8 @@ def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray
         e = k + 1
         rising = 1
         while e < n and xs[e] - xs[e - 1] <= gap and (
-                abs(vs[e] - vs[e - 1]) <= jump * (xs[e] - xs[e - 1])):
+                abs(vs[e] - vs[e - 1]) <= jump * (xs[e] - xs[e - 1])) and (
+                _bridged(xs, vs, k, e, n)):
             rising = rising if vs[e] > vs[e - 1] else 0
             e += 1
         if e - k >= 2:
