@@ -159,3 +159,16 @@ def test_band_rows_that_read_at_random_are_refused_and_force_decodes(tmp_path):
     both = (order >= 0) & known
     truth = np.floor(traced.truth.coord_x / 16)
     assert np.mean(order[both] != truth[both]) > 0.3  # the refusal is right
+
+
+@pytest.mark.parametrize(("levels", "gamma"), [(12, 2.2), (8, 2.8)])
+def test_the_misfit_check_reads_levels_a_gamma_moved(levels, gamma):
+    """An uncompensated gamma moves the stair phases 0.70 (12 x 12 at 2.2) and 0.79 (8 x 8
+    at 2.8) of the way to halfway between the code's levels, past the misfit check's 0.7:
+    the check judges them against where the levels read through the fitted response (0.01)
+    and the decode reads every order right, where it refused the captures."""
+    spec = bistair.make_spec("bidirectional", width=levels * levels * 4, height=96, period=4,
+                             partitions=levels, stairs=levels, group_rows=16, local_rows=10)
+    res = bistair.decode(bistair.encode(spec) ** gamma, spec)
+    want = np.arange(spec.width // 4).repeat(4)[None, :].repeat(96, axis=0)
+    assert res.mask.mean() > 0.9 and np.array_equal(res.order[res.mask], want[res.mask])

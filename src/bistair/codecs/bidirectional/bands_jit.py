@@ -516,6 +516,12 @@ def transitions(uid: np.ndarray, length: np.ndarray, theta: np.ndarray, top_ok: 
     any : bool
         Whether any run is dropped (else the other arrays are the inputs' values).
 
+    Raises
+    ------
+    IndexError
+        The last run an inner transition (its half for the run below has nowhere to go), as
+        ``np.add.at`` raised.
+
     Examples
     --------
     >>> uid, length = np.int32([1, 2, 3]), np.array([10.0, 2.0, 10.0])
