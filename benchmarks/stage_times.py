@@ -28,7 +28,7 @@ PATTERNS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("checks: do the captures fit the spec", (
         "bistair.core.checks*:*", "bistair.codecs.base:shift_order_problem",
         "bistair.codecs.base:check_convention", "bistair.codecs.graycode:_second_period_check",
-        "bistair.codecs.bidirectional.stairs:stair_fit",
+        "bistair.codecs.bidirectional.stairs:stair_fit", "bistair.codecs.bidirectional:_misfit",
         "bistair.codecs.bidirectional.stairs:grid_sample",
         "bistair.codecs.bidirectional.stairs_jit:stair_agreement",
         "bistair.core.captures:check_*")),
