@@ -30,50 +30,6 @@ from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, relabel, wrap_lin
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
 
-def _link_cuts(a: np.ndarray, b: np.ndarray, va: np.ndarray, vb: np.ndarray, cut: float,
-               sigma: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For the links between pixels ``a`` and ``b``: (connected, drop_a, drop_b).
-
-    A wrap link drops its high-phase end, a phase step both ends, so that 4-connected
-    components of the pixels kept never cross a cut link. With ``sigma`` (the noise of each
-    link's phase difference, for links along the rows), a run of links whose phase falls
-    by more than four sigma is a step too.
-    """
-    raw = b - a
-    both = va & vb
-    wrap = both & (np.abs(raw) > np.pi)
-    step = both & ~wrap & (np.abs(raw) > cut)
-    if sigma is not None:
-        step |= _backward_runs(raw, both & ~wrap & ~step, sigma)
-    connected = both & ~wrap & ~step
-    return connected, (wrap & (raw <= 0)) | step, (wrap & (raw > 0)) | step
-
-
-def _backward_runs(raw: np.ndarray, ok: np.ndarray, sigma: np.ndarray) -> np.ndarray:
-    """Links in runs (along each row) where the phase falls by more than noise explains.
-
-    Blur spreads the fall where two surfaces meet over a few pixels, so the test is on the
-    whole run of falling links, not on each. A run's fall is the difference of its end
-    pixels, whose noise does not grow with the run's length.
-    """
-    falling = (ok & (raw < 0)).ravel()
-    start = falling.copy()
-    start[1:] &= ~falling[:-1]
-    start[::raw.shape[1]] = falling[::raw.shape[1]]  # runs do not cross rows
-    run = np.cumsum(start) - 1
-    idx = np.flatnonzero(falling)
-    if idx.size == 0:
-        return np.zeros(raw.shape, bool)
-    n_runs = int(run[idx[-1]]) + 1
-    drop = np.bincount(run[idx], -raw.ravel()[idx], n_runs)
-    noise = np.zeros(n_runs)
-    np.maximum.at(noise, run[idx], np.broadcast_to(sigma, raw.shape).ravel()[idx])
-    bad = drop > np.maximum(0.15, 4.0 * noise)
-    out = np.zeros(falling.size, bool)
-    out[idx] = bad[run[idx]]
-    return out.reshape(raw.shape)
-
-
 def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
                  relative: float = 0.3, half: int = 3) -> tuple[np.ndarray, np.ndarray]:
     """NumPy reference of the period jumps that :func:`~bistair.core.regions_jit.link_bits`
