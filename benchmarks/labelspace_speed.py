@@ -32,37 +32,14 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from regions_speed import SIZES, report, rounds, scene  # the same scene and timing
 
 import bistair
 from bistair.codecs.bidirectional import bands
 from bistair.codecs.bidirectional.bands import Runs
 from bistair.core.jit import set_threads
 from bistair.core.memory import keep_freed_memory
-from bistair.evaluation.speed import CASES, opencv_floor, speed_captures
-
-SIZES = {"1.3": (1024, 1280), "12": (3000, 4000)}
-
-
-def scene(size: str) -> tuple[np.ndarray, bistair.spec.BaseSpec]:
-    """The speed scene's captures for the default decoder, kept in /tmp between runs."""
-    spec = CASES[0].spec()
-    path = Path(f"/tmp/bistair_labelspace_speed_{size}.npy")
-    if path.exists():
-        return np.load(path), spec
-    frames = speed_captures(spec, SIZES[size])
-    np.save(path, frames)
-    return frames, spec
-
-
-def rounds(jobs: dict, count: int, clock) -> dict[str, float]:
-    """The least time of each job over ``count`` interleaved rounds."""
-    best = {k: np.inf for k in jobs}
-    for _ in range(count):
-        for key, job in jobs.items():
-            t0 = clock()
-            job()
-            best[key] = min(best[key], clock() - t0)
-    return best
+from bistair.evaluation.speed import opencv_floor
 
 
 def decode_inputs(frames: np.ndarray, spec) -> tuple[tuple, Runs]:
@@ -194,13 +171,7 @@ def main() -> None:
         jobs = cases(frames, spec)
     for job in jobs.values():  # compiled and warm
         job()
-    best = rounds(jobs, args.rounds, clock)
-    px = frames.shape[1] * frames.shape[2]
-    print(f"bistair {Path(bistair.__file__).parents[1]}, {args.size} MP, {threads} thread(s), "
-          f"{'wall' if args.wall else 'CPU'} time, min of {args.rounds} rounds")
-    for key, t in best.items():
-        print(f"  {key:32s} {1e3 * t:8.2f} ms {1e9 * t / px:7.2f} ns/px "
-              f"{t / best['floor']:7.2f} x floor")
+    report(rounds(jobs, args.rounds, clock), frames, args.size, threads, args.rounds, args.wall)
 
 
 if __name__ == "__main__":

@@ -142,6 +142,17 @@ def rounds(jobs: dict, count: int, clock) -> dict[str, float]:
     return best
 
 
+def report(best: dict[str, float], frames: np.ndarray, size: str, threads: int, count: int,
+           wall: bool) -> None:
+    """Print each job's least time: ms, ns a pixel and the ratio to the ``floor`` job."""
+    px = frames.shape[1] * frames.shape[2]
+    print(f"bistair {Path(bistair.__file__).parents[1]}, {size} MP, {threads} thread(s), "
+          f"{'wall' if wall else 'CPU'} time, min of {count} rounds")
+    for key, t in best.items():
+        print(f"  {key:32s} {1e3 * t:8.2f} ms {1e9 * t / px:7.2f} ns/px "
+              f"{t / best['floor']:7.2f} x floor")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="1.3", choices=sorted(SIZES))
@@ -163,13 +174,7 @@ def main() -> None:
         jobs = cases(frames, spec)
     for job in jobs.values():  # compiled and warm
         job()
-    best = rounds(jobs, args.rounds, clock)
-    px = frames.shape[1] * frames.shape[2]
-    print(f"bistair {Path(bistair.__file__).parents[1]}, {args.size} MP, {threads} thread(s), "
-          f"{'wall' if args.wall else 'CPU'} time, min of {args.rounds} rounds")
-    for key, t in best.items():
-        print(f"  {key:32s} {1e3 * t:8.2f} ms {1e9 * t / px:7.2f} ns/px "
-              f"{t / best['floor']:7.2f} x floor")
+    report(rounds(jobs, args.rounds, clock), frames, args.size, threads, args.rounds, args.wall)
 
 
 if __name__ == "__main__":
