@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import BistairError
-from .checks_jit import code_steps, wrap_step_counts
+from .checks_jit import step_sums, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 from .sample import Sample, sample_grid
 from .stair import half_gaps
@@ -227,17 +227,11 @@ def edge_alignment(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray,
     >>> edge_alignment(np.float32(2 * np.pi) - phi, code, ok).reversed  # shifts run backwards
     1.0
     """
-    pa, pb, step = code_steps(phi, edges, valid)  # one pass, no full-size temporaries
-    if pa.size == 0:
+    count, zc, zs, against = step_sums(phi, edges, valid, edge_phase, levels)  # one pass
+    if count == 0:
         return EdgeCheck(0, 0.0, 0.0, 0, 0.0)
-    mid = np.angle(np.exp(1j * pa) + np.exp(1j * pb))  # the phase between the two pixels
-    z = np.exp(1j * (mid - edge_phase)).mean()
-    if levels:
-        step = np.where(step % levels < levels / 2, 1, -1)
-    rise = wrap(pb - pa)
-    against = np.sign(step) != np.sign(rise)  # the phase falls where the code grows
-    return EdgeCheck(int(pa.size), float(wrap(np.angle(z))), float(np.abs(z)), int(pa.size),
-                     float(against.mean()))
+    z = complex(zc, zs) / count
+    return EdgeCheck(count, float(wrap(np.angle(z))), float(abs(z)), count, against / count)
 
 
 def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,

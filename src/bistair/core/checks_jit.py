@@ -91,6 +91,101 @@ def code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
     return _code_steps(phi, edges, np.asarray(valid, bool))
 
 
+@kernel(parallel=True)
+def _step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase: float,
+               levels: int, every: int) -> tuple[int, float, float, int]:
+    h, w = edges.shape
+    rows = (h + every - 1) // every
+    sums = np.zeros((rows, 4), np.float64)
+    half = levels / 2.0
+    for r in prange(rows):
+        y = r * every
+        m = 0
+        against = 0
+        zc = 0.0
+        zs = 0.0
+        e = np.empty(w, np.int64)  # the row's code, -1 where not valid
+        for x in range(w):
+            e[x] = np.int64(edges[y, x]) if valid[y, x] else -1
+        for j in range(w - 3):
+            a = e[j + 1]
+            b = e[j + 2]
+            if a == b or a < 0 or b < 0 or e[j] != a or e[j + 3] != b:
+                continue
+            pa = np.float64(phi[y, j + 1])
+            pb = np.float64(phi[y, j + 2])
+            rise = (pb - pa + math.pi) % (2.0 * math.pi) - math.pi  # wrap(pb - pa)
+            # the phase between the two: angle(exp(i pa) + exp(i pb)), but for 2*pi
+            mid = pa + 0.5 * rise - edge_phase
+            zc += math.cos(mid)
+            zs += math.sin(mid)
+            step = np.int64(b) - np.int64(a)
+            if levels > 0:
+                step = 1 if step % levels < half else -1
+            if not ((step > 0 and rise > 0) or (step < 0 and rise < 0)):
+                against += 1
+            m += 1
+        sums[r, 0] = m
+        sums[r, 1] = zc
+        sums[r, 2] = zs
+        sums[r, 3] = against
+    count = 0
+    zc = 0.0
+    zs = 0.0
+    against = 0
+    for r in range(rows):
+        count += np.int64(sums[r, 0])
+        zc += sums[r, 1]
+        zs += sums[r, 2]
+        against += np.int64(sums[r, 3])
+    return count, zc, zs, against
+
+
+def step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase: float = 0.0,
+              levels: int | None = None, every: int = 1) -> tuple[int, float, float, int]:
+    """What :func:`~bistair.core.checks.edge_alignment` needs of the code steps of
+    :func:`code_steps` (on every ``every``-th row), summed in one pass with no list of the
+    steps: their count, the sums of the cosine and sine of the phase between the two pixels
+    of each less ``edge_phase``, and how many steps the phase falls across where the code
+    grows (a step of a code of ``levels`` values grows when it is less than half a cycle,
+    modulo ``levels``). The phase between ``pa`` and ``pb`` is ``pa + wrap(pb - pa) / 2``,
+    ``angle(exp(i pa) + exp(i pb))`` but for a whole turn, with one sine and cosine a step
+    instead of seven trigonometric calls; the sums are added row by row. Against NumPy on
+    :func:`code_steps`' arrays: the counts the same, the sums within 1e-12 per step.
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    edges : (H, W) int array
+        The code per pixel, -1 where not read.
+    valid : (H, W) bool array
+        Pixels whose phase counts (the others read as -1).
+    edge_phase : float
+        The wrapped phase (radians) at which the code's edges should sit.
+    levels : int, optional
+        The code's cycle, if it has one.
+    every : int
+        Judge every ``every``-th row (from the first).
+
+    Returns
+    -------
+    count : int
+    cos_sum, sin_sum : float
+    against : int
+
+    Examples
+    --------
+    >>> phi = np.float32([[0.1, 0.2, 0.3, 0.4, 0.5, 0.6]])
+    >>> code = np.int32([[1, 1, 2, 2, 2, 5]])
+    >>> n, c, s, against = step_sums(phi, code, np.ones((1, 6), bool))
+    >>> n, round(c, 4), round(s, 4), against
+    (1, 0.9689, 0.2474, 0)
+    """
+    return _step_sums(phi, edges, np.asarray(valid, bool), float(edge_phase),
+                      int(levels or 0), int(every))
+
+
 @kernel()
 def _wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: int,
                 reach: int) -> tuple[int, int, int]:

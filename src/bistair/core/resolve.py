@@ -19,19 +19,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import cv2
 import numpy as np
-from scipy import ndimage, sparse
+from scipy import sparse
 from scipy.sparse import csgraph
 
+from .parts import Agreement, split_parts
 from .regions import RegionLinks, fill_orders, fringe_direction, region_links
 from .resolve_jit import (
-    dense_tile,
     label_code_votes,
     label_orders,
     pass_messages,
-    pixel_orders,
-    window_seeds,
 )
 from .split import adopt_demanded, contradicted_regions, split_contradicted
 
@@ -186,7 +183,6 @@ def jump_violations(links: RegionLinks, region_order: np.ndarray) -> tuple[int, 
 
 
 Evidence = Callable[[np.ndarray, int], tuple[np.ndarray, int, np.ndarray]]
-Agreement = Callable[[np.ndarray], np.ndarray]
 
 
 def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
@@ -202,7 +198,8 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     links (:func:`resolve_regions`); a region whose best order scores below ``min_score`` or
     leads the runner-up by less than ``min_margin`` stays invalid. With ``agrees`` (which
     pixels' own codes fit a given per-pixel order), parts of regions whose codes contradict
-    their region's order are detached and decoded on their own (:func:`split_disagreeing`).
+    their region's order are detached and decoded on their own
+    (:func:`~bistair.core.parts.split_parts`).
     With ``phase_noise``, an undecided region whose decided neighbours demand different
     orders across its wraps is cut in two where its fringe period jumps
     (:func:`~bistair.core.split.split_contradicted`): two surfaces side by side whose phase
@@ -276,7 +273,7 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
                                             contradicted_regions(links, k_reg, faint=faint))
         k_reg = np.concatenate([k_reg, np.full(n - before, -1, k_reg.dtype)])
     if agrees is not None:
-        labels, n, detached = split_disagreeing(labels, n, k_reg, agrees)
+        labels, n, detached = split_parts(labels, n, k_reg, agrees)
     if detached or cut:
         labels, n, evidence = evidence_of(labels, n)
         links = region_links(phi, labels, direction)
@@ -463,98 +460,6 @@ def _decide(evidence: np.ndarray, links: RegionLinks, min_score: float,
     k_reg[(score < min_score) | (margin < min_margin)] = -1
     k_reg[0] = -1
     return k_reg
-
-
-def split_disagreeing(labels: np.ndarray, n: int, k_reg: np.ndarray, agrees: Agreement,
-                      window: int = 7, share: float = 0.7, min_size: int = 30
-                      ) -> tuple[np.ndarray, int, int]:
-    """Detach the parts of regions whose pixels' codes contradict the region's order.
-
-    Where two surfaces meet with a phase step close to a whole number of fringes, a fringe
-    of one joins a fringe of the other into one region, and the larger part's order wins.
-    The smaller part's codes then disagree with it: pixels in a neighbourhood
-    (``window`` x ``window``) where more than ``share`` of the decided pixels disagree seed a
-    part, which grows over the region's other disagreeing pixels. Parts of at least
-    ``min_size`` pixels become regions of their own; smaller ones are left undecided.
-    Returns ``(labels, n, parts detached)``.
-
-    Parameters
-    ----------
-    labels : (H, W) int32 array
-        Fringe regions, 0 outside any.
-    n : int
-        Number of regions.
-    k_reg : (n+1,) int array
-        The order per region, -1 where undecided.
-    agrees : callable
-        ``agrees(order) -> bool array``: the pixels whose own codes fit a per-pixel order
-        (-1 where undecided).
-    window : int
-        Side of the neighbourhood, in pixels.
-    share : float
-        Share of a neighbourhood's decided pixels that must disagree to seed a part.
-    min_size : int
-        Smallest part made a region, in pixels.
-
-    Returns
-    -------
-    labels : (H, W) array
-        The labels with the detached parts numbered from ``n + 1`` and the parts too small
-        set to 0 (a new array once a part is found, else the input itself).
-    n : int
-        The new number of regions.
-    detached : int
-        Parts made regions.
-
-    Examples
-    --------
-    >>> labels = np.ones((20, 40), np.int32)
-    >>> truth = np.where(np.arange(40) < 30, 3, 5)[None].repeat(20, axis=0)
-    >>> new, n, detached = split_disagreeing(labels, 1, np.array([-1, 3]), lambda k: k == truth)
-    >>> n, detached, np.unique(new[:, :30]).tolist(), np.unique(new[:, 30:]).tolist()
-    (2, 1, [1], [2])
-    """
-    k_pix = pixel_orders(labels, np.asarray(k_reg))
-    bad = np.asarray(agrees(k_pix), bool)  # a new array (changed in place below)
-    decided = k_pix >= 0
-    del k_pix
-    bad = np.logical_not(bad, out=bad if bad.flags.writeable else None)
-    bad &= decided
-    if not dense_tile(bad, decided, share, 8):  # a cheap test: no part anywhere
-        return labels, n, 0
-    # the window shares only matter at bad pixels: count them in their bounding box, with a
-    # margin the window cannot see past
-    ys, xs = np.flatnonzero(bad.any(axis=1)), np.flatnonzero(bad.any(axis=0))
-    m = 2 * window
-    box = (slice(max(ys[0] - m, 0), ys[-1] + m + 1), slice(max(xs[0] - m, 0), xs[-1] + m + 1))
-    seeds = np.zeros(bad.shape, bool)
-    close = min(bad[box].shape) < window
-    if not close:
-        seeds[box], close = window_seeds(bad[box], decided[box], window, share)
-    if close:  # a share at the limit: decide as the float32 window means always did
-        num = ndimage.uniform_filter(bad[box].astype(np.float32), window)
-        den = ndimage.uniform_filter(decided[box].astype(np.float32), window)
-        seeds[box] = bad[box] & (num > share * den)
-    if not seeds.any():
-        return labels, n, 0
-    del decided
-    _, parts = cv2.connectedComponents(bad.view(np.uint8), connectivity=4, ltype=cv2.CV_32S)
-    del bad
-    seeded = np.zeros(int(parts.max()) + 1, bool)
-    seeded[parts[seeds]] = True
-    seeded[0] = False
-    del seeds
-    grown = seeded[parts]  # the bad pixels connected to a seed
-    del parts  # (one label image at a time: 4 bytes a pixel each)
-    _, parts = cv2.connectedComponents(grown.view(np.uint8), connectivity=4,
-                                       ltype=cv2.CV_32S)
-    key = parts[grown].astype(np.int64) * (n + 1) + labels[grown]
-    del parts
-    uniq, inv, size = np.unique(key, return_inverse=True, return_counts=True)
-    new = np.where(size >= min_size, n + 1 + np.cumsum(size >= min_size) - 1, 0)
-    labels = labels.copy()
-    labels[grown] = new[inv]
-    return labels, n + int((size >= min_size).sum()), int((size >= min_size).sum())
 
 
 def code_evidence(labels: np.ndarray, n_regions: int, codes: np.ndarray, n_codes: int,

@@ -47,6 +47,7 @@ import numpy as np
 from ...core.captures import Prepared
 from ...core.checks import refuse, stair_misfit, stair_sample, wrap_steps
 from ...core.measure import FringeSet
+from ...core.parts import ALL, windowed
 from ...core.regions import (
     core_weight,
     fringe_direction,
@@ -450,9 +451,11 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
             evidence[doubtful_regions(runs, n, doubt)] *= THIN_DOUBT
         return labels, n, evidence
 
-    def agrees(k: np.ndarray) -> np.ndarray:
-        """A pixel reads its order's local or partition level (its row decides which)."""
-        return stair_agreement(ks, theta, k, spec.stairs, spec.partitions)
+    @windowed
+    def agrees(k: np.ndarray, at: tuple[slice, slice] = ALL) -> np.ndarray:
+        """A pixel of ``image[at]`` reads its order's local or partition level (its row
+        decides which)."""
+        return stair_agreement(ks[at], theta[at], k, spec.stairs, spec.partitions)
 
     # the labels are passed on, not kept here: the decode replaces them as it splits regions
     return orders_from_regions(fs.phi, fs.valid, regions(), evidence_of, agrees, info,
