@@ -9,7 +9,13 @@ right (``bistair.evaluation.metrics.score``), and the share of the image the box
 (the full-resolution work left).
 
     python benchmarks/sampled_parts.py [--seeds 3]
+    python benchmarks/sampled_parts.py --real
     python benchmarks/sampled_parts.py --speed [--size 1.3|12]
+
+``--real`` decodes every real capture in ../shared/data part by part
+(``tests/support/real_parts.py``) and, at each split of a region decoder (whatever its
+agreement: one that judges the whole image alone is judged through :func:`as_windowed`),
+compares the split from the sample with the whole image's.
 
 ``--speed`` times both on the default decode's own inputs (one kernel thread, process CPU
 time, the minimum of interleaved rounds, the OpenCV floor alongside).
@@ -19,7 +25,9 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -45,6 +53,68 @@ def watched_boxes(seen: dict):
         return found
 
     return boxes
+
+
+def as_windowed(agrees):
+    """Any agreement as a :func:`~bistair.core.parts.windowed` one: the orders of
+    ``image[at]`` placed in a whole image of -1 and judged there (as slow as the whole
+    image; for comparisons)."""
+
+    @parts.windowed
+    def windowed(k, at=parts.ALL):
+        full = np.full(shape, -1, k.dtype)
+        full[at] = k
+        return np.asarray(agrees(full), bool)[at]
+
+    shape = None
+
+    def bind(labels_shape):
+        nonlocal shape
+        shape = labels_shape
+        return windowed
+
+    return bind
+
+
+def same_split(labels, n, k_reg, agrees) -> tuple[bool, int]:
+    """Whether ``split_parts`` (through :func:`as_windowed` unless ``agrees`` is windowed)
+    gives what ``split_disagreeing`` gives; and the parts detached."""
+    full = parts.split_disagreeing(labels, n, k_reg, agrees)
+    if not getattr(agrees, "windowed", False):
+        agrees = as_windowed(agrees)(labels.shape)
+    sampled = parts.split_parts(labels, n, k_reg, agrees)
+    same = (np.array_equal(full[0], sampled[0]) and full[1:] == sampled[1:])
+    return same, full[2]
+
+
+def real(names: str = "") -> int:
+    """Every real part's splits compared; returns how many differ."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+    from support.real_parts import parts as real_parts
+
+    from bistair.io.read import read_with_spec
+
+    differ = 0
+    for name, folder, spec, options in real_parts():
+        if names and names not in name:
+            continue
+        seen = []
+
+        def split(labels, n, k_reg, agrees, *args, seen=seen):
+            seen.append(same_split(labels, n, k_reg, agrees))
+            return parts.split_disagreeing(labels, n, k_reg, agrees, *args)
+
+        stack, spec = read_with_spec(folder, spec)
+        resolve.split_parts = split
+        try:
+            bistair.decode(stack, spec, force=True, **options)
+        finally:
+            resolve.split_parts = parts.split_parts
+        differ += sum(not same for same, _ in seen)
+        print(f"{name:40s} splits {len(seen)}: the same {sum(s for s, _ in seen)}, parts "
+              f"detached {[d for _, d in seen]}", flush=True)
+    print(f"splits that differ: {differ}")
+    return differ
 
 
 def quality(seeds: int) -> None:
@@ -128,11 +198,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--speed", action="store_true")
+    parser.add_argument("--real", action="store_true")
     parser.add_argument("--size", default="1.3", choices=("1.3", "12"))
     parser.add_argument("--rounds", type=int, default=10)
     args = parser.parse_args()
     if args.speed:
         speed(args.size, args.rounds)
+    elif args.real:
+        real()
     else:
         quality(args.seeds)
 
