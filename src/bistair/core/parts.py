@@ -230,9 +230,10 @@ def sample_boxes(labels: np.ndarray, k_reg: np.ndarray, agrees: Agreement,
     """Boxes of the image around the parts that disagree on a sample: every
     :data:`STEP`-th row and column, where more than :data:`SAMPLE_SHARE` of a
     :data:`SAMPLE_WINDOW`-pixel neighbourhood's decided pixels disagree (a part of 30 px
-    still shows about 7 pixels there). Each flagged part of the sample (8-connected) gives
-    its bounding box at full resolution with a margin of ``2 * window`` pixels; boxes that
-    overlap are merged.
+    still shows about 7 pixels there; at 0.5, 5 of 400 drawn scenes of ``tests/test_parts.py``
+    lost a part 3 px wide along the image's edge, none at 0.45). Each cluster of flagged
+    sample pixels (8-connected) gives its bounding box at full resolution with a margin of
+    ``2 * window`` pixels; boxes that overlap are merged.
 
     Parameters
     ----------
@@ -256,7 +257,7 @@ def sample_boxes(labels: np.ndarray, k_reg: np.ndarray, agrees: Agreement,
     >>> truth = np.full(labels.shape, 3)
     >>> truth[8:20, 16:28] = truth[40:50, 70:80] = 5
     >>> sample_boxes(labels, np.array([-1, 3]), windowed(lambda k, at=ALL: k == truth[at]))
-    [(0, 34, 4, 42), (28, 64, 58, 94)]
+    [(0, 34, 2, 42), (26, 64, 56, 94)]
     """
     h, w = labels.shape
     bad, decided = _bad(labels, k_reg, agrees, (slice(None, None, STEP),) * 2)
