@@ -36,6 +36,7 @@ Agreement = Callable[..., np.ndarray]
 ALL = (slice(None), slice(None))  # the whole image, as ``at``
 STEP = 2  # the sample: every STEP-th row and column
 SAMPLE_WINDOW = 4  # the sample's neighbourhood, in sample pixels
+TILE = 8  # the sample's seeds are gathered in tiles of TILE x TILE sample pixels
 SAMPLE_SHARE = 0.45  # flags a part on the sample: more than this share of the decided pixels bad
 Box = tuple[int, int, int, int]  # y0, y1, x0, x1 (ends excluded)
 
@@ -257,37 +258,27 @@ def sample_boxes(labels: np.ndarray, k_reg: np.ndarray, agrees: Agreement,
     >>> truth = np.full(labels.shape, 3)
     >>> truth[8:20, 16:28] = truth[40:50, 70:80] = 5
     >>> sample_boxes(labels, np.array([-1, 3]), windowed(lambda k, at=ALL: k == truth[at]))
-    [(0, 34, 2, 42), (26, 64, 56, 94)]
+    [(0, 64, 0, 96)]
     """
     h, w = labels.shape
     bad, decided = _bad(labels, k_reg, agrees, (slice(None, None, STEP),) * 2)
-    ys, xs = np.flatnonzero(bad.any(axis=1)), np.flatnonzero(bad.any(axis=0))
-    if ys.size == 0:
-        return []
-    m = 2 * SAMPLE_WINDOW  # the windows' shares count in the bad pixels' bounding box
-    y0, x0 = max(int(ys[0]) - m, 0), max(int(xs[0]) - m, 0)
-    sub = np.ascontiguousarray(bad[y0:ys[-1] + m + 1, x0:xs[-1] + m + 1])
-    if min(sub.shape) < SAMPLE_WINDOW:
+    if min(bad.shape) < SAMPLE_WINDOW:
         return [(0, h, 0, w)]
-    seeds, _ = window_seeds(sub, decided[y0:y0 + sub.shape[0], x0:x0 + sub.shape[1]],
-                            SAMPLE_WINDOW, SAMPLE_SHARE)
-    if not seeds.any():
+    seeds, _ = window_seeds(bad, decided, SAMPLE_WINDOW, SAMPLE_SHARE)
+    # the seeds' tiles of TILE x TILE sample pixels, each widened by a tile (2 * TILE full
+    # pixels, at least 2 * window): each cluster of those (8-connected) gives a box; a part
+    # seeded in several is made whole at full resolution (split_in_boxes)
+    rows = np.flatnonzero(seeds.any(axis=1))  # (seeds are few: found row by row)
+    if rows.size == 0:
         return []
-    # the seeds that touch (8-connected) make one cluster: its box; a part seeded in
-    # several clusters is made whole at full resolution (split_in_boxes)
-    _, comp = cv2.connectedComponents(seeds.view(np.uint8), connectivity=8, ltype=cv2.CV_32S)
-    ys, xs = np.nonzero(seeds)
-    ids = comp[ys, xs]
-    order = np.argsort(ids, kind="stable")
-    ids, ys, xs = ids[order], ys[order], xs[order]
-    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
-    m = 2 * window
-    boxes = [(max(STEP * (y0 + int(top)) - m, 0), min(STEP * (y0 + int(bottom) + 1) + m, h),
-              max(STEP * (x0 + int(left)) - m, 0), min(STEP * (x0 + int(right) + 1) + m, w))
-             for top, bottom, left, right in zip(np.minimum.reduceat(ys, starts),
-                                                 np.maximum.reduceat(ys, starts),
-                                                 np.minimum.reduceat(xs, starts),
-                                                 np.maximum.reduceat(xs, starts), strict=True)]
+    ry, rx = np.nonzero(seeds[rows])
+    tiles = np.zeros((-(-seeds.shape[0] // TILE), -(-seeds.shape[1] // TILE)), np.uint8)
+    tiles[rows[ry] // TILE, rx // TILE] = 1
+    tiles = cv2.dilate(tiles, np.ones((3, 3), np.uint8))
+    count, _, stats, _ = cv2.connectedComponentsWithStats(tiles, connectivity=8)
+    full = STEP * TILE
+    boxes = [(ty * full, min((ty + bh) * full, h), tx * full, min((tx + bw) * full, w))
+             for tx, ty, bw, bh in (stats[c, :4].tolist() for c in range(1, count))]
     return merge_boxes(boxes)
 
 
