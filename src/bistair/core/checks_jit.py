@@ -104,27 +104,37 @@ def _step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase
         against = 0
         zc = 0.0
         zs = 0.0
-        e = np.empty(w, np.int64)  # the row's code, -1 where not valid
+        e = np.empty(w, np.int32)  # the row's code, -1 where not valid
         for x in range(w):
-            e[x] = np.int64(edges[y, x]) if valid[y, x] else -1
+            e[x] = edges[y, x] if valid[y, x] else -1
+        words = (w + 4) // 8  # the pairs (j+1, j+2) whose code differs: a byte each
+        change = np.zeros(8 * words, np.uint8)
         for j in range(w - 3):
-            a = e[j + 1]
-            b = e[j + 2]
-            if a == b or a < 0 or b < 0 or e[j] != a or e[j + 3] != b:
+            change[j] = e[j + 1] != e[j + 2]
+        packed = change.view(np.uint64)
+        for q in range(words):
+            if packed[q] == 0:  # eight pairs of equal codes
                 continue
-            pa = np.float64(phi[y, j + 1])
-            pb = np.float64(phi[y, j + 2])
-            rise = (pb - pa + math.pi) % (2.0 * math.pi) - math.pi  # wrap(pb - pa)
-            # the phase between the two: angle(exp(i pa) + exp(i pb)), but for 2*pi
-            mid = pa + 0.5 * rise - edge_phase
-            zc += math.cos(mid)
-            zs += math.sin(mid)
-            step = np.int64(b) - np.int64(a)
-            if levels > 0:
-                step = 1 if step % levels < half else -1
-            if not ((step > 0 and rise > 0) or (step < 0 and rise < 0)):
-                against += 1
-            m += 1
+            for j in range(8 * q, 8 * q + 8):
+                if change[j] == 0:
+                    continue
+                a = e[j + 1]
+                b = e[j + 2]
+                if a < 0 or b < 0 or e[j] != a or e[j + 3] != b:
+                    continue
+                pa = np.float64(phi[y, j + 1])
+                pb = np.float64(phi[y, j + 2])
+                rise = (pb - pa + math.pi) % (2.0 * math.pi) - math.pi  # wrap(pb - pa)
+                # the phase between the two: angle(exp(i pa) + exp(i pb)), but for 2*pi
+                mid = pa + 0.5 * rise - edge_phase
+                zc += math.cos(mid)
+                zs += math.sin(mid)
+                step = np.int64(b) - np.int64(a)
+                if levels > 0:
+                    step = 1 if step % levels < half else -1
+                if not ((step > 0 and rise > 0) or (step < 0 and rise < 0)):
+                    against += 1
+                m += 1
         sums[r, 0] = m
         sums[r, 1] = zc
         sums[r, 2] = zs
