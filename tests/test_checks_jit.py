@@ -115,3 +115,27 @@ def test_edge_alignment_sums_in_one_pass_what_numpy_did():
             assert new.reversed == old.reversed
             assert abs(new.spread - old.spread) < 1e-12
             assert abs(np.exp(1j * new.crossing) - np.exp(1j * old.crossing)) < 1e-12
+
+
+def test_stair_misfit_in_one_pass_is_numpys():
+    """stair_misfit's compiled distances (level_misfits) give the median NumPy's
+    (n, L) distances, argmin and division gave, bit for bit: levels as made and as a
+    response moves them, phases on the levels, halfway and at +-pi."""
+    from bistair.codecs.bidirectional.bands import union_levels
+    from bistair.core.checks import stair_misfit
+    from bistair.core.phase import wrap
+    from bistair.core.stair import half_gaps
+
+    for partitions, stairs in ((8, 8), (12, 12), (3, 4), (5, 7)):
+        levels = union_levels(partitions, stairs)
+        for moved in (levels, levels + RNG.normal(0, 0.05, levels.size)):
+            theta = RNG.uniform(-np.pi, np.pi, (70, 90)).astype(np.float32)
+            theta.flat[:levels.size] = moved
+            theta.flat[-3:] = [np.pi, -np.pi, (moved[0] + moved[1]) / 2]
+            valid = RNG.random(theta.shape) < 0.8
+            t = theta[valid]
+            t = t[:: max(1, -(-t.size // 20000))].astype(np.float64)
+            d = np.abs(wrap(t[:, None] - moved[None, :]))
+            nearest = d.argmin(axis=1)
+            want = np.median(d[np.arange(t.size), nearest] / half_gaps(moved)[nearest])
+            assert stair_misfit(theta, valid, moved) == want

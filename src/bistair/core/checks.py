@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import BistairError
-from .checks_jit import step_sums, wrap_step_counts
+from .checks_jit import level_misfits, step_sums, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 from .sample import Sample, sample_grid
 from .stair import half_gaps
@@ -663,9 +663,8 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     t = t[:: max(1, -(-t.size // 20000))].astype(np.float64)  # plenty for a median
     if t.size == 0:
         return 0.0
-    d = np.abs(wrap(t[:, None] - levels[None, :]))
-    nearest = d.argmin(axis=1)
-    return float(np.median(d[np.arange(t.size), nearest] / half_gaps(levels)[nearest]))
+    levels = np.asarray(levels, np.float64)
+    return float(np.median(level_misfits(t, levels, half_gaps(levels))))  # one pass
 
 
 def stair_sample(sample: Sample | None, theta: np.ndarray, valid: np.ndarray

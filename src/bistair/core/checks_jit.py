@@ -197,6 +197,50 @@ def step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase:
 
 
 @kernel()
+def level_misfits(theta: np.ndarray, levels: np.ndarray, half: np.ndarray) -> np.ndarray:
+    """Each stair phase's distance from its nearest level (the first of equal ones), over
+    half that level's gap (:func:`~bistair.core.checks.stair_misfit`'s values): as NumPy's
+    ``abs(wrap(theta[:, None] - levels[None, :]))``, ``argmin`` and division give them, in
+    one pass with no (n, L) temporaries.
+
+    Parameters
+    ----------
+    theta : (n,) float64 array
+        Stair phases in radians.
+    levels : (L,) float64 array
+        The levels' phases.
+    half : (L,) float64 array
+        Half of each level's gap to its neighbour.
+
+    Returns
+    -------
+    (n,) float64 array
+
+    Examples
+    --------
+    >>> level_misfits(np.array([0.1, 1.0, -2.0]), np.array([-2.0, 0.0, 2.0]),
+    ...               np.ones(3)).round(3).tolist()
+    [0.1, 1.0, 0.0]
+    """
+    n = theta.size
+    out = np.empty(n, np.float64)
+    for i in range(n):
+        best = np.inf
+        at = 0
+        for j in range(levels.size):
+            d = abs((theta[i] - levels[j] + math.pi) % (2.0 * math.pi) - math.pi)
+            if d != d:  # NaN: argmin's first NaN
+                best = d
+                at = j
+                break
+            if d < best:
+                best = d
+                at = j
+        out[i] = best / half[at]
+    return out
+
+
+@kernel()
 def _wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: int,
                 reach: int) -> tuple[int, int, int]:
     h, w = phi.shape
