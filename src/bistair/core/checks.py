@@ -663,7 +663,7 @@ def stair_misfit(theta: np.ndarray, valid: np.ndarray, levels: np.ndarray) -> fl
     t = t[:: max(1, -(-t.size // 20000))].astype(np.float64)  # plenty for a median
     if t.size == 0:
         return 0.0
-    levels = np.asarray(levels, np.float64)
+    levels = np.array(levels, np.float64)  # (a copy: the kernel takes writable arrays)
     return float(np.median(level_misfits(t, levels, half_gaps(levels))))  # one pass
 
 
