@@ -232,9 +232,10 @@ def sample_boxes(labels: np.ndarray, k_reg: np.ndarray, agrees: Agreement,
     :data:`STEP`-th row and column, where more than :data:`SAMPLE_SHARE` of a
     :data:`SAMPLE_WINDOW`-pixel neighbourhood's decided pixels disagree (a part of 30 px
     still shows about 7 pixels there; at 0.5, 5 of 400 drawn scenes of ``tests/test_parts.py``
-    lost a part 3 px wide along the image's edge, none at 0.45). Each cluster of flagged
-    sample pixels (8-connected) gives its bounding box at full resolution with a margin of
-    ``2 * window`` pixels; boxes that overlap are merged.
+    lost a part 3 px wide along the image's edge, none at 0.45). The flagged pixels' tiles
+    of :data:`TILE` x :data:`TILE` sample pixels, each widened by one tile (at least
+    ``2 * window`` full-resolution pixels), give a box per cluster of tiles (8-connected);
+    boxes that overlap are merged.
 
     Parameters
     ----------
@@ -245,7 +246,7 @@ def sample_boxes(labels: np.ndarray, k_reg: np.ndarray, agrees: Agreement,
     agrees : callable
         A :func:`windowed` agreement.
     window : int
-        The full-resolution neighbourhood (for the margin).
+        The full-resolution neighbourhood (the margin must reach ``2 * window``).
 
     Returns
     -------
