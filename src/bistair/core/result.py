@@ -23,30 +23,38 @@ import numpy as np
 from ..hooks import call
 from ..spec import BaseSpec
 from .measure import FringeSet
-from .result_jit import assemble
+from .result_jit import assemble, coord_factor
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 # the arrays a decode writes as NAME.npy (DecodeResult.arrays)
 ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")
+# the per-pixel arrays of a DecodeResult, as its constructor names them (coord: None when
+# it is computed from the phase)
+PIXEL_FIELDS = ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")
 
 
-@dataclass
+@dataclass(init=False)
 class DecodeResult:
     """Absolute phase and everything needed to judge it, per camera pixel.
 
     Attributes
     ----------
     phase : float32, absolute phase ``Phi = 2*pi*x_p/T`` (NaN where invalid).
-    coord : float32, projector coordinate ``x_p`` along the coded axis (NaN where invalid).
+    coord : float32, projector coordinate ``x_p`` along the coded axis (NaN where invalid):
+        computed from ``phase`` when asked for, ``phase * float32(period / (2*pi))`` (a new
+        array each time: read it once), unless the result was made with one.
     order : int32, fringe order ``floor(x_p/T)`` (-1 where invalid).
     wrapped : float32, wrapped phase in ``[0, 2*pi)`` (NaN where the modulation is too low).
     modulation : float32, fringe modulation ``B`` as a fraction of full scale.
     average : float32, average intensity ``A`` as a fraction of full scale.
     mask : bool, pixels with a valid absolute phase.
-    code : int32, the method's decoded code word per pixel (``k_s`` for stair methods;
-        -1 where not decoded), for previews and diagnosis.
+    code : the method's decoded code word per pixel (``k_s`` for stair methods; -1 where
+        not decoded), for previews and diagnosis; from a decode, the smallest of int8,
+        int16 and int32 that holds every code word the spec allows (int8 for up to 127
+        fringes: :func:`code_dtype`), so widen it before integer arithmetic
+        (``code.astype(int) * period``: int8 wraps around past 127).
     period : projector pixels per fringe of ``phase`` and ``order``.
     method : the codec's name.
     info : figures about the decode (thresholds, counts, consistency checks).
@@ -54,12 +62,13 @@ class DecodeResult:
     spec : the spec the captures were decoded with (set by :func:`bistair.decode`), for
         :func:`bistair.reconstruct`.
 
-    ``repr`` is one line (method, shape, valid share, noise); :meth:`save` writes what
-    ``bistair decode`` writes, :meth:`plot` draws the six-panel figure.
+    A decode holds 22 bytes per camera pixel (phase, order, wrapped, modulation, average:
+    4 each; mask and an int8 code: 1 each). ``repr`` is one line (method, shape, valid
+    share, noise); :meth:`save` writes what ``bistair decode`` writes, :meth:`plot` draws
+    the six-panel figure.
     """
 
     phase: np.ndarray
-    coord: np.ndarray
     order: np.ndarray
     wrapped: np.ndarray
     modulation: np.ndarray
@@ -71,6 +80,31 @@ class DecodeResult:
     info: dict[str, Any] = field(default_factory=dict)
     texture: np.ndarray | None = None  # the white frame if the spec has one (camera axes)
     spec: BaseSpec | None = None  # the spec it was decoded with, if known
+    _coord: np.ndarray | None = field(default=None, repr=False)  # else from the phase
+
+    def __init__(self, phase: np.ndarray, coord: np.ndarray | None, order: np.ndarray,
+                 wrapped: np.ndarray, modulation: np.ndarray, average: np.ndarray,
+                 mask: np.ndarray, code: np.ndarray, period: float, method: str,
+                 info: dict[str, Any] | None = None, texture: np.ndarray | None = None,
+                 spec: BaseSpec | None = None) -> None:
+        self.phase, self.order, self.wrapped = phase, order, wrapped
+        self.modulation, self.average, self.mask, self.code = modulation, average, mask, code
+        self.period, self.method = period, method
+        self.info = {} if info is None else info
+        self.texture, self.spec = texture, spec
+        self._coord = coord  # None: computed from the phase when asked for
+
+    @property
+    def coord(self) -> np.ndarray:
+        """Projector coordinate per camera pixel (float32, NaN where invalid): the one given
+        to the constructor, else ``phase * float32(period / (2*pi))``, computed anew."""
+        if self._coord is not None:
+            return self._coord
+        return np.multiply(self.phase, coord_factor(self.period), dtype=np.float32)
+
+    @coord.setter
+    def coord(self, value: np.ndarray | None) -> None:
+        self._coord = value
 
     def __repr__(self) -> str:
         return f"DecodeResult({_summary(self, f'{_share(self.mask)} valid')})"
@@ -91,8 +125,10 @@ class DecodeResult:
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
-        swap = {name: np.ascontiguousarray(getattr(self, name).T) for name in
-                ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
+        arrays = {name: self._coord if name == "coord" else getattr(self, name)
+                  for name in PIXEL_FIELDS}
+        swap = {name: None if a is None else np.ascontiguousarray(a.T)
+                for name, a in arrays.items()}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
                             texture=self.texture, spec=self.spec)
 
@@ -201,8 +237,9 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
         Fringe modulation ``B`` (fraction of full scale).
     average : (H, W) array, optional
         Average intensity ``A`` (fraction of full scale); zeros when not given.
-    code : (H, W) int32 array, optional
-        The method's decoded code word per pixel; -1 everywhere when not given.
+    code : (H, W) int array, optional
+        The method's decoded code word per pixel, kept as given; -1 everywhere (int8) when
+        not given.
     wrapped : (H, W) array, optional
         The wrapped phase to report (NaN where the modulation is too low); ``phi`` when not
         given.
@@ -215,9 +252,9 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
     Returns
     -------
     DecodeResult
-        Absolute phase ``phi + 2*pi*order`` and projector coordinate ``phase * period /
-        (2*pi)`` (float32, NaN where invalid), order (int32, -1 where invalid) and the mask
-        of valid pixels.
+        Absolute phase ``phi + 2*pi*order`` (float32, NaN where invalid; the projector
+        coordinate is ``phase * float32(period / (2*pi))``), order (int32, -1 where
+        invalid) and the mask of valid pixels.
 
     Examples
     --------
@@ -234,27 +271,71 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
 def _make(method: str, phi: np.ndarray, order: np.ndarray, period: float,
           modulation: np.ndarray, average: np.ndarray | None, code: np.ndarray | None,
           wrapped: np.ndarray | None, valid: np.ndarray | None, info: dict[str, Any] | None,
-          length: float | None) -> DecodeResult:
+          length: float | None, reuse: bool = False) -> DecodeResult:
     """:func:`make_result`; with ``valid`` (and no ``wrapped``), the wrapped phase reported is
-    ``phi`` where valid, NaN elsewhere."""
-    phase, coord, out_order, phi_out, mask, outside = assemble(phi, np.asarray(order), period,
-                                                               length, valid)
+    ``phi`` where valid, NaN elsewhere; with ``reuse``, ``phi`` and ``order`` are written
+    over (:func:`~bistair.core.result_jit.assemble`)."""
+    phase, out_order, phi_out, mask, outside = assemble(phi, order, period, length, valid,
+                                                        reuse=reuse)
     if wrapped is not None:
         phi_out = np.asarray(wrapped).astype(np.float32)
     return DecodeResult(
-        phase=phase, coord=coord, order=out_order, wrapped=phi_out,
+        phase=phase, coord=None, order=out_order, wrapped=phi_out,
         modulation=np.asarray(modulation, np.float32),
         average=(np.zeros_like(phase) if average is None
                  else np.asarray(average).astype(np.float32, copy=False)),
-        mask=mask, code=(np.full(phase.shape, -1, np.int32) if code is None else code),
+        mask=mask, code=(np.full(phase.shape, -1, np.int8) if code is None else code),
         period=float(period), method=method,
         info={**(info or {}), **({"outside_projector": outside} if outside else {})},
     )
 
 
+def code_dtype(most: int) -> np.dtype:
+    """The smallest of int8, int16, int32 and int64 that holds every code word from -1 (not
+    decoded) to ``most``.
+
+    Examples
+    --------
+    >>> [str(code_dtype(n)) for n in (127, 128, 40000)]
+    ['int8', 'int16', 'int32']
+    """
+    return next(np.dtype(t) for t in (np.int8, np.int16, np.int32, np.int64)
+                if most <= np.iinfo(t).max)
+
+
+def narrow_code(code: np.ndarray, most: int) -> np.ndarray:
+    """The code words in :func:`code_dtype` of ``most`` (the most the method's spec allows),
+    or of the largest word present where one is larger: never a word cut short.
+
+    Parameters
+    ----------
+    code : (H, W) int array
+        Code words, -1 where not decoded.
+    most : int
+        The largest code word the spec allows.
+
+    Returns
+    -------
+    (H, W) int array
+        The same words, int8 when they fit (``code`` itself if it has that dtype already).
+
+    Examples
+    --------
+    >>> narrow_code(np.int32([[-1, 5, 63]]), 127).dtype, narrow_code(np.int32([[300]]), 127)
+    (dtype('int8'), array([[300]], dtype=int16))
+    """
+    code = np.asarray(code)
+    if code.size:
+        low, high = int(code.min()), int(code.max())
+        if low < -1:
+            most = max(most, -low)  # (no codec writes these: kept whole all the same)
+        most = max(most, high)
+    return code.astype(code_dtype(most), copy=False)
+
+
 def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: float,
                        code: np.ndarray | None = None, info: dict[str, Any] | None = None,
-                       length: float | None = None) -> DecodeResult:
+                       length: float | None = None, reuse: bool = False) -> DecodeResult:
     """A result from a measured fringe set and its fringe orders (-1 = invalid); with
     ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`).
 
@@ -271,12 +352,16 @@ def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: fl
         Fringe order per pixel, -1 where invalid.
     period : float
         Projector pixels per fringe.
-    code : (H, W) int32 array, optional
-        The method's decoded code word per pixel (-1 where not decoded).
+    code : (H, W) int array, optional
+        The method's decoded code word per pixel (-1 where not decoded), kept as given.
     info : dict, optional
         Figures about the decode.
     length : float, optional
         Projector pixels along the coded axis.
+    reuse : bool, optional
+        The caller gives up ``fs.phi`` and ``order``: they become the result's wrapped
+        phase and order, written over, where their dtypes and layouts allow (no new array
+        for either); pass it only for arrays nothing else holds or shares memory with.
 
     Returns
     -------
@@ -291,4 +376,4 @@ def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: fl
     ([[1.0, 7.283, nan]], [[1.0, 1.0, nan]], [[True, True, False]])
     """
     return _make(method, fs.phi, order, period, fs.mod, fs.avg, code, None, fs.valid, info,
-                 length)
+                 length, reuse)
