@@ -55,7 +55,13 @@ from ..core.checks import (
 )
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
-from ..core.result import AxesResult, DecodeResult, narrow_code, result_from_orders
+from ..core.result import (
+    AxesResult,
+    DecodeResult,
+    narrow_code,
+    result_from_orders,
+    transpose_own,
+)
 from ..core.sample import Sample
 from ..errors import BistairError
 from ..spec import AXES, BaseSpec, PeriodSpec, fringe_count
@@ -388,8 +394,8 @@ class Codec:
                               spec.coded_length))
         result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
-        if spec.orientation == "rows":
-            result = result.transposed()
+        if spec.orientation == "rows":  # (only this function holds the result: turned array
+            result = transpose_own(result)  # by array, not copied whole)
         result.texture = prepared.white
         return result
 

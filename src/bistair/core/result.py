@@ -133,6 +133,26 @@ class DecodeResult:
                             texture=self.texture, spec=self.spec)
 
 
+def transpose_own(result: DecodeResult) -> DecodeResult:
+    """``result`` itself with its image axes swapped, array by array: each array's transposed
+    copy is made once the one before has replaced its original, so a result nothing else
+    holds takes one more array while it turns, not a second result
+    (:meth:`DecodeResult.transposed` makes a new result and leaves this one as it is).
+
+    Examples
+    --------
+    >>> res = make_result("demo", np.zeros((2, 3), np.float32), np.zeros((2, 3), int), 30.0,
+    ...                   np.ones((2, 3)))
+    >>> transpose_own(res) is res, res.phase.shape, res.coord.shape, res.phase.flags.c_contiguous
+    (True, (3, 2), (3, 2), True)
+    """
+    for name in PIXEL_FIELDS:
+        key = "_coord" if name == "coord" else name
+        if getattr(result, key) is not None:
+            setattr(result, key, np.ascontiguousarray(getattr(result, key).T))
+    return result
+
+
 @dataclass
 class AxesResult:
     """A decode of both projector axes: ``x`` (the columns, ``coord_x``) and ``y`` (the
