@@ -406,6 +406,17 @@ def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
     included), or a stair's ``cycle`` if that is more; the result's code is kept in the
     smallest integer dtype that holds it (:func:`~bistair.core.result.narrow_code`).
 
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec of one axis (its coded length and period).
+    cycle : int, optional
+        The code's cycle (:class:`CodeMap`), if it repeats.
+
+    Returns
+    -------
+    int
+
     Examples
     --------
     >>> from bistair.codecs import make_spec

@@ -139,6 +139,16 @@ def transpose_own(result: DecodeResult) -> DecodeResult:
     holds takes one more array while it turns, not a second result
     (:meth:`DecodeResult.transposed` makes a new result and leaves this one as it is).
 
+    Parameters
+    ----------
+    result : DecodeResult
+        A result nothing else holds (a decode's own, before it returns it).
+
+    Returns
+    -------
+    DecodeResult
+        ``result``, its arrays replaced by C-contiguous transposed copies.
+
     Examples
     --------
     >>> res = make_result("demo", np.zeros((2, 3), np.float32), np.zeros((2, 3), int), 30.0,
@@ -313,6 +323,15 @@ def _make(method: str, phi: np.ndarray, order: np.ndarray, period: float,
 def code_dtype(most: int) -> np.dtype:
     """The smallest of int8, int16, int32 and int64 that holds every code word from -1 (not
     decoded) to ``most``.
+
+    Parameters
+    ----------
+    most : int
+        The largest code word.
+
+    Returns
+    -------
+    numpy.dtype
 
     Examples
     --------

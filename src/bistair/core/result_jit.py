@@ -62,6 +62,15 @@ def coord_factor(period: float) -> np.float32:
     """Projector pixels per radian, ``period / (2*pi)`` in float32: the coordinate of a pixel
     is its float32 phase times this (one rounding).
 
+    Parameters
+    ----------
+    period : float
+        Projector pixels per fringe.
+
+    Returns
+    -------
+    numpy.float32
+
     Examples
     --------
     >>> coord_factor(2 * math.pi)
