@@ -347,7 +347,10 @@ class Codec:
         fs = replace(fs, stair=None)  # (the code's maps hold the pair: let go with them)
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
-        # the phase noise and the sample let go before the result is made
+        # the code's maps let go with it once the orders are made (the words narrowed for the
+        # result: int8 for up to 127 fringes), the phase noise and the sample too
+        words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
+        del code
         fs = replace(fs, sigma=None, sample=None)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
@@ -371,10 +374,7 @@ class Codec:
         modulated = int(np.count_nonzero(fs.valid))
         orders.info.setdefault("valid_modulation", modulated)
         judge(sparse_problem(int(np.count_nonzero(orders.order >= 0)), modulated))
-        # the code words narrowed (int8 for up to 127 fringes) before the result's arrays are
-        # made, the code's maps let go with the int32 words
-        words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
-        del code
+        orders.read = None  # (judged: let go before the result's arrays are made)
         # pass 2: the orders and the wrapped phase become the result's, written over where
         # nothing else (the result's other arrays, the captures) shares their memory; the
         # phase and the mask are the only new arrays
