@@ -55,7 +55,7 @@ def test_fill_in_chunks_is_the_whole_fill(monkeypatch, chunk):
 
 def _own(result):
     """The arrays a result holds (its coordinate is computed when asked for)."""
-    assert result._coord is None
+    assert vars(result).get("_coord") is None
     return [getattr(result, name) for name in PIXEL_FIELDS if name != "coord"]
 
 

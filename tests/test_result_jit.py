@@ -4,6 +4,9 @@ where roundings and thresholds bite."""
 
 from __future__ import annotations
 
+import dataclasses
+import pickle
+
 import numpy as np
 from support.arrays import same
 
@@ -82,6 +85,9 @@ def test_coord_is_the_phase_times_the_factor_as_before():
                              res.average, res.mask, res.code, period, "demo")
         assert same(given.coord, before + 1) and same(given.transposed().coord, (before + 1).T)
         assert same(res.transposed().coord, res.coord.T)
+        # the dataclass's replace and pickling keep it (the field stands where it stood)
+        assert same(dataclasses.replace(res, method="x").coord, res.coord)
+        assert same(pickle.loads(pickle.dumps(res)).coord, res.coord)
 
 
 def test_code_words_are_narrowed_never_cut():

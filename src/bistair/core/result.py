@@ -35,7 +35,7 @@ ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")
 PIXEL_FIELDS = ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")
 
 
-@dataclass(init=False)
+@dataclass
 class DecodeResult:
     """Absolute phase and everything needed to judge it, per camera pixel.
 
@@ -69,6 +69,7 @@ class DecodeResult:
     """
 
     phase: np.ndarray
+    coord: np.ndarray | None  # a property once the class is made (None: from the phase)
     order: np.ndarray
     wrapped: np.ndarray
     modulation: np.ndarray
@@ -80,31 +81,6 @@ class DecodeResult:
     info: dict[str, Any] = field(default_factory=dict)
     texture: np.ndarray | None = None  # the white frame if the spec has one (camera axes)
     spec: BaseSpec | None = None  # the spec it was decoded with, if known
-    _coord: np.ndarray | None = field(default=None, repr=False)  # else from the phase
-
-    def __init__(self, phase: np.ndarray, coord: np.ndarray | None, order: np.ndarray,
-                 wrapped: np.ndarray, modulation: np.ndarray, average: np.ndarray,
-                 mask: np.ndarray, code: np.ndarray, period: float, method: str,
-                 info: dict[str, Any] | None = None, texture: np.ndarray | None = None,
-                 spec: BaseSpec | None = None) -> None:
-        self.phase, self.order, self.wrapped = phase, order, wrapped
-        self.modulation, self.average, self.mask, self.code = modulation, average, mask, code
-        self.period, self.method = period, method
-        self.info = {} if info is None else info
-        self.texture, self.spec = texture, spec
-        self._coord = coord  # None: computed from the phase when asked for
-
-    @property
-    def coord(self) -> np.ndarray:
-        """Projector coordinate per camera pixel (float32, NaN where invalid): the one given
-        to the constructor, else ``phase * float32(period / (2*pi))``, computed anew."""
-        if self._coord is not None:
-            return self._coord
-        return np.multiply(self.phase, coord_factor(self.period), dtype=np.float32)
-
-    @coord.setter
-    def coord(self, value: np.ndarray | None) -> None:
-        self._coord = value
 
     def __repr__(self) -> str:
         return f"DecodeResult({_summary(self, f'{_share(self.mask)} valid')})"
@@ -125,12 +101,36 @@ class DecodeResult:
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
-        arrays = {name: self._coord if name == "coord" else getattr(self, name)
+        arrays = {name: _given_coord(self) if name == "coord" else getattr(self, name)
                   for name in PIXEL_FIELDS}
         swap = {name: None if a is None else np.ascontiguousarray(a.T)
                 for name, a in arrays.items()}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
                             texture=self.texture, spec=self.spec)
+
+
+def _coord(result: DecodeResult) -> np.ndarray:
+    """Projector coordinate per camera pixel (float32, NaN where invalid): the one the result
+    was made with, else ``phase * float32(period / (2*pi))``, computed anew."""
+    given = _given_coord(result)
+    if given is not None:
+        return given
+    return np.multiply(result.phase, coord_factor(result.period), dtype=np.float32)
+
+
+def _set_coord(result: DecodeResult, value: np.ndarray | None) -> None:
+    result.__dict__["_coord"] = value  # None: computed from the phase when read
+
+
+def _given_coord(result: DecodeResult) -> np.ndarray | None:
+    """The coordinate the result was made with (``None``: computed from the phase)."""
+    return result.__dict__.get("_coord")
+
+
+# the dataclass's own __init__, fields and replace() name ``coord`` where it always stood (the
+# constructor's second argument); reading it computes it (set after the class is made, so
+# that the dataclass does not take the property for the field's default)
+DecodeResult.coord = property(_coord, _set_coord)  # type: ignore[assignment]
 
 
 def transpose_own(result: DecodeResult) -> DecodeResult:
@@ -157,9 +157,9 @@ def transpose_own(result: DecodeResult) -> DecodeResult:
     (True, (3, 2), (3, 2), True)
     """
     for name in PIXEL_FIELDS:
-        key = "_coord" if name == "coord" else name
-        if getattr(result, key) is not None:
-            setattr(result, key, np.ascontiguousarray(getattr(result, key).T))
+        a = _given_coord(result) if name == "coord" else getattr(result, name)
+        if a is not None:
+            setattr(result, name, np.ascontiguousarray(a.T))
     return result
 
 
