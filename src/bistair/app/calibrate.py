@@ -110,10 +110,10 @@ def read_pose(folder: Path, specs: dict[str, BaseSpec]
         x, y = result.x, result.y
     else:
         x, y = (_decode_axis(folder, o, specs[o]) for o in AXES)
-        if x.coord.shape != y.coord.shape:
-            raise _SizeError(f"{folder.name}/rows images are {y.coord.shape[1]}x"
-                             f"{y.coord.shape[0]}, earlier ones {x.coord.shape[1]}x"
-                             f"{x.coord.shape[0]}")
+        if x.phase.shape != y.phase.shape:
+            raise _SizeError(f"{folder.name}/rows images are {y.phase.shape[1]}x"
+                             f"{y.phase.shape[0]}, earlier ones {x.phase.shape[1]}x"
+                             f"{x.phase.shape[0]}")
     white = x.texture if x.texture is not None else y.texture
     mean = (x.average + y.average) / 2
     if white is None:

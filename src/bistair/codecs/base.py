@@ -55,10 +55,16 @@ from ..core.checks import (
 )
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
-from ..core.result import AxesResult, DecodeResult, result_from_orders
+from ..core.result import (
+    AxesResult,
+    DecodeResult,
+    narrow_code,
+    result_from_orders,
+    transpose_own,
+)
 from ..core.sample import Sample
 from ..errors import BistairError
-from ..spec import AXES, BaseSpec, PeriodSpec
+from ..spec import AXES, BaseSpec, PeriodSpec, fringe_count
 
 
 @dataclass
@@ -341,7 +347,10 @@ class Codec:
         fs = replace(fs, stair=None)  # (the code's maps hold the pair: let go with them)
         warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
         orders = self.order_columns(fs, code, spec, **options)
-        # the phase noise and the sample let go before the result is made
+        # the code's maps let go with it once the orders are made (the words narrowed for the
+        # result: int8 for up to 127 fringes), the phase noise and the sample too
+        words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
+        del code
         fs = replace(fs, sigma=None, sample=None)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
@@ -365,10 +374,18 @@ class Codec:
         modulated = int(np.count_nonzero(fs.valid))
         orders.info.setdefault("valid_modulation", modulated)
         judge(sparse_problem(int(np.count_nonzero(orders.order >= 0)), modulated))
-        words, beyond = code.code, code.beyond
-        del code  # its maps are done with: the result is made without them in memory
-        result = result_from_orders(self.name, fs, orders.order, spec.period,
-                                   code=words, info=orders.info, length=spec.coded_length)
+        orders.read = None  # (judged: let go before the result's arrays are made)
+        # pass 2: the orders and the wrapped phase become the result's, written over where
+        # nothing else (the result's other arrays, the captures) shares their memory; the
+        # phase and the mask are the only new arrays
+        order = orders.order
+        kept = [a for a in (fs.mod, fs.avg, fs.valid, words, images, prepared.raw,
+                            prepared.white) if isinstance(a, np.ndarray)]
+        reuse = not np.may_share_memory(fs.phi, order) and not any(
+            np.may_share_memory(a, b) for a in (fs.phi, order) for b in kept)
+        result = result_from_orders(self.name, fs, order, spec.period, code=words,
+                                    info=orders.info, length=spec.coded_length, reuse=reuse)
+        del fs, orders, order, kept, words
         if beyond:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
@@ -377,10 +394,37 @@ class Codec:
                               spec.coded_length))
         result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
-        if spec.orientation == "rows":
-            result = result.transposed()
+        if spec.orientation == "rows":  # (only this function holds the result: turned array
+            result = transpose_own(result)  # by array, not copied whole)
         result.texture = prepared.white
         return result
+
+
+def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
+    """The largest code word a decode of ``spec`` can write: every word of a binary code
+    over its fringes (``2**bits - 1`` for the bits that count them, a fringe past the last
+    included), or a stair's ``cycle`` if that is more; the result's code is kept in the
+    smallest integer dtype that holds it (:func:`~bistair.core.result.narrow_code`).
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec of one axis (its coded length and period).
+    cycle : int, optional
+        The code's cycle (:class:`CodeMap`), if it repeats.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> most_code(make_spec("graycode", width=1920, height=1080, period=30))  # 64 fringes
+    127
+    """
+    fringes = fringe_count(spec.coded_length, spec.period)
+    return max((1 << fringes.bit_length()) - 1, cycle or 0)
 
 
 def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) -> str | None:

@@ -451,6 +451,9 @@ def region_links(phi: np.ndarray, labels: np.ndarray, direction: int | None = No
     return RegionLinks(key // 2 // n, key // 2 % n, np.where(key % 2 == 1, 1, -1), count)
 
 
+FILL_CHUNK = 8192  # fill_orders' targets a chunk: about 7 MB of temporaries at most
+
+
 def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
                 max_distance: float = 3.0, in_place: bool = False) -> np.ndarray:
     """Fringe orders for ``target`` pixels without one (``order < 0``) from the nearest
@@ -497,14 +500,25 @@ def fill_orders(phi: np.ndarray, order: np.ndarray, target: np.ndarray,
     near = near[(dist[near] > 0) & (dist[near] <= max_distance)]
     dy, dx = dy.ravel()[near], dx.ravel()[near]
     h, w = out.shape
-    yy = np.clip(ty[:, None] + dy[None, :], 0, h - 1)
-    xx = np.clip(tx[:, None] + dx[None, :], 0, w - 1)
-    cand = order[yy, xx]  # (targets, offsets), nearest offsets first
-    found = cand >= 0
-    first = found.argmax(axis=1)
-    has = found.any(axis=1)
-    pick_y, pick_x = yy[np.arange(ty.size), first][has], xx[np.arange(ty.size), first][has]
-    ref = phi[pick_y, pick_x] + TWO_PI * order[pick_y, pick_x]  # absolute phase, float64
-    sel_y, sel_x = ty[has], tx[has]
-    out[sel_y, sel_x] = order_from_reference(phi[sel_y, sel_x], ref)
+    # the targets a chunk at a time (each target's candidates take some 30 words: a whole
+    # image's at once could take more than the image), every order found before any is
+    # written, so that only the orders given are sources
+    filled = np.zeros(ty.size, bool)
+    found_order = np.empty(ty.size, np.float64)
+    for start in range(0, ty.size, FILL_CHUNK):
+        cy, cx = ty[start:start + FILL_CHUNK], tx[start:start + FILL_CHUNK]
+        yy = np.clip(cy[:, None] + dy[None, :], 0, h - 1)
+        xx = np.clip(cx[:, None] + dx[None, :], 0, w - 1)
+        cand = order[yy, xx]  # (targets, offsets), nearest offsets first
+        found = cand >= 0
+        first = found.argmax(axis=1)
+        has = found.any(axis=1)
+        rows = np.arange(cy.size)
+        pick_y, pick_x = yy[rows, first][has], xx[rows, first][has]
+        del yy, xx, cand, found
+        ref = phi[pick_y, pick_x] + TWO_PI * order[pick_y, pick_x]  # absolute phase, float64
+        chunk = slice(start, start + cy.size)
+        filled[chunk] = has
+        found_order[chunk][has] = order_from_reference(phi[cy[has], cx[has]], ref)
+    out[ty[filled], tx[filled]] = found_order[filled]
     return out

@@ -23,13 +23,16 @@ import numpy as np
 from ..hooks import call
 from ..spec import BaseSpec
 from .measure import FringeSet
-from .result_jit import assemble
+from .result_jit import assemble, coord_factor
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 # the arrays a decode writes as NAME.npy (DecodeResult.arrays)
 ARRAY_NAMES = ("phase", "coord", "order", "wrapped", "modulation", "mask")
+# the per-pixel arrays of a DecodeResult, as its constructor names them (coord: None when
+# it is computed from the phase)
+PIXEL_FIELDS = ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")
 
 
 @dataclass
@@ -39,14 +42,19 @@ class DecodeResult:
     Attributes
     ----------
     phase : float32, absolute phase ``Phi = 2*pi*x_p/T`` (NaN where invalid).
-    coord : float32, projector coordinate ``x_p`` along the coded axis (NaN where invalid).
+    coord : float32, projector coordinate ``x_p`` along the coded axis (NaN where invalid):
+        computed from ``phase`` when asked for, ``phase * float32(period / (2*pi))`` (a new
+        array each time: read it once), unless the result was made with one.
     order : int32, fringe order ``floor(x_p/T)`` (-1 where invalid).
     wrapped : float32, wrapped phase in ``[0, 2*pi)`` (NaN where the modulation is too low).
     modulation : float32, fringe modulation ``B`` as a fraction of full scale.
     average : float32, average intensity ``A`` as a fraction of full scale.
     mask : bool, pixels with a valid absolute phase.
-    code : int32, the method's decoded code word per pixel (``k_s`` for stair methods;
-        -1 where not decoded), for previews and diagnosis.
+    code : the method's decoded code word per pixel (``k_s`` for stair methods; -1 where
+        not decoded), for previews and diagnosis; from a decode, the smallest of int8,
+        int16 and int32 that holds every code word the spec allows (int8 for up to 127
+        fringes: :func:`code_dtype`), so widen it before integer arithmetic
+        (``code.astype(int) * period``: int8 wraps around past 127).
     period : projector pixels per fringe of ``phase`` and ``order``.
     method : the codec's name.
     info : figures about the decode (thresholds, counts, consistency checks).
@@ -54,12 +62,14 @@ class DecodeResult:
     spec : the spec the captures were decoded with (set by :func:`bistair.decode`), for
         :func:`bistair.reconstruct`.
 
-    ``repr`` is one line (method, shape, valid share, noise); :meth:`save` writes what
-    ``bistair decode`` writes, :meth:`plot` draws the six-panel figure.
+    A decode holds 22 bytes per camera pixel (phase, order, wrapped, modulation, average:
+    4 each; mask and an int8 code: 1 each). ``repr`` is one line (method, shape, valid
+    share, noise); :meth:`save` writes what ``bistair decode`` writes, :meth:`plot` draws
+    the six-panel figure.
     """
 
     phase: np.ndarray
-    coord: np.ndarray
+    coord: np.ndarray | None  # a property once the class is made (None: from the phase)
     order: np.ndarray
     wrapped: np.ndarray
     modulation: np.ndarray
@@ -91,10 +101,66 @@ class DecodeResult:
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
-        swap = {name: np.ascontiguousarray(getattr(self, name).T) for name in
-                ("phase", "coord", "order", "wrapped", "modulation", "average", "mask", "code")}
+        arrays = {name: _given_coord(self) if name == "coord" else getattr(self, name)
+                  for name in PIXEL_FIELDS}
+        swap = {name: None if a is None else np.ascontiguousarray(a.T)
+                for name, a in arrays.items()}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
                             texture=self.texture, spec=self.spec)
+
+
+def _coord(result: DecodeResult) -> np.ndarray:
+    """Projector coordinate per camera pixel (float32, NaN where invalid): the one the result
+    was made with, else ``phase * float32(period / (2*pi))``, computed anew."""
+    given = _given_coord(result)
+    if given is not None:
+        return given
+    return np.multiply(result.phase, coord_factor(result.period), dtype=np.float32)
+
+
+def _set_coord(result: DecodeResult, value: np.ndarray | None) -> None:
+    result.__dict__["_coord"] = value  # None: computed from the phase when read
+
+
+def _given_coord(result: DecodeResult) -> np.ndarray | None:
+    """The coordinate the result was made with (``None``: computed from the phase)."""
+    return result.__dict__.get("_coord")
+
+
+# the dataclass's own __init__, fields and replace() name ``coord`` where it always stood (the
+# constructor's second argument); reading it computes it (set after the class is made, so
+# that the dataclass does not take the property for the field's default)
+DecodeResult.coord = property(_coord, _set_coord)  # type: ignore[assignment]
+
+
+def transpose_own(result: DecodeResult) -> DecodeResult:
+    """``result`` itself with its image axes swapped, array by array: each array's transposed
+    copy is made once the one before has replaced its original, so a result nothing else
+    holds takes one more array while it turns, not a second result
+    (:meth:`DecodeResult.transposed` makes a new result and leaves this one as it is).
+
+    Parameters
+    ----------
+    result : DecodeResult
+        A result nothing else holds (a decode's own, before it returns it).
+
+    Returns
+    -------
+    DecodeResult
+        ``result``, its arrays replaced by C-contiguous transposed copies.
+
+    Examples
+    --------
+    >>> res = make_result("demo", np.zeros((2, 3), np.float32), np.zeros((2, 3), int), 30.0,
+    ...                   np.ones((2, 3)))
+    >>> transpose_own(res) is res, res.phase.shape, res.coord.shape, res.phase.flags.c_contiguous
+    (True, (3, 2), (3, 2), True)
+    """
+    for name in PIXEL_FIELDS:
+        a = _given_coord(result) if name == "coord" else getattr(result, name)
+        if a is not None:
+            setattr(result, name, np.ascontiguousarray(a.T))
+    return result
 
 
 @dataclass
@@ -201,8 +267,9 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
         Fringe modulation ``B`` (fraction of full scale).
     average : (H, W) array, optional
         Average intensity ``A`` (fraction of full scale); zeros when not given.
-    code : (H, W) int32 array, optional
-        The method's decoded code word per pixel; -1 everywhere when not given.
+    code : (H, W) int array, optional
+        The method's decoded code word per pixel, kept as given; -1 everywhere (int8) when
+        not given.
     wrapped : (H, W) array, optional
         The wrapped phase to report (NaN where the modulation is too low); ``phi`` when not
         given.
@@ -215,9 +282,9 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
     Returns
     -------
     DecodeResult
-        Absolute phase ``phi + 2*pi*order`` and projector coordinate ``phase * period /
-        (2*pi)`` (float32, NaN where invalid), order (int32, -1 where invalid) and the mask
-        of valid pixels.
+        Absolute phase ``phi + 2*pi*order`` (float32, NaN where invalid; the projector
+        coordinate is ``phase * float32(period / (2*pi))``), order (int32, -1 where
+        invalid) and the mask of valid pixels.
 
     Examples
     --------
@@ -234,27 +301,80 @@ def make_result(method: str, phi: np.ndarray, order: np.ndarray, period: float,
 def _make(method: str, phi: np.ndarray, order: np.ndarray, period: float,
           modulation: np.ndarray, average: np.ndarray | None, code: np.ndarray | None,
           wrapped: np.ndarray | None, valid: np.ndarray | None, info: dict[str, Any] | None,
-          length: float | None) -> DecodeResult:
+          length: float | None, reuse: bool = False) -> DecodeResult:
     """:func:`make_result`; with ``valid`` (and no ``wrapped``), the wrapped phase reported is
-    ``phi`` where valid, NaN elsewhere."""
-    phase, coord, out_order, phi_out, mask, outside = assemble(phi, np.asarray(order), period,
-                                                               length, valid)
+    ``phi`` where valid, NaN elsewhere; with ``reuse``, ``phi`` and ``order`` are written
+    over (:func:`~bistair.core.result_jit.assemble`)."""
+    phase, out_order, phi_out, mask, outside = assemble(phi, order, period, length, valid,
+                                                        reuse=reuse)
     if wrapped is not None:
         phi_out = np.asarray(wrapped).astype(np.float32)
     return DecodeResult(
-        phase=phase, coord=coord, order=out_order, wrapped=phi_out,
+        phase=phase, coord=None, order=out_order, wrapped=phi_out,
         modulation=np.asarray(modulation, np.float32),
         average=(np.zeros_like(phase) if average is None
                  else np.asarray(average).astype(np.float32, copy=False)),
-        mask=mask, code=(np.full(phase.shape, -1, np.int32) if code is None else code),
+        mask=mask, code=(np.full(phase.shape, -1, np.int8) if code is None else code),
         period=float(period), method=method,
         info={**(info or {}), **({"outside_projector": outside} if outside else {})},
     )
 
 
+def code_dtype(most: int) -> np.dtype:
+    """The smallest of int8, int16, int32 and int64 that holds every code word from -1 (not
+    decoded) to ``most``.
+
+    Parameters
+    ----------
+    most : int
+        The largest code word.
+
+    Returns
+    -------
+    numpy.dtype
+
+    Examples
+    --------
+    >>> [str(code_dtype(n)) for n in (127, 128, 40000)]
+    ['int8', 'int16', 'int32']
+    """
+    return next(np.dtype(t) for t in (np.int8, np.int16, np.int32, np.int64)
+                if most <= np.iinfo(t).max)
+
+
+def narrow_code(code: np.ndarray, most: int) -> np.ndarray:
+    """The code words in :func:`code_dtype` of ``most`` (the most the method's spec allows),
+    or of the largest word present where one is larger: never a word cut short.
+
+    Parameters
+    ----------
+    code : (H, W) int array
+        Code words, -1 where not decoded.
+    most : int
+        The largest code word the spec allows.
+
+    Returns
+    -------
+    (H, W) int array
+        The same words, int8 when they fit (``code`` itself if it has that dtype already).
+
+    Examples
+    --------
+    >>> narrow_code(np.int32([[-1, 5, 63]]), 127).dtype, narrow_code(np.int32([[300]]), 127)
+    (dtype('int8'), array([[300]], dtype=int16))
+    """
+    code = np.asarray(code)
+    if code.size:
+        low, high = int(code.min()), int(code.max())
+        if low < -1:
+            most = max(most, -low)  # (no codec writes these: kept whole all the same)
+        most = max(most, high)
+    return code.astype(code_dtype(most), copy=False)
+
+
 def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: float,
                        code: np.ndarray | None = None, info: dict[str, Any] | None = None,
-                       length: float | None = None) -> DecodeResult:
+                       length: float | None = None, reuse: bool = False) -> DecodeResult:
     """A result from a measured fringe set and its fringe orders (-1 = invalid); with
     ``length``, coordinates outside ``[0, length)`` are invalid (:func:`make_result`).
 
@@ -271,12 +391,16 @@ def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: fl
         Fringe order per pixel, -1 where invalid.
     period : float
         Projector pixels per fringe.
-    code : (H, W) int32 array, optional
-        The method's decoded code word per pixel (-1 where not decoded).
+    code : (H, W) int array, optional
+        The method's decoded code word per pixel (-1 where not decoded), kept as given.
     info : dict, optional
         Figures about the decode.
     length : float, optional
         Projector pixels along the coded axis.
+    reuse : bool, optional
+        The caller gives up ``fs.phi`` and ``order``: they become the result's wrapped
+        phase and order, written over, where their dtypes and layouts allow (no new array
+        for either); pass it only for arrays nothing else holds or shares memory with.
 
     Returns
     -------
@@ -291,4 +415,4 @@ def result_from_orders(method: str, fs: FringeSet, order: np.ndarray, period: fl
     ([[1.0, 7.283, nan]], [[1.0, 1.0, nan]], [[True, True, False]])
     """
     return _make(method, fs.phi, order, period, fs.mod, fs.avg, code, None, fs.valid, info,
-                 length)
+                 length, reuse)

@@ -356,7 +356,7 @@ def check_fit(result: DecodeResult | AxesResult, calibration: Calibration,
         raise BistairError("a spec of both axes needs the decode of both axes" if not axes
                            else f"the decode holds both axes, the spec codes {coded} only")
     cam, proj = calibration.camera, calibration.projector
-    h, w = (result.coord_x if axes else result.coord).shape
+    h, w = (result.x if axes else result).phase.shape
     if (w, h) != cam.size:
         raise BistairError(f"calibration is for {cam.width}x{cam.height} camera images, "
                            f"captures are {w}x{h}")
@@ -485,13 +485,14 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration | st
         valid, pts, info = _both_axes(result, calibration, epipolar_tolerance, options)
         first = result.x
     else:
-        valid = np.flatnonzero(result.mask.ravel() & np.isfinite(result.coord.ravel()))
-        pts, sens = triangulate(_pixels(valid, result.coord.shape[1]),
-                                result.coord.ravel()[valid], calibration, coded,
-                                sensitivity=True, **options)
+        coord = result.coord.ravel()  # (computed from the phase: read once)
+        valid = np.flatnonzero(result.mask.ravel() & np.isfinite(coord))
+        pts, sens = triangulate(_pixels(valid, result.phase.shape[1]), coord[valid],
+                                calibration, coded, sensitivity=True, **options)
+        del coord
         _check_geometry(pts, sens, calibration, coded)
         info, first = {}, result
-    h, w = first.coord.shape
+    h, w = first.phase.shape
     found = np.isfinite(pts[:, 2])
     with np.errstate(invalid="ignore"):
         keep = found & (pts[:, 2] >= min_depth) & (pts[:, 2] <= max_depth)
@@ -515,17 +516,19 @@ def _both_axes(result: AxesResult, calibration: Calibration, epipolar_tolerance:
     valid coordinate along the baseline, triangulated with both coordinates where the other
     is valid too."""
     along = baseline_orientation(calibration)
+    coord_x, coord_y = result.coord_x, result.coord_y  # (computed from the phases: read once)
     main, cross = (result.x, result.y) if along == "columns" else (result.y, result.x)
-    ok_main = main.mask & np.isfinite(main.coord)
-    ok_cross = cross.mask & np.isfinite(cross.coord)
+    main_coord, cross_coord = (coord_x, coord_y) if along == "columns" else (coord_y, coord_x)
+    ok_main = main.mask & np.isfinite(main_coord)
+    ok_cross = cross.mask & np.isfinite(cross_coord)
     valid = np.flatnonzero(ok_main.ravel())
-    pix = _pixels(valid, main.coord.shape[1])
-    pts, sens = triangulate(pix, main.coord.ravel()[valid], calibration, along,
+    pix = _pixels(valid, main_coord.shape[1])
+    pts, sens = triangulate(pix, main_coord.ravel()[valid], calibration, along,
                             sensitivity=True, **options)
     _check_geometry(pts, sens, calibration, along, both=True)
     two = ok_cross.ravel()[valid]
-    pts[two], dist = triangulate_axes(pix[two], result.coord_x.ravel()[valid[two]],
-                                      result.coord_y.ravel()[valid[two]], calibration,
+    pts[two], dist = triangulate_axes(pix[two], coord_x.ravel()[valid[two]],
+                                      coord_y.ravel()[valid[two]], calibration,
                                       epipolar_tolerance, residual=True)
     info = {"baseline_axis": along, "both_axes": int(two.sum()),
             "one_axis": int((~two).sum()),
