@@ -54,9 +54,11 @@ def test_fill_in_chunks_is_the_whole_fill(monkeypatch, chunk):
 
 
 def _own(result):
-    """The arrays a result holds (its coordinate is computed when asked for)."""
+    """The arrays a result holds (its coordinate is computed when asked for, its code
+    widened when read)."""
     assert vars(result).get("_coord") is None
-    return [getattr(result, name) for name in PIXEL_FIELDS if name != "coord"]
+    return [vars(result)["_code"] if name == "code" else getattr(result, name)
+            for name in PIXEL_FIELDS if name != "coord"]
 
 
 @pytest.mark.parametrize("method", ["bidirectional", "graycode", "multifreq"])
@@ -72,7 +74,9 @@ def test_result_owns_its_arrays_and_leaves_the_captures(method, dtype):
     for i, a in enumerate(arrays):
         for b in arrays[i + 1:]:
             assert not np.shares_memory(a, b)
-    assert res.code.dtype == np.int8 and res.order.dtype == np.int32
+    # the code stored narrow, read as int32 (arithmetic on it never wraps around)
+    assert vars(res)["_code"].dtype == np.int8 and res.order.dtype == np.int32
+    assert res.code.dtype == np.int32 and np.array_equal(res.code, vars(res)["_code"])
     assert sum(a.nbytes for a in _own(res)) == 22 * res.mask.size
     # the coordinate: float32 from the phase, NaN where invalid, a new array each time
     assert res.coord.dtype == np.float32 and res.coord is not res.coord

@@ -50,11 +50,11 @@ class DecodeResult:
     modulation : float32, fringe modulation ``B`` as a fraction of full scale.
     average : float32, average intensity ``A`` as a fraction of full scale.
     mask : bool, pixels with a valid absolute phase.
-    code : the method's decoded code word per pixel (``k_s`` for stair methods; -1 where
-        not decoded), for previews and diagnosis; from a decode, the smallest of int8,
-        int16 and int32 that holds every code word the spec allows (int8 for up to 127
-        fringes: :func:`code_dtype`), so widen it before integer arithmetic
-        (``code.astype(int) * period``: int8 wraps around past 127).
+    code : int32, the method's decoded code word per pixel (``k_s`` for stair methods; -1
+        where not decoded), for previews and diagnosis. A decode stores it in the smallest
+        of int8, int16 and int32 that holds every code word the spec allows
+        (:func:`code_dtype`) and widens it to int32 when read (a new array each time unless
+        it is stored as int32: read it once), so arithmetic on it never wraps around.
     period : projector pixels per fringe of ``phase`` and ``order``.
     method : the codec's name.
     info : figures about the decode (thresholds, counts, consistency checks).
@@ -63,7 +63,7 @@ class DecodeResult:
         :func:`bistair.reconstruct`.
 
     A decode holds 22 bytes per camera pixel (phase, order, wrapped, modulation, average:
-    4 each; mask and an int8 code: 1 each). ``repr`` is one line (method, shape, valid
+    4 each; mask and a code stored as int8: 1 each). ``repr`` is one line (method, shape, valid
     share, noise); :meth:`save` writes what ``bistair decode`` writes, :meth:`plot` draws
     the six-panel figure.
     """
@@ -101,8 +101,7 @@ class DecodeResult:
 
     def transposed(self) -> DecodeResult:
         """The same result with image axes swapped (for the rows orientation)."""
-        arrays = {name: _given_coord(self) if name == "coord" else getattr(self, name)
-                  for name in PIXEL_FIELDS}
+        arrays = {name: _stored(self, name) for name in PIXEL_FIELDS}
         swap = {name: None if a is None else np.ascontiguousarray(a.T)
                 for name, a in arrays.items()}
         return DecodeResult(**swap, period=self.period, method=self.method, info=self.info,
@@ -127,10 +126,28 @@ def _given_coord(result: DecodeResult) -> np.ndarray | None:
     return result.__dict__.get("_coord")
 
 
-# the dataclass's own __init__, fields and replace() name ``coord`` where it always stood (the
-# constructor's second argument); reading it computes it (set after the class is made, so
-# that the dataclass does not take the property for the field's default)
+def _code(result: DecodeResult) -> np.ndarray:
+    """The code words per camera pixel as int32 (stored narrower by a decode)."""
+    return result.__dict__["_code"].astype(np.int32, copy=False)
+
+
+def _set_code(result: DecodeResult, value: np.ndarray) -> None:
+    result.__dict__["_code"] = value
+
+
+def _stored(result: DecodeResult, name: str) -> np.ndarray | None:
+    """A per-pixel array as the result holds it (``coord``: None when computed from the
+    phase; ``code``: in its stored dtype), not as reading the attribute makes it."""
+    if name in ("coord", "code"):
+        return result.__dict__.get(f"_{name}")
+    return getattr(result, name)
+
+
+# the dataclass's own __init__, fields and replace() name ``coord`` and ``code`` where they
+# always stood; reading coord computes it, reading code widens it to int32 (set after the
+# class is made, so that the dataclass does not take the properties for the fields' defaults)
 DecodeResult.coord = property(_coord, _set_coord)  # type: ignore[assignment]
+DecodeResult.code = property(_code, _set_code)  # type: ignore[assignment]
 
 
 def transpose_own(result: DecodeResult) -> DecodeResult:
@@ -157,7 +174,7 @@ def transpose_own(result: DecodeResult) -> DecodeResult:
     (True, (3, 2), (3, 2), True)
     """
     for name in PIXEL_FIELDS:
-        a = _given_coord(result) if name == "coord" else getattr(result, name)
+        a = _stored(result, name)
         if a is not None:
             setattr(result, name, np.ascontiguousarray(a.T))
     return result
