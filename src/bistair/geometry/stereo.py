@@ -79,7 +79,6 @@ from .stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
-    drop_kinks,
     grid_depth,
     match_pair,
     rectified_positions,
@@ -416,15 +415,15 @@ def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification
                       remap_valid(rc, *rect.maps_right, spread[name]))
                for name, (lc, rc) in coords.items()}
     axis, slope = _matched_axis(on_grid)
-    src, dst = on_grid[axis] if slope > 0 else (-m for m in on_grid[axis])
     # the thresholds grow with the noise: the phase's own (a row's second differences)
-    # as a position along the row
-    noise_l, noise_r = _noise(src), _noise(dst)
+    # as a position along the row (a map and its negation have the same)
+    noise_l, noise_r = (_noise(m) for m in on_grid[axis])
     noise = max(noise_l, noise_r) / abs(slope)
-    src, dst = (drop_kinks(m, max(KINK * n * math.sqrt(6.0), 0.5 * abs(slope)), KINK_REACH)
-                for m, n in ((src, noise_l), (dst, noise_r)))
-    if smooth > 0:
-        src, dst = (smooth_runs(m, smooth, spread[axis]) for m in (src, dst))
+    # both maps rising along the rows, without their kinks, smoothed: one pass each
+    src, dst = (smooth_runs(m, smooth, spread[axis], max(KINK * n * math.sqrt(6.0),
+                                                         0.5 * abs(slope)), KINK_REACH,
+                            negate=slope < 0)
+                for m, n in zip(on_grid[axis], (noise_l, noise_r), strict=True))
     wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
     support = max(support, 4.0 * math.sqrt(2.0) * noise)
     low, high = rect.disparities(min_depth, max_depth)

@@ -626,83 +626,111 @@ def _fit_at(line: np.ndarray, x: int, a: int, b: int, radius: int,
     return total
 
 
+@_numba_inline
+def _reach(line: np.ndarray, x: int, step: int, r: int, jump: float) -> int:
+    """How many neighbours of sample ``x`` of ``line``, up to ``r``, its run holds on the
+    side ``step`` (-1 or +1)."""
+    n = 0
+    end = line.shape[0]
+    while n < r and 0 <= x + step * (n + 1) < end and _joined(
+            line[x + step * n], line[x + step * (n + 1)], jump):
+        n += 1
+    return n
+
+
 @kernel(parallel=True)
-def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray,
-            jump: float) -> np.ndarray:
-    """:func:`smooth_runs`: each pass filters every sample with the whole window's weights
-    (a fixed filter, in vector loops; NaN wherever the window holds one), then fits again
-    the samples whose window is cut short (``left``/``right``, ``up``/``down``: how far
-    each sample's run reaches, up to ``radius``)."""
+def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray, jump: float,
+            kink: float, kink_reach: int, negate: bool) -> np.ndarray:
+    """:func:`smooth_runs`: the rows, then the columns, in chunks of rows (the scratch made
+    once a chunk). Each row is taken negated (``negate``) and without its kinks
+    (:func:`drop_kinks`, on a copy of the row). Each pass filters every sample with the
+    whole window's weights and notes whether the window's neighbours all join (vector
+    loops; NaN wherever the window holds one), then fits again the samples whose run is cut
+    short within the window (:func:`_reach` on each side, up to ``radius``)."""
     h, w = values.shape
     r = radius
     full = coefficients[r, r].copy()
     rows = np.empty_like(values)
-    for y in prange(h):  # along the rows
-        line = values[y]
-        left = np.zeros(w, np.int8)
-        run = 0
-        for x in range(1, w):
-            run = min(run + 1, r) if _joined(line[x], line[x - 1], jump) else 0
-            left[x] = run
-        acc = np.zeros(w, np.float64)
-        if r == 3:  # the default sigma (1 px): a loop of fixed length, in vector registers
-            for x in range(r, w - r):
-                total = 0.0
-                for k in range(7):
-                    total += full[k] * float(line[x + k - 3])
-                acc[x] = total
-        else:
-            for x in range(r, w - r):
-                total = 0.0
-                for k in range(2 * r + 1):
-                    total += full[k] * float(line[x + k - r])
-                acc[x] = total
-        run = 0
-        for x in range(w - 1, -1, -1):
-            if x < w - 1:
-                run = min(run + 1, r) if _joined(line[x], line[x + 1], jump) else 0
-            a = int(left[x])
-            if a < r or run < r:
-                acc[x] = (_fit_at(line, x, a, run, r, coefficients)
-                          if line[x] == line[x] else line[x])
-            rows[y, x] = acc[x]
     out = np.empty_like(values)
-    strip = 64  # down the columns, in strips of columns
-    for s in prange((w + strip - 1) // strip):
-        x0, x1 = s * strip, min(s * strip + strip, w)
-        n = x1 - x0
-        up = np.zeros((h, n), np.int8)
-        for y in range(1, h):
-            for i in range(n):
-                up[y, i] = (min(up[y - 1, i] + 1, r)
-                            if _joined(rows[y, x0 + i], rows[y - 1, x0 + i], jump) else 0)
-        down = np.zeros(n, np.int64)
-        acc = np.zeros(n, np.float64)
-        for y in range(h - 1, -1, -1):
-            if r == 3 and 3 <= y < h - 3:
-                for i in range(n):
+    chunks = min(h, 64)
+    for c in prange(chunks):  # along the rows
+        line = np.empty(w, values.dtype)
+        whole = np.empty(w, np.uint8)
+        for y in range(c * h // chunks, (c + 1) * h // chunks):
+            src = values[y]
+            if negate:
+                for x in range(w):
+                    line[x] = -src[x]
+            else:
+                line[:] = src
+            if kink < math.inf:  # as drop_kinks: found on the row, dropped from the copy
+                for x in range(1, w - 1):
+                    a, b, d = src[x - 1], src[x], src[x + 1]
+                    if a == a and b == b and d == d and abs(a - 2.0 * b + d) > kink:
+                        for k in range(max(0, x - kink_reach), min(w, x + kink_reach + 1)):
+                            line[k] = np.nan
+            _filter_line(line, full, r, jump, rows[y], whole)
+            for x in range(w):  # the windows cut short
+                if whole[x] == 0:
+                    v = line[x]
+                    a, b = _reach(line, x, -1, r, jump), _reach(line, x, 1, r, jump)
+                    if v != v or a < r or b < r:
+                        rows[y, x] = _fit_at(line, x, a, b, r, coefficients) if v == v else v
+    for c in prange(chunks):  # down the columns
+        whole = np.empty(w, np.uint8)
+        for y in range(c * h // chunks, (c + 1) * h // chunks):
+            row = out[y]
+            whole[:] = 0
+            if r == 3 and 3 <= y < h - 3:  # a loop of fixed length, in vector registers
+                for x in range(w):
                     total = 0.0
+                    joined = True
                     for k in range(7):
-                        total += full[k] * float(rows[y + k - 3, x0 + i])
-                    acc[i] = total
+                        total += full[k] * float(rows[y + k - 3, x])
+                    for k in range(6):
+                        joined &= _joined(rows[y + k - 3, x], rows[y + k - 2, x], jump)
+                    row[x] = total
+                    whole[x] = joined
             elif r <= y < h - r:
-                for i in range(n):
+                for x in range(w):
                     total = 0.0
                     for k in range(2 * r + 1):
-                        total += full[k] * float(rows[y + k - r, x0 + i])
-                    acc[i] = total
-            if y < h - 1:
-                for i in range(n):
-                    down[i] = (min(down[i] + 1, r)
-                               if _joined(rows[y, x0 + i], rows[y + 1, x0 + i], jump) else 0)
-            for i in range(n):  # the windows cut short
-                a, b = int(up[y, i]), down[i]
-                if a < r or b < r:
-                    v = rows[y, x0 + i]
-                    acc[i] = _fit_at(rows[:, x0 + i], y, a, b, r, coefficients) if v == v else v
-            for i in range(n):
-                out[y, x0 + i] = acc[i]
+                        total += full[k] * float(rows[y + k - r, x])
+                    row[x] = total
+            for x in range(w):  # the windows cut short
+                if whole[x] == 0:
+                    column = rows[:, x]
+                    v = column[y]
+                    a, b = _reach(column, y, -1, r, jump), _reach(column, y, 1, r, jump)
+                    if v != v or a < r or b < r:
+                        row[x] = _fit_at(column, y, a, b, r, coefficients) if v == v else v
     return out
+
+
+@_numba_inline
+def _filter_line(line: np.ndarray, full: np.ndarray, r: int, jump: float, row: np.ndarray,
+                 whole: np.ndarray) -> None:
+    """``row``: ``line`` filtered with the whole window's weights ``full`` where the window
+    fits in the line; ``whole``: 1 where the window's neighbours all join (radius 3, the
+    default sigma: loops of fixed length, in vector registers), else 0."""
+    w = line.shape[0]
+    whole[:] = 0
+    if r == 3:
+        for x in range(3, w - 3):
+            total = 0.0
+            joined = True
+            for k in range(7):
+                total += full[k] * float(line[x + k - 3])
+            for k in range(6):
+                joined &= _joined(line[x + k - 3], line[x + k - 2], jump)
+            row[x] = total
+            whole[x] = joined
+    else:
+        for x in range(r, w - r):
+            total = 0.0
+            for k in range(2 * r + 1):
+                total += full[k] * float(line[x + k - r])
+            row[x] = total
 
 
 def line_coefficients(weights: np.ndarray) -> np.ndarray:
@@ -742,26 +770,39 @@ def line_coefficients(weights: np.ndarray) -> np.ndarray:
     return out
 
 
-def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
+def smooth_runs(values: np.ndarray, sigma: float, jump: float, kink: float = math.inf,
+                kink_reach: int = 2, negate: bool = False) -> np.ndarray:
     """Smooth a map along its rows, then its columns: each valid value becomes that of the
     Gaussian-weighted (``sigma`` px, to 3 sigma) least-squares line through its neighbours,
     taken only up to the first invalid one or step over ``jump`` (never across two
     surfaces; a line, not a mean, so a window cut short on one side is not biased by the
     slope).
 
+    With ``kink`` and ``negate``, the map is first negated and its kinks dropped (as
+    :func:`drop_kinks` with ``kink`` and ``kink_reach``) in the same pass, bit for bit
+    ``smooth_runs(drop_kinks(-values, kink, kink_reach), sigma, jump)`` without the two
+    full-image copies.
+
     Parameters
     ----------
     values : numpy.ndarray
         ``(h, w)`` float32, NaN where invalid.
     sigma : float
-        Gaussian sigma (px); 0 returns a copy.
+        Gaussian sigma (px); 0 smooths nothing (a copy, negated and without its kinks).
     jump : float
         Largest step between neighbours of one surface.
+    kink : float, optional
+        Largest second difference along a row of one surface (:func:`drop_kinks`);
+        infinite (the default) drops none.
+    kink_reach : int, optional
+        Columns on each side of a kink dropped too.
+    negate : bool, optional
+        Smooth ``-values`` (for a coordinate that falls along the rows).
 
     Returns
     -------
     numpy.ndarray
-        ``(h, w)`` float32, NaN where ``values`` is.
+        ``(h, w)`` float32, NaN where ``values`` is (and at the kinks dropped).
 
     Examples
     --------
@@ -771,13 +812,17 @@ def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
     >>> noisy = np.float32([[0, 1, 2, 3, 4, 5, 6]]) + np.float32([[0, 0, 0, 0.7, 0, 0, 0]])
     >>> round(float(smooth_runs(noisy, 1.0, 5.0)[0, 3]), 3)  # the spike mostly averaged out
     3.279
+    >>> step = np.float32([[0, 1, 2, 3, 4, 8, 12, 13, 14, 15, 16, 17]])  # a blurred step
+    >>> np.round(smooth_runs(step, 1.0, 5.0, kink=2.0, kink_reach=1, negate=True), 6).tolist()
+    [[-0.0, -1.0, -2.0, nan, nan, nan, nan, nan, -14.0, -15.0, -16.0, -17.0]]
     """
     values = np.ascontiguousarray(values, np.float32)
     if not sigma > 0:
-        return values.copy()
+        return drop_kinks(-values if negate else values, kink, kink_reach)
     radius = max(1, int(math.ceil(3 * sigma)))
     weights = np.exp(-0.5 * (np.arange(radius + 1) / sigma) ** 2)
-    return _smooth(values, radius, line_coefficients(weights), float(jump))
+    return _smooth(values, radius, line_coefficients(weights), float(jump), float(kink),
+                   int(kink_reach), bool(negate))
 
 
 @kernel(parallel=True)
