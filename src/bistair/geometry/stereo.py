@@ -79,8 +79,10 @@ from .stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
-    grid_depth,
+    count_status,
+    depth_counts,
     match_pair,
+    pick_finite,
     rectified_positions,
     remap_valid,
     smooth_runs,
@@ -347,11 +349,11 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     coords = _coordinates(left, right, calibration, orientation)
     settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
     m = _match(coords, rect, *settings)
-    mask = np.isfinite(m.depth)
-    counts = np.bincount(m.status.ravel(), minlength=8)
+    mask, matched = m.mask, int(m.per_row.sum())
+    counts = count_status(m.status)
     info: dict[str, Any] = {
-        "left_decoded": int(m.decoded.sum()), "matched": int(mask.sum()),
-        "matched_fraction": round(float(mask.sum() / max(m.decoded.sum(), 1)), 6),
+        "left_decoded": m.decoded, "matched": matched,
+        "matched_fraction": round(float(matched / max(m.decoded, 1)), 6),
         "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
         "not_monotonic": int(counts[NOT_MONOTONIC]),
         "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
@@ -389,16 +391,19 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
 @dataclass
 class _Matched:
     """What :func:`_match` gives: the matched axis, the disparity and status on the
-    rectified left grid, the depth on the left camera's own grid (and how many points fell
-    outside the depth range), the left pixels decoded on that axis, and the thresholds
-    used (noise, tolerance, wiggle, support: rectified pixels)."""
+    rectified left grid, the depth on the left camera's own grid, where it is found
+    (``mask``, and how many per row), how many points fell outside the depth range, the
+    left pixels decoded on that axis, and the thresholds used (noise, tolerance, wiggle,
+    support: rectified pixels)."""
 
     axis: str
     disparity: np.ndarray
     status: np.ndarray
     depth: np.ndarray
+    mask: np.ndarray
+    per_row: np.ndarray
     outside: int
-    decoded: np.ndarray
+    decoded: int
     noise: float
     tolerance: float
     wiggle: float
@@ -436,11 +441,11 @@ def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification
                                    other=pair[0], other_right=pair[1],
                                    other_tolerance=other_tolerance)
     disparity, status = supported(disparity, status, support)
-    decoded = np.isfinite(coords[axis][0])
-    depth, outside = grid_depth(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
-                                rect.cy, rect.tx, rect.R1, min_depth, max_depth)
-    return _Matched(axis, disparity, status, depth, int(outside), decoded, noise, tolerance,
-                    wiggle, support)
+    depth, mask, outside, per_row, decoded = depth_counts(
+        disparity, *rect.positions, coords[axis][0], rect.f, rect.cx_left, rect.cy, rect.tx,
+        rect.R1, min_depth, max_depth)
+    return _Matched(axis, disparity, status, depth, mask, per_row, outside, decoded, noise,
+                    tolerance, wiggle, support)
 
 
 def _misfits(coords: Coords, rect: Rectification, settings: tuple,
@@ -449,11 +454,10 @@ def _misfits(coords: Coords, rect: Rectification, settings: tuple,
     ``coords`` (``m`` if already made) and its share of the decoded left pixels with a
     point."""
     m = m or _match(coords, rect, *settings)
-    mask = np.isfinite(m.depth)
-    rows, cols = np.nonzero(mask)
-    share = float(len(rows) / max(m.decoded.sum(), 1))
-    pick = np.linspace(0, len(rows) - 1, min(len(rows), MISFIT_SAMPLE)).astype(np.int64)
-    rows, cols = rows[pick], cols[pick]
+    matched = int(m.per_row.sum())
+    share = float(matched / max(m.decoded, 1))
+    pick = np.linspace(0, matched - 1, min(matched, MISFIT_SAMPLE)).astype(np.int64)
+    rows, cols = pick_finite(m.depth, m.per_row, pick)  # (not the list of all matches)
     z = m.depth[rows, cols]
     points = np.column_stack([z * rect.rays[0][rows, cols], z * rect.rays[1][rows, cols], z])
     return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share

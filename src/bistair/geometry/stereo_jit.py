@@ -878,17 +878,24 @@ def supported(disparity: np.ndarray, status: np.ndarray, support: float = 2.0
 
 
 @kernel(parallel=True)
-def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
+def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, decoded: np.ndarray, f: float,
            cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
-           max_step: float) -> tuple[np.ndarray, int]:
+           max_step: float) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, int]:
+    """:func:`grid_depth` of the pixels where ``decoded`` (a coordinate map) is not NaN,
+    with the mask of the depths found (uint8), the points outside the range, the depths
+    found per row and the pixels decoded."""
     h, w = u.shape
     depth = np.empty((h, w), np.float32)
+    found = np.empty((h, w), np.uint8)
     outside = np.zeros(h, np.int64)
+    per_row = np.zeros(h, np.int64)
+    valid = np.zeros(h, np.int64)
     for y in prange(h):
         for x in range(w):
             z = math.nan
             d = math.nan
-            if valid[y, x] != 0:  # uint8: numba reads bool arrays slowly
+            if decoded[y, x] == decoded[y, x]:
+                valid[y] += 1
                 d = _bilinear(disparity, u[y, x], v[y, x], max_step)
             if d * tx < 0.0:  # not NaN, and in front of the cameras
                 scale = -tx / d  # Z / f in the rectified frame
@@ -897,7 +904,9 @@ def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarra
                     outside[y] += 1
                     z = math.nan
             depth[y, x] = z
-    return depth, outside.sum()
+            found[y, x] = z == z
+            per_row[y] += 1 if z == z else 0
+    return depth, found, outside.sum(), per_row, valid.sum()
 
 
 def grid_depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
@@ -948,8 +957,139 @@ def grid_depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.nd
     >>> z.tolist(), out
     ([[300.0, 300.0]], 0)
     """
-    return _depth(np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
-                  np.asarray(v, np.float32),
-                  np.ascontiguousarray(valid, np.bool_).view(np.uint8), float(f), float(cx),
-                  float(cy), float(tx), np.ascontiguousarray(np.asarray(rotation, np.float64).T),
-                  float(min_depth), float(max_depth), float(max_step))
+    decoded = np.where(np.asarray(valid, bool), np.float32(0), np.float32(np.nan))
+    out = depth_counts(disparity, u, v, decoded, f, cx, cy, tx, rotation, min_depth,
+                       max_depth, max_step)
+    return out[0], out[2]
+
+
+def depth_counts(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, decoded: np.ndarray,
+                 f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
+                 min_depth: float = 0.0, max_depth: float = math.inf, max_step: float = 2.0
+                 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, int]:
+    """:func:`grid_depth` of the pixels where the coordinate map ``decoded`` is not NaN,
+    with what the checks count, in the same pass (no full-image temporaries).
+
+    Parameters
+    ----------
+    disparity, u, v, f, cx, cy, tx, rotation, min_depth, max_depth, max_step
+        As for :func:`grid_depth`.
+    decoded : numpy.ndarray
+        ``(H, W)`` float map (the camera's projector coordinate), NaN where not decoded.
+
+    Returns
+    -------
+    depth : numpy.ndarray
+        As :func:`grid_depth`'s.
+    mask : numpy.ndarray
+        ``(H, W)`` bool: where ``depth`` is not NaN.
+    outside : int
+        Pixels triangulated but outside the depth range.
+    per_row : numpy.ndarray
+        ``(H,)`` int64: the depths found in each row.
+    valid : int
+        The pixels decoded.
+
+    Examples
+    --------
+    >>> d = np.full((3, 4), 20.0, np.float32)
+    >>> u, v = np.float32([[1.0, 2.5, 1.0]]), np.float32([[1.0, 1.0, 9.0]])
+    >>> out = depth_counts(d, u, v, np.float32([[3, 4, 5]]), 100.0, 1.0, 1.0, -60.0,
+    ...                    np.eye(3))
+    >>> out[0].tolist(), out[1].tolist(), out[2], out[3].tolist(), out[4]
+    ([[300.0, 300.0, nan]], [[True, True, False]], 0, [2], 3)
+    """
+    depth, found, outside, per_row, valid = _depth(
+        np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
+        np.asarray(v, np.float32), np.asarray(decoded), float(f), float(cx), float(cy),
+        float(tx), np.ascontiguousarray(np.asarray(rotation, np.float64).T), float(min_depth),
+        float(max_depth), float(max_step))
+    return depth, found.view(np.bool_), int(outside), per_row, int(valid)
+
+
+@kernel(parallel=True)
+def _pick(values: np.ndarray, starts: np.ndarray, picks: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    h, w = values.shape
+    rows = np.empty(len(picks), np.int64)
+    cols = np.empty(len(picks), np.int64)
+    for y in prange(h):
+        i = np.searchsorted(picks, starts[y])  # the first pick in this row
+        if i == len(picks) or picks[i] >= starts[y + 1]:
+            continue
+        k = starts[y]
+        for x in range(w):
+            if values[y, x] == values[y, x]:
+                while i < len(picks) and picks[i] == k:
+                    rows[i] = y
+                    cols[i] = x
+                    i += 1
+                k += 1
+    return rows, cols
+
+
+def pick_finite(values: np.ndarray, per_row: np.ndarray, picks: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and columns of the finite values of ``values`` whose places in row-major
+    order are ``picks``: ``np.nonzero(np.isfinite(values))`` at ``picks``, without the
+    list of them all.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(H, W)`` float map, NaN where invalid.
+    per_row : numpy.ndarray
+        ``(H,)`` the finite values in each row.
+    picks : numpy.ndarray
+        Non-decreasing places, each less than ``per_row.sum()``.
+
+    Returns
+    -------
+    rows, cols : numpy.ndarray
+        int64, one per pick.
+
+    Examples
+    --------
+    >>> m = np.float32([[np.nan, 1, 2], [3, np.nan, 4]])
+    >>> [a.tolist() for a in pick_finite(m, np.array([2, 2]), np.array([0, 2, 3]))]
+    [[0, 1, 1], [1, 0, 2]]
+    """
+    starts = np.zeros(len(per_row) + 1, np.int64)
+    np.cumsum(per_row, out=starts[1:])
+    return _pick(np.asarray(values), starts, np.ascontiguousarray(picks, np.int64))
+
+
+@kernel(parallel=True)
+def _count(status: np.ndarray, n: int) -> np.ndarray:
+    h, w = status.shape
+    per_row = np.zeros((h, n), np.int64)
+    for y in prange(h):
+        for x in range(w):
+            per_row[y, status[y, x]] += 1
+    counts = np.zeros(n, np.int64)
+    for y in range(h):
+        for k in range(n):
+            counts[k] += per_row[y, k]
+    return counts
+
+
+def count_status(status: np.ndarray) -> np.ndarray:
+    """How many pixels have each status code (:data:`NO_PHASE` to :data:`ALONE`):
+    ``np.bincount(status.ravel(), minlength=8)`` without its copy of the codes.
+
+    Parameters
+    ----------
+    status : numpy.ndarray
+        ``(h, w)`` int8 codes, 0 to 7 (:func:`match_pair`, :func:`supported`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(8,)`` int64.
+
+    Examples
+    --------
+    >>> count_status(np.int8([[1, 1, 2], [7, 0, 1]])).tolist()
+    [1, 3, 1, 0, 0, 0, 0, 1]
+    """
+    return _count(np.ascontiguousarray(status, np.int8), 8)
