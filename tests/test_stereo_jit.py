@@ -23,9 +23,11 @@ from bistair.geometry.stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
+    cloud_points,
     count_status,
     depth_counts,
     grid_depth,
+    grid_points,
     match_pair,
     pick_finite,
     rectified_positions,
@@ -345,3 +347,23 @@ def test_the_misfit_share_is_the_one_the_copies_gave():
         want = stereo_before.projector_misfits(pts, coord, rows)
         assert projector_misfits(pts, coord, rows) == want
         assert (want > 0) == (moved > 0)
+
+
+def test_the_points_and_the_cloud_are_those_of_the_numpy_expressions():
+    """``grid_points`` and ``cloud_points`` (one pass each) give the points and the cloud
+    that ``StereoResult`` made with NumPy, bit for bit, in row-major order."""
+    rng = np.random.default_rng(4)
+    depth = rng.uniform(400, 900, (70, 90)).astype(np.float32)
+    depth[rng.random(depth.shape) < 0.3] = np.nan
+    depth[20:30] = np.nan
+    rx, ry = (rng.uniform(-0.6, 0.6, depth.shape).astype(np.float32) for _ in range(2))
+    grey = rng.integers(0, 256, depth.shape).astype(np.uint8)
+    want = np.stack([depth * rx, depth * ry, depth], axis=-1)
+    got = grid_points(depth, rx, ry)
+    np.testing.assert_array_equal(got.view(np.uint32), want.view(np.uint32))
+    mask = np.isfinite(depth)
+    pts, rgb = cloud_points(depth, rx, ry, grey, mask)
+    want = np.column_stack([depth[mask] * rx[mask], depth[mask] * ry[mask], depth[mask]])
+    assert pts.dtype == np.float32 and rgb.dtype == np.uint8
+    np.testing.assert_array_equal(pts.view(np.uint32), want.view(np.uint32))
+    np.testing.assert_array_equal(rgb, np.repeat(grey[mask][:, None], 3, axis=1))

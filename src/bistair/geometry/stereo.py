@@ -79,8 +79,10 @@ from .stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
+    cloud_points,
     count_status,
     depth_counts,
+    grid_points,
     match_pair,
     pick_finite,
     rectified_positions,
@@ -246,8 +248,7 @@ class StereoResult:
     @property
     def points(self) -> np.ndarray:
         """``(H, W, 3)`` float32, the left camera's frame (mm), NaN where unknown."""
-        x, y = self.rectification.rays
-        return np.stack([self.depth * x, self.depth * y, self.depth], axis=-1)
+        return grid_points(self.depth, *self.rectification.rays)
 
     @property
     def colors(self) -> np.ndarray:
@@ -256,10 +257,7 @@ class StereoResult:
 
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
-        z = self.depth[self.mask]
-        x, y = (r[self.mask] for r in self.rectification.rays)
-        return (np.column_stack([z * x, z * y, z]),
-                np.repeat(self.grey[self.mask][:, None], 3, axis=1))
+        return cloud_points(self.depth, *self.rectification.rays, self.grey, self.mask)
 
 
 def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,

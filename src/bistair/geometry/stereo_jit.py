@@ -814,7 +814,7 @@ def smooth_runs(values: np.ndarray, sigma: float, jump: float, kink: float = mat
     3.279
     >>> step = np.float32([[0, 1, 2, 3, 4, 8, 12, 13, 14, 15, 16, 17]])  # a blurred step
     >>> np.round(smooth_runs(step, 1.0, 5.0, kink=2.0, kink_reach=1, negate=True), 6).tolist()
-    [[-0.0, -1.0, -2.0, nan, nan, nan, nan, nan, -14.0, -15.0, -16.0, -17.0]]
+    [[0.0, -1.0, -2.0, nan, nan, nan, nan, nan, -14.0, -15.0, -16.0, -17.0]]
     """
     values = np.ascontiguousarray(values, np.float32)
     if not sigma > 0:
@@ -1093,3 +1093,108 @@ def count_status(status: np.ndarray) -> np.ndarray:
     [1, 3, 1, 0, 0, 0, 0, 1]
     """
     return _count(np.ascontiguousarray(status, np.int8), 8)
+
+
+@kernel(parallel=True)
+def _points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+    h, w = depth.shape
+    out = np.empty((h, w, 3), np.float32)
+    for y in prange(h):
+        for x in range(w):
+            z = depth[y, x]
+            out[y, x, 0] = z * rx[y, x]
+            out[y, x, 1] = z * ry[y, x]
+            out[y, x, 2] = z
+    return out
+
+
+def grid_points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+    """The points ``z * (x, y, 1)`` of a depth map and its pixels' rays, on its grid:
+    ``np.stack([depth * rx, depth * ry, depth], axis=-1)`` in one pass.
+
+    Parameters
+    ----------
+    depth : numpy.ndarray
+        ``(H, W)`` float32 ``z`` (NaN where unknown).
+    rx, ry : numpy.ndarray
+        ``(H, W)`` float32 rays (:func:`rectified_positions`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` float32.
+
+    Examples
+    --------
+    >>> z = np.float32([[2, np.nan]])
+    >>> grid_points(z, np.float32([[0.5, 1]]), np.float32([[-1, 1]])).tolist()
+    [[[1.0, -2.0, 2.0], [nan, nan, nan]]]
+    """
+    return _points(np.ascontiguousarray(depth, np.float32), np.asarray(rx, np.float32),
+                   np.asarray(ry, np.float32))
+
+
+@kernel(parallel=True)
+def _cloud(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray, grey: np.ndarray,
+           mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    h, w = depth.shape
+    per_row = np.zeros(h, np.int64)
+    for y in prange(h):
+        n = 0
+        for x in range(w):
+            n += 1 if mask[y, x] != 0 else 0
+        per_row[y] = n
+    starts = np.zeros(h + 1, np.int64)
+    for y in range(h):
+        starts[y + 1] = starts[y] + per_row[y]
+    pts = np.empty((starts[h], 3), np.float32)
+    cols = np.empty((starts[h], 3), np.uint8)
+    for y in prange(h):
+        i = starts[y]
+        for x in range(w):
+            if mask[y, x] != 0:
+                z = depth[y, x]
+                pts[i, 0] = z * rx[y, x]
+                pts[i, 1] = z * ry[y, x]
+                pts[i, 2] = z
+                g = grey[y, x]
+                cols[i, 0] = g
+                cols[i, 1] = g
+                cols[i, 2] = g
+                i += 1
+    return pts, cols
+
+
+def cloud_points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray, grey: np.ndarray,
+                 mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The points of ``mask`` in row-major order and their grey as RGB, in one pass: what
+    ``grid_points(depth, rx, ry)[mask]`` and ``np.repeat(grey[mask][:, None], 3, axis=1)``
+    give, without the full grids.
+
+    Parameters
+    ----------
+    depth, rx, ry : numpy.ndarray
+        As for :func:`grid_points`.
+    grey : numpy.ndarray
+        ``(H, W)`` uint8.
+    mask : numpy.ndarray
+        ``(H, W)`` bool: the points kept.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(N, 3)`` float32.
+    colors : numpy.ndarray
+        ``(N, 3)`` uint8.
+
+    Examples
+    --------
+    >>> z = np.float32([[2, 4], [np.nan, 1]])
+    >>> pts, rgb = cloud_points(z, np.ones((2, 2), np.float32), np.zeros((2, 2), np.float32),
+    ...                         np.uint8([[10, 20], [30, 40]]), np.isfinite(z))
+    >>> pts.tolist(), rgb[:, 0].tolist()
+    ([[2.0, 0.0, 2.0], [4.0, 0.0, 4.0], [1.0, 0.0, 1.0]], [10, 20, 40])
+    """
+    return _cloud(np.ascontiguousarray(depth, np.float32), np.asarray(rx, np.float32),
+                  np.asarray(ry, np.float32), np.ascontiguousarray(grey, np.uint8),
+                  np.ascontiguousarray(mask, np.bool_).view(np.uint8))
