@@ -891,21 +891,23 @@ def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, decoded: np.ndar
     per_row = np.zeros(h, np.int64)
     valid = np.zeros(h, np.int64)
     for y in prange(h):
+        n_valid, n_found, n_outside = 0, 0, 0  # (in registers)
         for x in range(w):
             z = math.nan
             d = math.nan
             if decoded[y, x] == decoded[y, x]:
-                valid[y] += 1
+                n_valid += 1
                 d = _bilinear(disparity, u[y, x], v[y, x], max_step)
             if d * tx < 0.0:  # not NaN, and in front of the cameras
                 scale = -tx / d  # Z / f in the rectified frame
                 z = ((u[y, x] - cx) * rt[2, 0] + (v[y, x] - cy) * rt[2, 1] + f * rt[2, 2]) * scale
                 if not zmin <= z <= zmax:
-                    outside[y] += 1
+                    n_outside += 1
                     z = math.nan
             depth[y, x] = z
             found[y, x] = z == z
-            per_row[y] += 1 if z == z else 0
+            n_found += 1 if z == z else 0
+        valid[y], per_row[y], outside[y] = n_valid, n_found, n_outside
     return depth, found, outside.sum(), per_row, valid.sum()
 
 
