@@ -14,7 +14,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
 2. Before matching, the kinks of each rectified row are dropped
    (:func:`~.stereo_jit.drop_kinks`: second differences over four times the measured noise,
    the blurred step between two surfaces whose pixels mix both), and with ``smooth`` both
-   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`).
+   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`, which does
+   both, and turns a falling coordinate round, in one pass).
 3. Matching (:func:`~.stereo_jit.match_pair`): for each valid left pixel, the right pixel
    of equal projector coordinate on the same rectified row, interpolated between the two
    valid neighbours that bracket it (a line through four samples where it crosses once),
@@ -27,7 +28,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    below (:func:`~.stereo_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
    with the measured noise (four, three and 5.7 times it, as a position along the row).
    Occlusions and mismatches are NaN, never a guess.
-4. Points (:func:`~.stereo_jit.grid_depth`): each decoded left pixel reads the disparity
+4. Points (:func:`~.stereo_jit.grid_depth`; :func:`~.stereo_jit.depth_counts` counts the
+   points per row in the same pass): each decoded left pixel reads the disparity
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
