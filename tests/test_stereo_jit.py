@@ -2,7 +2,8 @@
 mixing surfaces, where pixels land on the rectified grid (against OpenCV), the row search for
 equal phase (against a plain search on random rising rows), its refusals (gaps, steps,
 falls, two places), the row-support check, the points, and the smoothing within runs
-(against its definition, sample by sample)."""
+(against its definition, sample by sample); and the passes issue 32 made cheaper against
+the ones they replaced (``tests/support/stereo_before.py``), bit for bit."""
 
 from __future__ import annotations
 
@@ -11,7 +12,9 @@ import math
 import cv2
 import numpy as np
 import pytest
+from support import stereo_before
 
+from bistair.geometry.stereo_checks import projector_misfits
 from bistair.geometry.stereo_jit import (
     ALONE,
     AMBIGUOUS,
@@ -20,8 +23,13 @@ from bistair.geometry.stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
+    cloud_points,
+    count_status,
+    depth_counts,
     grid_depth,
+    grid_points,
     match_pair,
+    pick_finite,
     rectified_positions,
     remap_valid,
     smooth_runs,
@@ -262,3 +270,100 @@ def test_a_gap_is_bridged_only_where_the_slope_carries_across_it():
     _, status = match_pair(np.float32([[3.0, 3.5, 4.0]]), smooth + np.float32(
         [[0, 0, 0, 0, 0, 1.4, 1.4, 1.4]]), -20.0, 20.0, reach=1)
     assert status[0, 1] == MATCHED
+
+
+def _surfaces(rng: np.random.Generator, h: int, w: int, slope: float) -> np.ndarray:
+    """A rectified coordinate map: three surfaces, blurred steps (kinks), noise, holes."""
+    yy, xx = np.mgrid[0:h, 0:w].astype(float)
+    values = slope * xx + 0.3 * yy + 4 * np.sin(xx / 7)
+    values[:, 30:] += 50.0 * np.sign(slope)
+    values[15:, :] -= 40.0
+    values[:, 29] = 0.5 * (values[:, 28] + values[:, 31])  # a pixel mixing two surfaces
+    values += rng.normal(0, 0.05, values.shape)
+    values[rng.random(values.shape) < 0.04] = np.nan
+    values[5:9, 10:14] = np.nan
+    return values.astype(np.float32)
+
+
+@pytest.mark.parametrize(("sigma", "negate", "kink"),
+                         [(1.0, False, 2.0), (1.0, True, 2.0), (0.6, True, 1.0),
+                          (2.0, False, 2.0), (1.0, False, math.inf), (0.0, True, 2.0)])
+def test_one_pass_prepares_a_map_as_the_kinks_negation_and_smoothing_did(sigma, negate,
+                                                                         kink):
+    """Dropping the kinks, negating and smoothing in one pass (``smooth_runs`` with ``kink``
+    and ``negate``) gives what the three passes gave, bit for bit."""
+    rng = np.random.default_rng(11)
+    for trial in range(3):
+        values = _surfaces(rng, 34 + trial, 61, -1.5 if negate else 1.5)
+        got = smooth_runs(values, sigma, 5.0, kink, 1, negate=negate)
+        want = stereo_before.prepared(values, sigma, 5.0, kink, 1, negate)
+        np.testing.assert_array_equal(got.view(np.uint32), want.view(np.uint32))
+
+
+def test_the_points_counts_and_sample_are_those_of_the_whole_image_passes():
+    """``depth_counts`` gives ``grid_depth``'s depth with its mask, counts per row and the
+    decoded pixels; ``pick_finite`` the misfit check's sample that ``np.nonzero`` of every
+    point gave; ``count_status`` ``np.bincount``'s counts."""
+    rng = np.random.default_rng(3)
+    h, w = 90, 120
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float32)
+    disparity = (16.0 + 0.05 * xx + 0.02 * yy + rng.normal(0, 0.1, (h, w))).astype(np.float32)
+    disparity[:, 100:] -= 3.0  # beyond the depth range
+    disparity[rng.random((h, w)) < 0.05] = np.nan
+    disparity[40:50] = np.nan  # rows without a point
+    u = xx + rng.uniform(-1, 1, (h, w)).astype(np.float32)
+    v = yy + rng.uniform(-1, 1, (h, w)).astype(np.float32)
+    coord = rng.uniform(0, 100, (h, w)).astype(np.float32)
+    coord[rng.random((h, w)) < 0.1] = np.nan
+    rot = cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0]
+    args = (100.0, 60.0, 45.0, -80.0, rot, 380.0, 520.0)
+    depth, mask, outside, per_row, decoded = depth_counts(disparity, u, v, coord, *args)
+    want, want_outside = grid_depth(disparity, u, v, np.isfinite(coord), *args)
+    np.testing.assert_array_equal(depth.view(np.uint32), want.view(np.uint32))
+    np.testing.assert_array_equal(mask, np.isfinite(want))
+    assert outside == want_outside > 0 and decoded == np.isfinite(coord).sum()
+    assert 0.5 * decoded < mask.sum() < decoded and (per_row == 0).any()
+    np.testing.assert_array_equal(per_row, np.isfinite(want).sum(axis=1))
+    for count in (0, 1, 7, int(mask.sum()) // 3, int(mask.sum())):
+        pick = np.linspace(0, mask.sum() - 1, count).astype(np.int64)
+        rows, cols = np.nonzero(mask)
+        got = pick_finite(depth, per_row, pick)
+        np.testing.assert_array_equal(got[0], rows[pick])
+        np.testing.assert_array_equal(got[1], cols[pick])
+    status = rng.integers(0, 8, (h, w)).astype(np.int8)
+    np.testing.assert_array_equal(count_status(status), np.bincount(status.ravel(),
+                                                                    minlength=8))
+
+
+def test_the_misfit_share_is_the_one_the_copies_gave():
+    """``projector_misfits`` with its cubic's powers made once and its first fit on the
+    arrays themselves: the share of misfits the old one gave, exactly."""
+    rng = np.random.default_rng(8)
+    for n, moved in ((40000, 0), (40000, 1500), (12000, 900), (30000, 2500)):
+        pts = rng.uniform([-100, -80, 500], [100, 80, 700], (n, 3))
+        coord = 960 + 2000 * (pts[:, 0] - 100) / pts[:, 2] + rng.normal(0, 0.3, n)
+        rows = np.floor(240 + 600 * pts[:, 1] / pts[:, 2])
+        pts[:moved, 2] *= rng.uniform(1.01, 1.2, moved)
+        want = stereo_before.projector_misfits(pts, coord, rows)
+        assert projector_misfits(pts, coord, rows) == want
+        assert (want > 0) == (moved > 0)
+
+
+def test_the_points_and_the_cloud_are_those_of_the_numpy_expressions():
+    """``grid_points`` and ``cloud_points`` (one pass each) give the points and the cloud
+    that ``StereoResult`` made with NumPy, bit for bit, in row-major order."""
+    rng = np.random.default_rng(4)
+    depth = rng.uniform(400, 900, (70, 90)).astype(np.float32)
+    depth[rng.random(depth.shape) < 0.3] = np.nan
+    depth[20:30] = np.nan
+    rx, ry = (rng.uniform(-0.6, 0.6, depth.shape).astype(np.float32) for _ in range(2))
+    grey = rng.integers(0, 256, depth.shape).astype(np.uint8)
+    want = np.stack([depth * rx, depth * ry, depth], axis=-1)
+    got = grid_points(depth, rx, ry)
+    np.testing.assert_array_equal(got.view(np.uint32), want.view(np.uint32))
+    mask = np.isfinite(depth)
+    pts, rgb = cloud_points(depth, rx, ry, grey, mask)
+    want = np.column_stack([depth[mask] * rx[mask], depth[mask] * ry[mask], depth[mask]])
+    assert pts.dtype == np.float32 and rgb.dtype == np.uint8
+    np.testing.assert_array_equal(pts.view(np.uint32), want.view(np.uint32))
+    np.testing.assert_array_equal(rgb, np.repeat(grey[mask][:, None], 3, axis=1))

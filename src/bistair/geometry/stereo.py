@@ -14,7 +14,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
 2. Before matching, the kinks of each rectified row are dropped
    (:func:`~.stereo_jit.drop_kinks`: second differences over four times the measured noise,
    the blurred step between two surfaces whose pixels mix both), and with ``smooth`` both
-   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`).
+   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`, which does
+   both, and turns a falling coordinate round, in one pass).
 3. Matching (:func:`~.stereo_jit.match_pair`): for each valid left pixel, the right pixel
    of equal projector coordinate on the same rectified row, interpolated between the two
    valid neighbours that bracket it (a line through four samples where it crosses once),
@@ -27,7 +28,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    below (:func:`~.stereo_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
    with the measured noise (four, three and 5.7 times it, as a position along the row).
    Occlusions and mismatches are NaN, never a guess.
-4. Points (:func:`~.stereo_jit.grid_depth`): each decoded left pixel reads the disparity
+4. Points (:func:`~.stereo_jit.grid_depth`; :func:`~.stereo_jit.depth_counts` counts the
+   points per row in the same pass): each decoded left pixel reads the disparity
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
@@ -79,9 +81,12 @@ from .stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
-    drop_kinks,
-    grid_depth,
+    cloud_points,
+    count_status,
+    depth_counts,
+    grid_points,
     match_pair,
+    pick_finite,
     rectified_positions,
     remap_valid,
     smooth_runs,
@@ -245,8 +250,7 @@ class StereoResult:
     @property
     def points(self) -> np.ndarray:
         """``(H, W, 3)`` float32, the left camera's frame (mm), NaN where unknown."""
-        x, y = self.rectification.rays
-        return np.stack([self.depth * x, self.depth * y, self.depth], axis=-1)
+        return grid_points(self.depth, *self.rectification.rays)
 
     @property
     def colors(self) -> np.ndarray:
@@ -255,10 +259,7 @@ class StereoResult:
 
     def cloud(self) -> tuple[np.ndarray, np.ndarray]:
         """The valid points ``(N, 3)`` float32 and their colours ``(N, 3)`` uint8."""
-        z = self.depth[self.mask]
-        x, y = (r[self.mask] for r in self.rectification.rays)
-        return (np.column_stack([z * x, z * y, z]),
-                np.repeat(self.grey[self.mask][:, None], 3, axis=1))
+        return cloud_points(self.depth, *self.rectification.rays, self.grey, self.mask)
 
 
 def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | AxesResult,
@@ -348,11 +349,11 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     coords = _coordinates(left, right, calibration, orientation)
     settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
     m = _match(coords, rect, *settings)
-    mask = np.isfinite(m.depth)
-    counts = np.bincount(m.status.ravel(), minlength=8)
+    mask, matched = m.mask, int(m.per_row.sum())
+    counts = count_status(m.status)
     info: dict[str, Any] = {
-        "left_decoded": int(m.decoded.sum()), "matched": int(mask.sum()),
-        "matched_fraction": round(float(mask.sum() / max(m.decoded.sum(), 1)), 6),
+        "left_decoded": m.decoded, "matched": matched,
+        "matched_fraction": round(float(matched / max(m.decoded, 1)), 6),
         "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
         "not_monotonic": int(counts[NOT_MONOTONIC]),
         "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
@@ -390,16 +391,19 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
 @dataclass
 class _Matched:
     """What :func:`_match` gives: the matched axis, the disparity and status on the
-    rectified left grid, the depth on the left camera's own grid (and how many points fell
-    outside the depth range), the left pixels decoded on that axis, and the thresholds
-    used (noise, tolerance, wiggle, support: rectified pixels)."""
+    rectified left grid, the depth on the left camera's own grid, where it is found
+    (``mask``, and how many per row), how many points fell outside the depth range, the
+    left pixels decoded on that axis, and the thresholds used (noise, tolerance, wiggle,
+    support: rectified pixels)."""
 
     axis: str
     disparity: np.ndarray
     status: np.ndarray
     depth: np.ndarray
+    mask: np.ndarray
+    per_row: np.ndarray
     outside: int
-    decoded: np.ndarray
+    decoded: int
     noise: float
     tolerance: float
     wiggle: float
@@ -416,15 +420,15 @@ def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification
                       remap_valid(rc, *rect.maps_right, spread[name]))
                for name, (lc, rc) in coords.items()}
     axis, slope = _matched_axis(on_grid)
-    src, dst = on_grid[axis] if slope > 0 else (-m for m in on_grid[axis])
     # the thresholds grow with the noise: the phase's own (a row's second differences)
-    # as a position along the row
-    noise_l, noise_r = _noise(src), _noise(dst)
+    # as a position along the row (a map and its negation have the same)
+    noise_l, noise_r = (_noise(m) for m in on_grid[axis])
     noise = max(noise_l, noise_r) / abs(slope)
-    src, dst = (drop_kinks(m, max(KINK * n * math.sqrt(6.0), 0.5 * abs(slope)), KINK_REACH)
-                for m, n in ((src, noise_l), (dst, noise_r)))
-    if smooth > 0:
-        src, dst = (smooth_runs(m, smooth, spread[axis]) for m in (src, dst))
+    # both maps rising along the rows, without their kinks, smoothed: one pass each
+    src, dst = (smooth_runs(m, smooth, spread[axis], max(KINK * n * math.sqrt(6.0),
+                                                         0.5 * abs(slope)), KINK_REACH,
+                            negate=slope < 0)
+                for m, n in zip(on_grid[axis], (noise_l, noise_r), strict=True))
     wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
     support = max(support, 4.0 * math.sqrt(2.0) * noise)
     low, high = rect.disparities(min_depth, max_depth)
@@ -437,11 +441,11 @@ def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification
                                    other=pair[0], other_right=pair[1],
                                    other_tolerance=other_tolerance)
     disparity, status = supported(disparity, status, support)
-    decoded = np.isfinite(coords[axis][0])
-    depth, outside = grid_depth(disparity, *rect.positions, decoded, rect.f, rect.cx_left,
-                                rect.cy, rect.tx, rect.R1, min_depth, max_depth)
-    return _Matched(axis, disparity, status, depth, int(outside), decoded, noise, tolerance,
-                    wiggle, support)
+    depth, mask, outside, per_row, decoded = depth_counts(
+        disparity, *rect.positions, coords[axis][0], rect.f, rect.cx_left, rect.cy, rect.tx,
+        rect.R1, min_depth, max_depth)
+    return _Matched(axis, disparity, status, depth, mask, per_row, outside, decoded, noise,
+                    tolerance, wiggle, support)
 
 
 def _misfits(coords: Coords, rect: Rectification, settings: tuple,
@@ -450,11 +454,10 @@ def _misfits(coords: Coords, rect: Rectification, settings: tuple,
     ``coords`` (``m`` if already made) and its share of the decoded left pixels with a
     point."""
     m = m or _match(coords, rect, *settings)
-    mask = np.isfinite(m.depth)
-    rows, cols = np.nonzero(mask)
-    share = float(len(rows) / max(m.decoded.sum(), 1))
-    pick = np.linspace(0, len(rows) - 1, min(len(rows), MISFIT_SAMPLE)).astype(np.int64)
-    rows, cols = rows[pick], cols[pick]
+    matched = int(m.per_row.sum())
+    share = float(matched / max(m.decoded, 1))
+    pick = np.linspace(0, matched - 1, min(matched, MISFIT_SAMPLE)).astype(np.int64)
+    rows, cols = pick_finite(m.depth, m.per_row, pick)  # (not the list of all matches)
     z = m.depth[rows, cols]
     points = np.column_stack([z * rect.rays[0][rows, cols], z * rect.rays[1][rows, cols], z])
     return projector_misfits(points, coords[m.axis][0][rows, cols], rows), share

@@ -248,18 +248,25 @@ def projector_misfits(points: np.ndarray, coord: np.ndarray, rows: np.ndarray) -
     x_mean, x_scale = x.mean(), x.std() or 1.0
     xn = (x - x_mean) / x_scale
     vn = (v - v.mean()) / (v.std() or 1.0)
-    cubic = np.column_stack([xn**i * vn**j for i in range(4) for j in range(4 - i)])
+    xp, vp = [xn**i for i in range(4)], [vn**j for j in range(4)]
+    cubic = np.empty((len(xn), 10))  # x^i v^j, i + j <= 3
+    powers = [(i, j) for i in range(4) for j in range(4 - i)]
+    for c, (i, j) in enumerate(powers):
+        np.multiply(xp[i], vp[j], out=cubic[:, c])
     system = np.empty((len(xn), 8))  # a . P + a0 - x (c . P + c0), x the corrected coordinate
     system[:, :3], system[:, 3] = pts, 1.0
     bent = np.zeros_like(xn)  # the distortion's share of each coordinate
-    keep = np.arange(len(xn))
+    keep = None  # every point, at first
     for _ in range(4):
         corrected = xn - bent
         system[:, 4:7], system[:, 7] = -corrected[:, None] * pts, -corrected
-        p = _dlt(system[keep], pts[keep])
+        if keep is None:
+            p = _dlt(system, pts)
+        else:
+            p = _dlt(system[keep], pts[keep])
         residual = xn - (pts @ p[:3] + p[3]) / (pts @ p[4:7] + p[7])
-        sub = cubic[keep]
-        bent = cubic @ np.linalg.solve(sub.T @ sub, sub.T @ residual[keep])
+        sub, kept = (cubic, residual) if keep is None else (cubic[keep], residual[keep])
+        bent = cubic @ np.linalg.solve(sub.T @ sub, sub.T @ kept)
         off = np.abs(residual - bent)
         keep = np.flatnonzero(off <= np.partition(off, int(0.9 * (len(off) - 1)))[
             int(0.9 * (len(off) - 1))])

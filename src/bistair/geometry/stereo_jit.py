@@ -626,83 +626,111 @@ def _fit_at(line: np.ndarray, x: int, a: int, b: int, radius: int,
     return total
 
 
+@_numba_inline
+def _reach(line: np.ndarray, x: int, step: int, r: int, jump: float) -> int:
+    """How many neighbours of sample ``x`` of ``line``, up to ``r``, its run holds on the
+    side ``step`` (-1 or +1)."""
+    n = 0
+    end = line.shape[0]
+    while n < r and 0 <= x + step * (n + 1) < end and _joined(
+            line[x + step * n], line[x + step * (n + 1)], jump):
+        n += 1
+    return n
+
+
 @kernel(parallel=True)
-def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray,
-            jump: float) -> np.ndarray:
-    """:func:`smooth_runs`: each pass filters every sample with the whole window's weights
-    (a fixed filter, in vector loops; NaN wherever the window holds one), then fits again
-    the samples whose window is cut short (``left``/``right``, ``up``/``down``: how far
-    each sample's run reaches, up to ``radius``)."""
+def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray, jump: float,
+            kink: float, kink_reach: int, negate: bool) -> np.ndarray:
+    """:func:`smooth_runs`: the rows, then the columns, in chunks of rows (the scratch made
+    once a chunk). Each row is taken negated (``negate``) and without its kinks
+    (:func:`drop_kinks`, on a copy of the row). Each pass filters every sample with the
+    whole window's weights and notes whether the window's neighbours all join (vector
+    loops; NaN wherever the window holds one), then fits again the samples whose run is cut
+    short within the window (:func:`_reach` on each side, up to ``radius``)."""
     h, w = values.shape
     r = radius
     full = coefficients[r, r].copy()
     rows = np.empty_like(values)
-    for y in prange(h):  # along the rows
-        line = values[y]
-        left = np.zeros(w, np.int8)
-        run = 0
-        for x in range(1, w):
-            run = min(run + 1, r) if _joined(line[x], line[x - 1], jump) else 0
-            left[x] = run
-        acc = np.zeros(w, np.float64)
-        if r == 3:  # the default sigma (1 px): a loop of fixed length, in vector registers
-            for x in range(r, w - r):
-                total = 0.0
-                for k in range(7):
-                    total += full[k] * float(line[x + k - 3])
-                acc[x] = total
-        else:
-            for x in range(r, w - r):
-                total = 0.0
-                for k in range(2 * r + 1):
-                    total += full[k] * float(line[x + k - r])
-                acc[x] = total
-        run = 0
-        for x in range(w - 1, -1, -1):
-            if x < w - 1:
-                run = min(run + 1, r) if _joined(line[x], line[x + 1], jump) else 0
-            a = int(left[x])
-            if a < r or run < r:
-                acc[x] = (_fit_at(line, x, a, run, r, coefficients)
-                          if line[x] == line[x] else line[x])
-            rows[y, x] = acc[x]
     out = np.empty_like(values)
-    strip = 64  # down the columns, in strips of columns
-    for s in prange((w + strip - 1) // strip):
-        x0, x1 = s * strip, min(s * strip + strip, w)
-        n = x1 - x0
-        up = np.zeros((h, n), np.int8)
-        for y in range(1, h):
-            for i in range(n):
-                up[y, i] = (min(up[y - 1, i] + 1, r)
-                            if _joined(rows[y, x0 + i], rows[y - 1, x0 + i], jump) else 0)
-        down = np.zeros(n, np.int64)
-        acc = np.zeros(n, np.float64)
-        for y in range(h - 1, -1, -1):
-            if r == 3 and 3 <= y < h - 3:
-                for i in range(n):
+    chunks = min(h, 64)
+    for c in prange(chunks):  # along the rows
+        line = np.empty(w, values.dtype)
+        whole = np.empty(w, np.uint8)
+        for y in range(c * h // chunks, (c + 1) * h // chunks):
+            src = values[y]
+            if negate:
+                for x in range(w):
+                    line[x] = -src[x]
+            else:
+                line[:] = src
+            if kink < math.inf:  # as drop_kinks: found on the row, dropped from the copy
+                for x in range(1, w - 1):
+                    a, b, d = src[x - 1], src[x], src[x + 1]
+                    if a == a and b == b and d == d and abs(a - 2.0 * b + d) > kink:
+                        for k in range(max(0, x - kink_reach), min(w, x + kink_reach + 1)):
+                            line[k] = np.nan
+            _filter_line(line, full, r, jump, rows[y], whole)
+            for x in range(w):  # the windows cut short
+                if whole[x] == 0:
+                    v = line[x]
+                    a, b = _reach(line, x, -1, r, jump), _reach(line, x, 1, r, jump)
+                    if v != v or a < r or b < r:
+                        rows[y, x] = _fit_at(line, x, a, b, r, coefficients) if v == v else v
+    for c in prange(chunks):  # down the columns
+        whole = np.empty(w, np.uint8)
+        for y in range(c * h // chunks, (c + 1) * h // chunks):
+            row = out[y]
+            whole[:] = 0
+            if r == 3 and 3 <= y < h - 3:  # a loop of fixed length, in vector registers
+                for x in range(w):
                     total = 0.0
+                    joined = True
                     for k in range(7):
-                        total += full[k] * float(rows[y + k - 3, x0 + i])
-                    acc[i] = total
+                        total += full[k] * float(rows[y + k - 3, x])
+                    for k in range(6):
+                        joined &= _joined(rows[y + k - 3, x], rows[y + k - 2, x], jump)
+                    row[x] = total
+                    whole[x] = joined
             elif r <= y < h - r:
-                for i in range(n):
+                for x in range(w):
                     total = 0.0
                     for k in range(2 * r + 1):
-                        total += full[k] * float(rows[y + k - r, x0 + i])
-                    acc[i] = total
-            if y < h - 1:
-                for i in range(n):
-                    down[i] = (min(down[i] + 1, r)
-                               if _joined(rows[y, x0 + i], rows[y + 1, x0 + i], jump) else 0)
-            for i in range(n):  # the windows cut short
-                a, b = int(up[y, i]), down[i]
-                if a < r or b < r:
-                    v = rows[y, x0 + i]
-                    acc[i] = _fit_at(rows[:, x0 + i], y, a, b, r, coefficients) if v == v else v
-            for i in range(n):
-                out[y, x0 + i] = acc[i]
+                        total += full[k] * float(rows[y + k - r, x])
+                    row[x] = total
+            for x in range(w):  # the windows cut short
+                if whole[x] == 0:
+                    column = rows[:, x]
+                    v = column[y]
+                    a, b = _reach(column, y, -1, r, jump), _reach(column, y, 1, r, jump)
+                    if v != v or a < r or b < r:
+                        row[x] = _fit_at(column, y, a, b, r, coefficients) if v == v else v
     return out
+
+
+@_numba_inline
+def _filter_line(line: np.ndarray, full: np.ndarray, r: int, jump: float, row: np.ndarray,
+                 whole: np.ndarray) -> None:
+    """``row``: ``line`` filtered with the whole window's weights ``full`` where the window
+    fits in the line; ``whole``: 1 where the window's neighbours all join (radius 3, the
+    default sigma: loops of fixed length, in vector registers), else 0."""
+    w = line.shape[0]
+    whole[:] = 0
+    if r == 3:
+        for x in range(3, w - 3):
+            total = 0.0
+            joined = True
+            for k in range(7):
+                total += full[k] * float(line[x + k - 3])
+            for k in range(6):
+                joined &= _joined(line[x + k - 3], line[x + k - 2], jump)
+            row[x] = total
+            whole[x] = joined
+    else:
+        for x in range(r, w - r):
+            total = 0.0
+            for k in range(2 * r + 1):
+                total += full[k] * float(line[x + k - r])
+            row[x] = total
 
 
 def line_coefficients(weights: np.ndarray) -> np.ndarray:
@@ -742,26 +770,39 @@ def line_coefficients(weights: np.ndarray) -> np.ndarray:
     return out
 
 
-def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
+def smooth_runs(values: np.ndarray, sigma: float, jump: float, kink: float = math.inf,
+                kink_reach: int = 2, negate: bool = False) -> np.ndarray:
     """Smooth a map along its rows, then its columns: each valid value becomes that of the
     Gaussian-weighted (``sigma`` px, to 3 sigma) least-squares line through its neighbours,
     taken only up to the first invalid one or step over ``jump`` (never across two
     surfaces; a line, not a mean, so a window cut short on one side is not biased by the
     slope).
 
+    With ``kink`` and ``negate``, the map is first negated and its kinks dropped (as
+    :func:`drop_kinks` with ``kink`` and ``kink_reach``) in the same pass, bit for bit
+    ``smooth_runs(drop_kinks(-values, kink, kink_reach), sigma, jump)`` without the two
+    full-image copies.
+
     Parameters
     ----------
     values : numpy.ndarray
         ``(h, w)`` float32, NaN where invalid.
     sigma : float
-        Gaussian sigma (px); 0 returns a copy.
+        Gaussian sigma (px); 0 smooths nothing (a copy, negated and without its kinks).
     jump : float
         Largest step between neighbours of one surface.
+    kink : float, optional
+        Largest second difference along a row of one surface (:func:`drop_kinks`);
+        infinite (the default) drops none.
+    kink_reach : int, optional
+        Columns on each side of a kink dropped too.
+    negate : bool, optional
+        Smooth ``-values`` (for a coordinate that falls along the rows).
 
     Returns
     -------
     numpy.ndarray
-        ``(h, w)`` float32, NaN where ``values`` is.
+        ``(h, w)`` float32, NaN where ``values`` is (and at the kinks dropped).
 
     Examples
     --------
@@ -771,13 +812,17 @@ def smooth_runs(values: np.ndarray, sigma: float, jump: float) -> np.ndarray:
     >>> noisy = np.float32([[0, 1, 2, 3, 4, 5, 6]]) + np.float32([[0, 0, 0, 0.7, 0, 0, 0]])
     >>> round(float(smooth_runs(noisy, 1.0, 5.0)[0, 3]), 3)  # the spike mostly averaged out
     3.279
+    >>> step = np.float32([[0, 1, 2, 3, 4, 8, 12, 13, 14, 15, 16, 17]])  # a blurred step
+    >>> np.round(smooth_runs(step, 1.0, 5.0, kink=2.0, kink_reach=1, negate=True), 6).tolist()
+    [[0.0, -1.0, -2.0, nan, nan, nan, nan, nan, -14.0, -15.0, -16.0, -17.0]]
     """
     values = np.ascontiguousarray(values, np.float32)
     if not sigma > 0:
-        return values.copy()
+        return drop_kinks(-values if negate else values, kink, kink_reach)
     radius = max(1, int(math.ceil(3 * sigma)))
     weights = np.exp(-0.5 * (np.arange(radius + 1) / sigma) ** 2)
-    return _smooth(values, radius, line_coefficients(weights), float(jump))
+    return _smooth(values, radius, line_coefficients(weights), float(jump), float(kink),
+                   int(kink_reach), bool(negate))
 
 
 @kernel(parallel=True)
@@ -833,26 +878,37 @@ def supported(disparity: np.ndarray, status: np.ndarray, support: float = 2.0
 
 
 @kernel(parallel=True)
-def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray, f: float,
+def _depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, decoded: np.ndarray, f: float,
            cx: float, cy: float, tx: float, rt: np.ndarray, zmin: float, zmax: float,
-           max_step: float) -> tuple[np.ndarray, int]:
+           max_step: float) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, int]:
+    """:func:`grid_depth` of the pixels where ``decoded`` (a coordinate map) is not NaN,
+    with the mask of the depths found (uint8), the points outside the range, the depths
+    found per row and the pixels decoded."""
     h, w = u.shape
     depth = np.empty((h, w), np.float32)
+    found = np.empty((h, w), np.uint8)
     outside = np.zeros(h, np.int64)
+    per_row = np.zeros(h, np.int64)
+    valid = np.zeros(h, np.int64)
     for y in prange(h):
+        n_valid, n_found, n_outside = 0, 0, 0  # (in registers)
         for x in range(w):
             z = math.nan
             d = math.nan
-            if valid[y, x] != 0:  # uint8: numba reads bool arrays slowly
+            if decoded[y, x] == decoded[y, x]:
+                n_valid += 1
                 d = _bilinear(disparity, u[y, x], v[y, x], max_step)
             if d * tx < 0.0:  # not NaN, and in front of the cameras
                 scale = -tx / d  # Z / f in the rectified frame
                 z = ((u[y, x] - cx) * rt[2, 0] + (v[y, x] - cy) * rt[2, 1] + f * rt[2, 2]) * scale
                 if not zmin <= z <= zmax:
-                    outside[y] += 1
+                    n_outside += 1
                     z = math.nan
             depth[y, x] = z
-    return depth, outside.sum()
+            found[y, x] = z == z
+            n_found += 1 if z == z else 0
+        valid[y], per_row[y], outside[y] = n_valid, n_found, n_outside
+    return depth, found, outside.sum(), per_row, valid.sum()
 
 
 def grid_depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.ndarray,
@@ -903,8 +959,244 @@ def grid_depth(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, valid: np.nd
     >>> z.tolist(), out
     ([[300.0, 300.0]], 0)
     """
-    return _depth(np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
-                  np.asarray(v, np.float32),
-                  np.ascontiguousarray(valid, np.bool_).view(np.uint8), float(f), float(cx),
-                  float(cy), float(tx), np.ascontiguousarray(np.asarray(rotation, np.float64).T),
-                  float(min_depth), float(max_depth), float(max_step))
+    decoded = np.where(np.asarray(valid, bool), np.float32(0), np.float32(np.nan))
+    out = depth_counts(disparity, u, v, decoded, f, cx, cy, tx, rotation, min_depth,
+                       max_depth, max_step)
+    return out[0], out[2]
+
+
+def depth_counts(disparity: np.ndarray, u: np.ndarray, v: np.ndarray, decoded: np.ndarray,
+                 f: float, cx: float, cy: float, tx: float, rotation: np.ndarray,
+                 min_depth: float = 0.0, max_depth: float = math.inf, max_step: float = 2.0
+                 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, int]:
+    """:func:`grid_depth` of the pixels where the coordinate map ``decoded`` is not NaN,
+    with what the checks count, in the same pass (no full-image temporaries).
+
+    Parameters
+    ----------
+    disparity, u, v, f, cx, cy, tx, rotation, min_depth, max_depth, max_step
+        As for :func:`grid_depth`.
+    decoded : numpy.ndarray
+        ``(H, W)`` float map (the camera's projector coordinate), NaN where not decoded.
+
+    Returns
+    -------
+    depth : numpy.ndarray
+        As :func:`grid_depth`'s.
+    mask : numpy.ndarray
+        ``(H, W)`` bool: where ``depth`` is not NaN.
+    outside : int
+        Pixels triangulated but outside the depth range.
+    per_row : numpy.ndarray
+        ``(H,)`` int64: the depths found in each row.
+    valid : int
+        The pixels decoded.
+
+    Examples
+    --------
+    >>> d = np.full((3, 4), 20.0, np.float32)
+    >>> u, v = np.float32([[1.0, 2.5, 1.0]]), np.float32([[1.0, 1.0, 9.0]])
+    >>> out = depth_counts(d, u, v, np.float32([[3, 4, 5]]), 100.0, 1.0, 1.0, -60.0,
+    ...                    np.eye(3))
+    >>> out[0].tolist(), out[1].tolist(), out[2], out[3].tolist(), out[4]
+    ([[300.0, 300.0, nan]], [[True, True, False]], 0, [2], 3)
+    """
+    depth, found, outside, per_row, valid = _depth(
+        np.ascontiguousarray(disparity, np.float32), np.asarray(u, np.float32),
+        np.asarray(v, np.float32), np.asarray(decoded), float(f), float(cx), float(cy),
+        float(tx), np.ascontiguousarray(np.asarray(rotation, np.float64).T), float(min_depth),
+        float(max_depth), float(max_step))
+    return depth, found.view(np.bool_), int(outside), per_row, int(valid)
+
+
+@kernel(parallel=True)
+def _pick(values: np.ndarray, starts: np.ndarray, picks: np.ndarray
+          ) -> tuple[np.ndarray, np.ndarray]:
+    h, w = values.shape
+    rows = np.empty(len(picks), np.int64)
+    cols = np.empty(len(picks), np.int64)
+    for y in prange(h):
+        i = np.searchsorted(picks, starts[y])  # the first pick in this row
+        if i == len(picks) or picks[i] >= starts[y + 1]:
+            continue
+        k = starts[y]
+        for x in range(w):
+            if values[y, x] == values[y, x]:
+                while i < len(picks) and picks[i] == k:
+                    rows[i] = y
+                    cols[i] = x
+                    i += 1
+                k += 1
+    return rows, cols
+
+
+def pick_finite(values: np.ndarray, per_row: np.ndarray, picks: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and columns of the finite values of ``values`` whose places in row-major
+    order are ``picks``: ``np.nonzero(np.isfinite(values))`` at ``picks``, without the
+    list of them all.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``(H, W)`` float map, NaN where invalid.
+    per_row : numpy.ndarray
+        ``(H,)`` the finite values in each row.
+    picks : numpy.ndarray
+        Non-decreasing places, each less than ``per_row.sum()``.
+
+    Returns
+    -------
+    rows, cols : numpy.ndarray
+        int64, one per pick.
+
+    Examples
+    --------
+    >>> m = np.float32([[np.nan, 1, 2], [3, np.nan, 4]])
+    >>> [a.tolist() for a in pick_finite(m, np.array([2, 2]), np.array([0, 2, 3]))]
+    [[0, 1, 1], [1, 0, 2]]
+    """
+    starts = np.zeros(len(per_row) + 1, np.int64)
+    np.cumsum(per_row, out=starts[1:])
+    return _pick(np.asarray(values), starts, np.ascontiguousarray(picks, np.int64))
+
+
+@kernel(parallel=True)
+def _count(status: np.ndarray, n: int) -> np.ndarray:
+    h, w = status.shape
+    per_row = np.zeros((h, n), np.int64)
+    for y in prange(h):
+        for x in range(w):
+            per_row[y, status[y, x]] += 1
+    counts = np.zeros(n, np.int64)
+    for y in range(h):
+        for k in range(n):
+            counts[k] += per_row[y, k]
+    return counts
+
+
+def count_status(status: np.ndarray) -> np.ndarray:
+    """How many pixels have each status code (:data:`NO_PHASE` to :data:`ALONE`):
+    ``np.bincount(status.ravel(), minlength=8)`` without its copy of the codes.
+
+    Parameters
+    ----------
+    status : numpy.ndarray
+        ``(h, w)`` int8 codes, 0 to 7 (:func:`match_pair`, :func:`supported`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(8,)`` int64.
+
+    Examples
+    --------
+    >>> count_status(np.int8([[1, 1, 2], [7, 0, 1]])).tolist()
+    [1, 3, 1, 0, 0, 0, 0, 1]
+    """
+    return _count(np.ascontiguousarray(status, np.int8), 8)
+
+
+@kernel(parallel=True)
+def _points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+    h, w = depth.shape
+    out = np.empty((h, w, 3), np.float32)
+    for y in prange(h):
+        for x in range(w):
+            z = depth[y, x]
+            out[y, x, 0] = z * rx[y, x]
+            out[y, x, 1] = z * ry[y, x]
+            out[y, x, 2] = z
+    return out
+
+
+def grid_points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray) -> np.ndarray:
+    """The points ``z * (x, y, 1)`` of a depth map and its pixels' rays, on its grid:
+    ``np.stack([depth * rx, depth * ry, depth], axis=-1)`` in one pass.
+
+    Parameters
+    ----------
+    depth : numpy.ndarray
+        ``(H, W)`` float32 ``z`` (NaN where unknown).
+    rx, ry : numpy.ndarray
+        ``(H, W)`` float32 rays (:func:`rectified_positions`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` float32.
+
+    Examples
+    --------
+    >>> z = np.float32([[2, np.nan]])
+    >>> grid_points(z, np.float32([[0.5, 1]]), np.float32([[-1, 1]])).tolist()
+    [[[1.0, -2.0, 2.0], [nan, nan, nan]]]
+    """
+    return _points(np.ascontiguousarray(depth, np.float32), np.asarray(rx, np.float32),
+                   np.asarray(ry, np.float32))
+
+
+@kernel(parallel=True)
+def _cloud(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray, grey: np.ndarray,
+           mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    h, w = depth.shape
+    per_row = np.zeros(h, np.int64)
+    for y in prange(h):
+        n = 0
+        for x in range(w):
+            n += 1 if mask[y, x] != 0 else 0
+        per_row[y] = n
+    starts = np.zeros(h + 1, np.int64)
+    for y in range(h):
+        starts[y + 1] = starts[y] + per_row[y]
+    pts = np.empty((starts[h], 3), np.float32)
+    cols = np.empty((starts[h], 3), np.uint8)
+    for y in prange(h):
+        i = starts[y]
+        for x in range(w):
+            if mask[y, x] != 0:
+                z = depth[y, x]
+                pts[i, 0] = z * rx[y, x]
+                pts[i, 1] = z * ry[y, x]
+                pts[i, 2] = z
+                g = grey[y, x]
+                cols[i, 0] = g
+                cols[i, 1] = g
+                cols[i, 2] = g
+                i += 1
+    return pts, cols
+
+
+def cloud_points(depth: np.ndarray, rx: np.ndarray, ry: np.ndarray, grey: np.ndarray,
+                 mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The points of ``mask`` in row-major order and their grey as RGB, in one pass: what
+    ``grid_points(depth, rx, ry)[mask]`` and ``np.repeat(grey[mask][:, None], 3, axis=1)``
+    give, without the full grids.
+
+    Parameters
+    ----------
+    depth, rx, ry : numpy.ndarray
+        As for :func:`grid_points`.
+    grey : numpy.ndarray
+        ``(H, W)`` uint8.
+    mask : numpy.ndarray
+        ``(H, W)`` bool: the points kept.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(N, 3)`` float32.
+    colors : numpy.ndarray
+        ``(N, 3)`` uint8.
+
+    Examples
+    --------
+    >>> z = np.float32([[2, 4], [np.nan, 1]])
+    >>> pts, rgb = cloud_points(z, np.ones((2, 2), np.float32), np.zeros((2, 2), np.float32),
+    ...                         np.uint8([[10, 20], [30, 40]]), np.isfinite(z))
+    >>> pts.tolist(), rgb[:, 0].tolist()
+    ([[2.0, 0.0, 2.0], [4.0, 0.0, 4.0], [1.0, 0.0, 1.0]], [10, 20, 40])
+    """
+    return _cloud(np.ascontiguousarray(depth, np.float32), np.asarray(rx, np.float32),
+                  np.asarray(ry, np.float32), np.ascontiguousarray(grey, np.uint8),
+                  np.ascontiguousarray(mask, np.bool_).view(np.uint8))
