@@ -137,9 +137,10 @@ def test_scans_the_decode_falls_behind_on_are_counted_and_said(tmp_path, monkeyp
     assert (data["decoded"], data["behind"]) == (1 + backlog, count - 1 - backlog)
     lines, warnings = summary_lines(report)
     assert lines[1].startswith(f"decoded {1 + backlog} of {count} while the next was grabbed")
+    rate = report.info["scans_per_s"]  # how far behind: a decode's time against a scan's
     assert any(w.startswith(f"{count - 1 - backlog} of {count} scans not decoded: the decode ("
                             "median ") and f"bistair batch {out} --out RESULT" in w
-               for w in warnings), warnings
+               and f"scans/s, one every {1e3 / rate:.0f} ms)" in w for w in warnings), warnings
 
 
 def test_the_camera_keeps_its_frame_rate(tmp_path, monkeypatch):

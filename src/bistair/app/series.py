@@ -368,9 +368,11 @@ def summary_lines(report: SeriesReport) -> tuple[list[str], list[str]]:
                      f"{out}/scan-*/{DECODE_FOLDER}")
         behind = report.count("behind")
         if behind:
+            period = f", one every {1e3 / rate:.0f} ms" if rate else ""
             warnings.append(f"{behind} of {n} scans not decoded: the decode ({each.rstrip('; ')}"
-                            f") fell behind the scans ({rate or 0:.1f} scans/s); their captures "
-                            f"are in {out} ('bistair batch {out} --out RESULT' decodes them)")
+                            f") fell behind the scans ({rate or 0:.1f} scans/s{period}); their "
+                            f"captures are in {out} ('bistair batch {out} --out RESULT' decodes "
+                            "them)")
         failed = [r for r in report.records if r["not_decoded"] not in _NOT_FAILED]
         if failed:
             warnings.append(f"{len(failed)} scans not decoded ({failed[0]['folder']}: "
