@@ -64,7 +64,7 @@ from .cli_options import (
               help="skip the decode's PNG previews (they take about as long as the decode)")
 @click.option("--compress-captures", is_flag=True,
               help="with --scans: deflate the captures' PNG as one scan does (files 2.2 "
-              "times smaller, ten times the CPU time) instead of storing them")
+              "times smaller, five times the CPU time) instead of storing them")
 @_quiet
 @reports_errors
 def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,

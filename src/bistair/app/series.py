@@ -9,7 +9,7 @@
                          grabbed, its decode's seconds and valid share, or why it has none
 
 Four threads: the grab loop (the caller's), a writer (each scan's captures, in grab order;
-PNG stored, not deflated, unless ``compress_captures``: a tenth of the CPU time, the same
+PNG stored, not deflated, unless ``compress_captures``: a fifth of the CPU time, the same
 pixel values), a decoder (the kernels release the GIL, so it decodes while the next scan is
 grabbed and written) and an outputs thread (each decode's files and previews, so that the
 decoder goes on to the next scan). The grab loop never waits for a decode: a scan grabbed
@@ -119,9 +119,9 @@ def scan_series(spec: BaseSpec | str | Path, display: Display | str, camera: Cam
     """Scan ``spec`` ``count`` times with ``display`` and ``camera`` into ``out`` (see the
     module's description); ``decode`` decodes each scan while the next is grabbed, with at
     most ``backlog`` scans waiting for the decoder (``previews``: the decodes' PNG
-    previews, which take about as long as a decode; ``compress_captures``: the captures'
-    PNG deflated as one scan writes them, else stored: the same pixel values, files 2.2
-    times as big, a tenth of the CPU time). ``options`` go to
+    previews, which take about twice the CPU time of a decode; ``compress_captures``: the
+    captures' PNG deflated as one scan writes them, else stored: the same pixel values,
+    files 2.2 times as big, a fifth of the CPU time). ``options`` go to
     :func:`bistair.acquire.scan` (``settle_ms``, ``average``, ``drop``, ``exposure``,
     ``gain``, ``pixel_format``, ``latency_file``). ``display`` and ``camera``: device
     strings or device objects (not yet open)."""
