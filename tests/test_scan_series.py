@@ -137,9 +137,10 @@ def test_scans_the_decode_falls_behind_on_are_counted_and_said(tmp_path, monkeyp
     assert (data["decoded"], data["behind"]) == (1 + backlog, count - 1 - backlog)
     lines, warnings = summary_lines(report)
     assert lines[1].startswith(f"decoded {1 + backlog} of {count} while the next was grabbed")
+    rate = report.info["scans_per_s"]  # how far behind: a decode's time against a scan's
     assert any(w.startswith(f"{count - 1 - backlog} of {count} scans not decoded: the decode ("
                             "median ") and f"bistair batch {out} --out RESULT" in w
-               for w in warnings), warnings
+               and f"scans/s, one every {1e3 / rate:.0f} ms)" in w for w in warnings), warnings
 
 
 def test_the_camera_keeps_its_frame_rate(tmp_path, monkeypatch):
@@ -168,6 +169,8 @@ def test_the_camera_keeps_its_frame_rate(tmp_path, monkeypatch):
      "--backlog must be a whole number from 1 to 100, got 0"),
     (["--backlog", "3"], "--backlog applies to --scans N with --decode"),
     (["--scans", "3", "--backlog", "3"], "--backlog applies to --scans N with --decode"),
+    (["--compress-captures"], "--compress-captures applies to --scans N (one scan's captures "
+                              "are always compressed)"),
     (["--scans", "3", "--calibration", "c.json"], "--calibration applies to one scan"),
     (["--camera", "sim:plane:64x48@0"], "the frame rate of camera 'sim:plane:64x48@0' must be"),
     (["--camera", "sim@fast"], "the frame rate of camera 'sim@fast' must be a number"),
@@ -287,3 +290,91 @@ def test_a_signal_mid_series_keeps_the_scans_grabbed_whole(tmp_path, sig):
         _check_scan_folder(out / record["folder"], decoded=record["decoded"])
     assert data["decoded"] >= 1
     assert os.path.getsize(out / "series.json") > 0
+
+
+def test_captures_stored_or_compressed_read_the_same(tmp_path, monkeypatch, capsys):
+    """A series stores its captures' PNG (a tenth of the CPU time of deflating them) unless
+    --compress-captures: either way 'bistair decode' reads the same pixel values and
+    decodes them to the same numbers; the stored files hold every byte of the frame."""
+    spec_path = _spec_file(tmp_path)
+    outs = {}
+    for name, extra in (("stored", []), ("deflated", ["--compress-captures"])):
+        outs[name] = tmp_path / name
+        code, _, err = cli_run(monkeypatch, capsys, "scan", "--spec", spec_path, "--display",
+                               "none", "--camera", f"{CAMERA}@500", "--scans", 2, *extra,
+                               "--out", outs[name])
+        assert code == 0, err
+        data = json.loads((outs[name] / "series.json").read_text())
+        assert data["compress_captures"] is bool(extra)
+        assert set(data["cpu_s"]) == {"grab", "write", "decode", "outputs", "process"}
+        assert data["cpu_s"]["write"] > 0 and data["cpu_s"]["decode"] == 0  # none asked for
+    rig, scene = preset("sphere-on-plane", camera_size=SIZE)
+    images, _ = render(encode(SPEC), rig, scene, Imaging(**SIM_IMAGING))
+    decoded = {}
+    for name, out in outs.items():
+        folder = out / "scan-0001"
+        assert np.array_equal(_check_scan_folder(folder, decoded=False), images)
+        code, _, err = cli_run(monkeypatch, capsys, "decode", folder, "--no-previews",
+                               "--out", tmp_path / f"{name}-decode")
+        assert code == 0, err
+        decoded[name] = [np.load(tmp_path / f"{name}-decode" / f) for f in ARRAYS
+                         if f.endswith(".npy")]
+    for stored, deflated in zip(decoded["stored"], decoded["deflated"], strict=True):
+        assert np.array_equal(stored, deflated, equal_nan=True)
+    sizes = {name: sum(p.stat().st_size for p in (out / "scan-0000").glob("*.png"))
+             for name, out in outs.items()}
+    assert sizes["stored"] >= images.size > sizes["deflated"]  # 8-bit frames: a byte a pixel
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+def test_a_stored_png_reads_back_bit_for_bit(tmp_path, dtype):
+    """Stored PNG of 8- and 16-bit grey frames (a 12-bit camera's too: the byte order of
+    PNG) reads back to the same values as deflated PNG, and is no smaller than the frame."""
+    from bistair.io.atomic import write_image
+    from bistair.io.read import read_image
+
+    top = np.iinfo(dtype).max
+    image = (np.add.outer(np.arange(64), np.arange(80)) * (top // 160)).astype(dtype)  # a ramp
+    image[0, :4] = (0, 1, top - 1, top)
+    image[5, 7:9] = np.random.default_rng(5).integers(0, top, 2, endpoint=True)
+    for compress in (True, False):
+        path = tmp_path / f"{compress}.png"
+        write_image(path, image, compress=compress)
+        back = read_image(path)
+        assert back.dtype == image.dtype and np.array_equal(back, image)
+    assert (tmp_path / "False.png").stat().st_size >= image.nbytes > \
+        (tmp_path / "True.png").stat().st_size
+
+
+def test_the_decoder_goes_on_while_a_decode_is_written(tmp_path, monkeypatch):
+    """A decode's files and previews are written on their own thread: the decoder decodes
+    the next scan while the first scan's outputs are still being written (held here until
+    it has), and every scan ends decoded with its previews."""
+    decoded_two = threading.Event()
+    decodes = []
+
+    def counted(frames, spec):
+        result = decode(frames, spec)
+        if frames.shape[1:] == (SIZE[1], SIZE[0]):  # a scan (not the decoder's warm-up)
+            decodes.append(1)
+            if len(decodes) == 2:
+                decoded_two.set()
+        return result
+
+    save = series.save_result
+    held = []
+
+    def held_save(result, folder, previews):
+        if not held:
+            held.append(decoded_two.wait(60))  # False if the decoder waits for this write
+        return save(result, folder, previews=previews)
+
+    monkeypatch.setattr(series, "decode_stack", counted)
+    monkeypatch.setattr(series, "save_result", held_save)
+    out = tmp_path / "series"
+    report = scan_series(SPEC, "none", f"{CAMERA}@500", out, 3, decode=True, backlog=3)
+    assert held == [True]
+    assert report.count("decoded") == 3
+    for record in report.records:
+        _check_scan_folder(out / record["folder"], decoded=True)
+        assert (out / record["folder"] / "decode" / "phase.png").is_file()

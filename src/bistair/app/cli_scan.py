@@ -62,6 +62,9 @@ from .cli_options import (
               "grabbed when this many wait is not decoded (counted and said)")
 @click.option("--no-previews", is_flag=True,
               help="skip the decode's PNG previews (they take about as long as the decode)")
+@click.option("--compress-captures", is_flag=True,
+              help="with --scans: deflate the captures' PNG as one scan does (files 2.2 "
+              "times smaller, five times the CPU time) instead of storing them")
 @_quiet
 @reports_errors
 def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
@@ -69,7 +72,7 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
          gain: float | None, pixel_format: str | None, decode_it: bool,
          calibration: Path | None, depth_range: str | None, measure_latency: bool,
          latency_file: Path | None, scans: int, backlog: int, no_previews: bool,
-         quiet: bool) -> None:
+         compress_captures: bool, quiet: bool) -> None:
     """Project a pattern set with DISPLAY, grab it with CAMERA, write a capture folder.
 
     Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
@@ -99,10 +102,13 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     given = click.get_current_context().get_parameter_source("backlog")
     if given is not click.core.ParameterSource.DEFAULT and (scans == 1 or not decode_it):
         raise CliError("--backlog applies to --scans N with --decode")
+    if compress_captures and scans == 1:
+        raise CliError("--compress-captures applies to --scans N (one scan's captures are "
+                       "always compressed)")
     if scans != 1:
         _series(spec_path, display, camera, out, scans, decode_it, backlog, no_previews,
                 calibration, quiet, settle_ms=settle_ms, average=average, drop=drop,
-                latency_file=latency_file, **settings)
+                latency_file=latency_file, compress_captures=compress_captures, **settings)
         return
     from .jobs import parse_depth_range
     from .scan import scan_folder

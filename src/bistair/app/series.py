@@ -8,14 +8,19 @@
     OUT/series.json      the devices, the counts, and per scan its folder, when it was
                          grabbed, its decode's seconds and valid share, or why it has none
 
-Three threads: the grab loop (the caller's), a writer (each scan's captures, in grab order)
-and a decoder (the kernels release the GIL, so it decodes while the next scan is grabbed
-and written). The grab loop never waits for a decode: a scan grabbed while ``backlog``
-scans already wait for the decoder is not decoded (its captures are written; counted and
-said as scans the decode fell behind on; ``bistair batch OUT`` decodes them later). It waits
-for the writer only when :data:`WRITE_BACKLOG` scans wait to be written (the seconds it
-waited are counted). Before the first scan the decoder decodes the spec's own patterns once,
-so that loading its kernels does not hold up the first scans.
+Four threads: the grab loop (the caller's), a writer (each scan's captures, in grab order;
+PNG stored, not deflated, unless ``compress_captures``: a fifth of the CPU time, the same
+pixel values), a decoder (the kernels release the GIL, so it decodes while the next scan is
+grabbed and written) and an outputs thread (each decode's files and previews, so that the
+decoder goes on to the next scan). The grab loop never waits for a decode: a scan grabbed
+while ``backlog`` scans already wait for the decoder is not decoded (its captures are
+written; counted and said as scans the decode fell behind on; ``bistair batch OUT`` decodes
+them later). It waits for the writer only when :data:`WRITE_BACKLOG` scans wait to be
+written (the seconds it waited are counted); the decoder waits for the outputs when
+:data:`OUTPUT_BACKLOG` decodes wait to be written. Before the first scan the decoder
+decodes the spec's own patterns once, so that loading its kernels does not hold up the
+first scans. ``series.json`` keeps each thread's CPU seconds (``cpu_s``): where the time
+went.
 
 ``OUT`` is written as a temporary folder that replaces it as a whole at the end. Ctrl-C,
 SIGTERM or a failing camera stops the grabbing: the scans grabbed are written whole, the
@@ -67,6 +72,7 @@ from .scan import DECODE_FOLDER, _check_out
 
 SERIES_FILE = "series.json"
 WRITE_BACKLOG = 8  # scans grabbed and not yet written before the grab loop waits
+OUTPUT_BACKLOG = 2  # decodes not yet written before the decoder waits
 MAX_BACKLOG = 100
 MAX_SCANS = 1_000_000
 # why a scan has no decode
@@ -108,12 +114,14 @@ class SeriesReport:
 
 def scan_series(spec: BaseSpec | str | Path, display: Display | str, camera: Camera | str,
                 out: str | Path, count: int, *, decode: bool = False, backlog: int = 2,
-                previews: bool = True, progress: Callable[[str], None] | None = None,
-                **options: Any) -> SeriesReport:
+                previews: bool = True, compress_captures: bool = False,
+                progress: Callable[[str], None] | None = None, **options: Any) -> SeriesReport:
     """Scan ``spec`` ``count`` times with ``display`` and ``camera`` into ``out`` (see the
     module's description); ``decode`` decodes each scan while the next is grabbed, with at
     most ``backlog`` scans waiting for the decoder (``previews``: the decodes' PNG
-    previews, which take about as long as a decode). ``options`` go to
+    previews, which take about twice the CPU time of a decode; ``compress_captures``: the
+    captures' PNG deflated as one scan writes them, else stored: the same pixel values,
+    files 2.2 times as big, a fifth of the CPU time). ``options`` go to
     :func:`bistair.acquire.scan` (``settle_ms``, ``average``, ``drop``, ``exposure``,
     ``gain``, ``pixel_format``, ``latency_file``). ``display`` and ``camera``: device
     strings or device objects (not yet open)."""
@@ -130,7 +138,8 @@ def scan_series(spec: BaseSpec | str | Path, display: Display | str, camera: Cam
                parse_camera(camera, *settings) if isinstance(camera, str) else camera)
     start = time.monotonic()
     with replace_folder(out, prefix=f"{TEMP_PREFIX}{os.getpid()}-") as tmp:
-        pipe = _Pipeline(tmp, spec, count, decode, backlog, previews, start)
+        pipe = _Pipeline(tmp, spec, count, decode, backlog, previews, start,
+                         compress_captures)
         stopped: BaseException | None = None
         try:
             if decode:
@@ -149,6 +158,7 @@ def scan_series(spec: BaseSpec | str | Path, display: Display | str, camera: Cam
         report = SeriesReport(out, spec, pipe.records, {
             "method": spec.method, "display": devices[0].describe(),
             "camera": devices[1].describe(), "decode": decode, "backlog": backlog,
+            "compress_captures": compress_captures,
             "seconds": round(time.monotonic() - start, 3), **pipe.figures(),
             "stopped": None if stopped is None else (one_line(stopped) if isinstance(
                 stopped, BistairError) else type(stopped).__name__)})
@@ -165,14 +175,19 @@ class _Pipeline:
     """The writer and decoder threads of a series, and its records."""
 
     def __init__(self, tmp: Path, spec: BaseSpec, count: int, decode: bool, backlog: int,
-                 previews: bool, start: float) -> None:
+                 previews: bool, start: float, compress: bool) -> None:
         self.tmp, self.spec, self.decoding, self.backlog = tmp, spec, decode, backlog
-        self.previews, self.start = previews, start
+        self.previews, self.start, self.compress = previews, start, compress
+        # CPU seconds from the first scan: each thread's (the decoder's without numba's
+        # worker threads, previews encoded on a pool thread) and the process's
+        self.cpu = {"grab": 0.0, "write": 0.0, "decode": 0.0, "outputs": 0.0, "process": 0.0}
+        self.cpu_start = (0.0, 0.0)  # the grab loop's and the process's, at the first scan
         self.digits = max(4, len(str(count - 1)))
         self.entries: list[tuple[dict[str, Any], threading.Event]] = []  # handed on or not
         self.records: list[dict[str, Any]] = []  # those written (made by finish)
         self.writes: queue.Queue = queue.Queue(maxsize=WRITE_BACKLOG)
         self.decodes: queue.Queue = queue.Queue()
+        self.outputs: queue.Queue = queue.Queue(maxsize=OUTPUT_BACKLOG)
         self.lock = threading.Lock()
         self.waiting = self.most_waiting = 0
         self.waited = 0.0  # seconds the grab loop waited for the writer
@@ -181,8 +196,9 @@ class _Pipeline:
         self.warnings: list[str] = []  # the scan loop's (a settle time never measured)
         self.threads = [threading.Thread(target=self._writer, daemon=True)]
         if decode:
-            self.threads.append(threading.Thread(target=self._decoder, args=(thread_count(),),
-                                                 daemon=True))
+            self.threads += [threading.Thread(target=self._decoder, args=(thread_count(),),
+                                              daemon=True),
+                             threading.Thread(target=self._outputs, daemon=True)]
         for thread in self.threads:
             thread.start()
 
@@ -199,6 +215,7 @@ class _Pipeline:
         index = len(self.entries)
         if index == 0:
             self.warnings = list(grabbed.info.get("warnings", []))
+            self.cpu_start = (time.thread_time(), time.process_time())
         now = time.monotonic() - self.start
         record = {"index": index, "folder": f"scan-{index:0{self.digits}d}",
                   "started": round(now - grabbed.info["seconds"], 4),
@@ -222,12 +239,14 @@ class _Pipeline:
         """Write every scan handed on; with ``stop``, decode none that has not begun. Then
         the records: a scan stopped before it reached the writer is left out, one stopped
         before it reached the decoder is listed as stopped."""
+        self.cpu["grab"] = time.thread_time() - self.cpu_start[0]
         if stop:
             self.stop.set()
         self.writes.put(None)
         self.decodes.put(None)
         for thread in self.threads:
             thread.join()
+        self.cpu["process"] = time.process_time() - self.cpu_start[1]
         self.records = [record for record, written in self.entries if written.is_set()]
         for record in self.records:
             if not record["decoded"] and record["not_decoded"] is None:
@@ -241,22 +260,25 @@ class _Pipeline:
         return {"scans_per_s": round(len(grabbed) / span, 3) if span > 0 else None,
                 "decode_median_s": round(float(np.median(seconds)), 4) if seconds else None,
                 "most_waiting": self.most_waiting, "waited_for_writer_s": round(self.waited, 3),
-                "warm_up_s": self.warm_seconds, "warnings": self.warnings}
+                "warm_up_s": self.warm_seconds, "warnings": self.warnings,
+                "cpu_s": {k: round(v, 3) for k, v in self.cpu.items()}}
 
     def _writer(self) -> None:
+        t0 = time.thread_time()
         while (item := self.writes.get()) is not None:
             record, grabbed, written = item
             try:
                 files = [f"{i:02d}.png" for i in range(len(grabbed.frames))]
                 with output_folder(self.tmp / record["folder"]) as folder:
                     for name, image in zip(files, grabbed.frames, strict=True):
-                        write_image(folder / name, image)
+                        write_image(folder / name, image, compress=self.compress)
                     (folder / "spec.json").write_text(self.spec.to_json())
                     write_json(folder / "scan.json", to_jsonable(grabbed.to_dict(files)))
             except Exception as exc:  # recorded; the series goes on
                 record["not_decoded"] = record["write_error"] = one_line(exc)
             finally:
                 written.set()
+        self.cpu["write"] = time.thread_time() - t0
 
     def _decoder(self, threads: int) -> None:
         set_threads(threads)  # numba's count is per thread: the caller's
@@ -265,6 +287,7 @@ class _Pipeline:
             if record is None:  # the warm-up
                 self._warm(written)
                 continue
+            t_cpu = time.thread_time()
             with self.lock:
                 self.waiting -= 1
             if self.stop.is_set():
@@ -274,16 +297,32 @@ class _Pipeline:
                 t0 = time.perf_counter()
                 result = require_valid(decode_stack(grabbed.frames, self.spec))
                 record["decode_seconds"] = round(time.perf_counter() - t0, 4)
-                written.wait()
-                if "write_error" in record:
-                    continue
+            except Exception as exc:  # a refusal or failure of this scan: the series goes on
+                record["not_decoded"] = one_line(exc)
+                continue
+            finally:
+                self.cpu["decode"] += time.thread_time() - t_cpu
+            self.outputs.put((record, result, written))  # waits when OUTPUT_BACKLOG wait
+        self.outputs.put(None)
+
+    def _outputs(self) -> None:
+        """Each decode's files and previews, once its scan's captures are written: off the
+        decoder's thread, which goes on to the next scan."""
+        t0 = time.thread_time()
+        while (item := self.outputs.get()) is not None:
+            record, result, written = item
+            written.wait()
+            if "write_error" in record:
+                continue
+            try:
                 save_result(result, self.tmp / record["folder"] / DECODE_FOLDER,
                             previews=self.previews)
-            except Exception as exc:  # a refusal or failure of this scan: the series goes on
+            except Exception as exc:  # recorded; the series goes on
                 record["not_decoded"] = one_line(exc)
                 continue
             record.update(decoded=True, not_decoded=None, valid=round(float(
                 result.mask.mean()), 6), warnings=_warnings(result))
+        self.cpu["outputs"] = time.thread_time() - t0
 
     def _warm(self, done: threading.Event) -> None:
         t0 = time.perf_counter()
@@ -329,9 +368,11 @@ def summary_lines(report: SeriesReport) -> tuple[list[str], list[str]]:
                      f"{out}/scan-*/{DECODE_FOLDER}")
         behind = report.count("behind")
         if behind:
+            period = f", one every {1e3 / rate:.0f} ms" if rate else ""
             warnings.append(f"{behind} of {n} scans not decoded: the decode ({each.rstrip('; ')}"
-                            f") fell behind the scans ({rate or 0:.1f} scans/s); their captures "
-                            f"are in {out} ('bistair batch {out} --out RESULT' decodes them)")
+                            f") fell behind the scans ({rate or 0:.1f} scans/s{period}); their "
+                            f"captures are in {out} ('bistair batch {out} --out RESULT' decodes "
+                            "them)")
         failed = [r for r in report.records if r["not_decoded"] not in _NOT_FAILED]
         if failed:
             warnings.append(f"{len(failed)} scans not decoded ({failed[0]['folder']}: "
