@@ -20,8 +20,13 @@ from support.real_parts import parts
 import bistair
 from bistair.core.jit import set_threads
 from bistair.core.measure import coherent_pixels
-from bistair.core.regions import fringe_regions, period_jumps
-from bistair.core.regions_jit import NO_CUTS, TILE, label_kept, link_bits
+from bistair.core.regions import (
+    cut_reference,
+    default_cut,
+    fringe_regions,
+    period_jumps,
+)
+from bistair.core.regions_jit import NO_CUTS, TILE, cut_medians, label_kept, link_bits
 from bistair.io.read import read_with_spec
 from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.presets import preset_spec
@@ -98,6 +103,49 @@ def test_links_are_the_old_passes(h, w, seed, noise, holes, sign, cut, nan, ties
     got = link_bits(phi, valid, sigma, float(np.float32(cut)), sign, 0.3,
                     *(edges if cuts else (NO_CUTS, NO_CUTS)), cuts)
     assert before.same_links(got, *want, valid)
+
+
+@PROPERTY
+@given(h=st.integers(1, 70), w=st.integers(1, 70), seed=st.integers(0, 2**32 - 1),
+       noise=st.sampled_from([0.0, 0.05, 3.0]), holes=st.sampled_from([0.0, 0.3, 0.97, 1.0]),
+       nan=st.booleans(), ties=st.booleans(), flip=st.booleans())
+def test_cut_is_numpys(h, w, seed, noise, holes, nan, ties, flip):
+    """default_cut of a float32 phase (compiled medians) gives what its NumPy reference
+    gives, bit for bit: odd and even counts, ties on a grid of pi/8 (differences on pi,
+    equal middle values), NaN phases at valid pixels, no pair at all."""
+    phi, valid, _ = field(h, w, seed, noise, holes if holes < 1 else 0.0, nan, ties)
+    if holes == 1.0:
+        valid[:] = False
+    if nan:  # NaN where it counts, now and then
+        valid |= np.random.default_rng(seed).random((h, w)) < 0.02
+    if flip:
+        phi = np.ascontiguousarray(phi[:, ::-1])
+    cut, want = default_cut(phi, valid), cut_reference(phi, valid)
+    assert cut == want or (np.isnan(cut) and np.isnan(want))
+
+
+def test_cut_medians_of_many_equal_and_spread_values():
+    """The medians' count by bins, then selection: a middle pair split across bins, all
+    values equal, values from 0 to pi (many exponents), large images (many per bin)."""
+    rng = np.random.default_rng(4)
+    for h, w in [(400, 600), (8, 8), (3, 2), (1000, 5)]:
+        for kind in range(4):
+            if kind == 0:
+                phi = rng.uniform(0, 2 * np.pi, (h, w))
+            elif kind == 1:
+                phi = np.full((h, w), 1.25)
+            elif kind == 2:  # differences of every size (tiny to pi)
+                phi = np.cumsum(10.0 ** rng.uniform(-7, 0.5, (h, w)), axis=1) % (2 * np.pi)
+            else:
+                phi = (np.arange(w) * 0.7 + np.arange(h)[:, None] * 0.2) % (2 * np.pi)
+            phi = phi.astype(np.float32)
+            valid = rng.random((h, w)) < 0.8
+            meds, counts, ok = cut_medians(phi, valid)
+            assert ok
+            gx = np.abs(phi[::4, 1::4] - phi[::4, :-1:4][:, :phi[::4, 1::4].shape[1]])
+            assert counts[0] == (valid[::4, :-1:4][:, :gx.shape[1]]
+                                 & valid[::4, 1::4]).sum()
+            assert default_cut(phi, valid) == cut_reference(phi, valid)
 
 
 def masks(draw_rng: np.random.Generator, h: int, w: int, kind: str) -> np.ndarray:

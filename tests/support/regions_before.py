@@ -14,7 +14,8 @@ import numpy as np
 from numba import prange
 
 from bistair.core.jit import PI32, TWO_PI32
-from bistair.core.regions import default_cut, fringe_direction
+from bistair.core.regions import cut_reference as default_cut
+from bistair.core.regions import fringe_direction
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")

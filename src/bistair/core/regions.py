@@ -25,7 +25,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, relabel, wrap_links
+from .regions_jit import (
+    NO_CUTS,
+    TILE,
+    cut_medians,
+    label_kept,
+    link_bits,
+    relabel,
+    wrap_links,
+)
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -164,7 +172,10 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     """Cut threshold for phase steps: three times the median phase gradient, in [0.6, 2.2].
 
     The gradient is the hypotenuse of the median absolute wrapped neighbour differences
-    along the rows and down the columns, on every fourth row and column.
+    along the rows and down the columns, on every fourth row and column. A float32 phase
+    has its medians taken in one compiled pass
+    (:func:`~bistair.core.regions_jit.cut_medians`): the same threshold, bit for bit, as
+    :func:`cut_reference`.
 
     Parameters
     ----------
@@ -183,6 +194,44 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     >>> phi = np.tile(2 * np.pi * np.arange(40.0) / 10 % (2 * np.pi), (8, 1))
     >>> round(default_cut(phi, np.ones(phi.shape, bool)), 3), default_cut(phi, phi < 0)
     (1.885, 1.5)
+    >>> default_cut(phi.astype(np.float32), np.ones(phi.shape, bool)) == cut_reference(
+    ...     phi.astype(np.float32), np.ones(phi.shape, bool))
+    True
+    """
+    if phi.dtype != np.float32 or phi.ndim != 2:
+        return cut_reference(phi, valid)
+    meds, counts, ok = cut_medians(np.ascontiguousarray(phi),
+                                   np.ascontiguousarray(valid, dtype=bool))
+    if not ok:  # NaN (or differences of 4 and more): NumPy's median decides
+        return cut_reference(phi, valid)
+    if counts[0] + counts[1] == 0:
+        return 1.5
+    grad = np.hypot(meds[0], meds[1])  # float32, as the reference's (a median absent: 0)
+    return float(np.clip(3.0 * grad, 0.6, 2.2))
+
+
+def cut_reference(phi: np.ndarray, valid: np.ndarray) -> float:
+    """NumPy reference of :func:`default_cut` (of its compiled medians,
+    :func:`~bistair.core.regions_jit.cut_medians`): three times the hypotenuse of the
+    median wrapped neighbour differences on every fourth row and column, in [0.6, 2.2].
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+
+    Returns
+    -------
+    float
+        The threshold in radians; 1.5 when no pair of valid neighbours is found.
+
+    Examples
+    --------
+    >>> phi = np.tile(2 * np.pi * np.arange(40.0) / 10 % (2 * np.pi), (8, 1))
+    >>> round(cut_reference(phi, np.ones(phi.shape, bool)), 3)
+    1.885
     """
     # Neighbour differences on every fourth row and column: plenty for a median.
     a, va = phi[::4, ::4], valid[::4, ::4]
