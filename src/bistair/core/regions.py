@@ -20,6 +20,8 @@ Examples
 
 from __future__ import annotations
 
+import threading
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,10 +30,14 @@ from .phase import TWO_PI, order_from_reference, wrap
 from .regions_jit import (
     NO_CUTS,
     TILE,
+    band_links,
+    cut_links,
     cut_medians,
     label_kept,
     link_bits,
     relabel,
+    relink,
+    valid_changes,
     wrap_links,
 )
 
@@ -265,11 +271,22 @@ class Labelling:
 def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                   phase_noise: np.ndarray | None = None,
                   boundaries: tuple[np.ndarray, np.ndarray] | None = None,
-                  sign: int | None = None, strong: np.ndarray | None = None) -> Labelling:
+                  sign: int | None = None, strong: np.ndarray | None = None,
+                  share: bool = False) -> Labelling:
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
     labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
     pixels labelled and the dropped ones reattached, with per-region counts
     (:func:`~bistair.core.regions_jit.label_kept`).
+
+    With ``share``, the links are kept for the next labelling of the same ``phi`` and
+    ``phase_noise`` (the same arrays) in this thread (a decode labels its phase twice:
+    the coherent dim pixels on the weak mask, then its regions on the valid pixels with
+    its own cuts): that labelling takes them over, makes again only the row tiles whose
+    validity changed (:func:`~bistair.core.regions_jit.relink`) and adds its cuts
+    (:func:`~bistair.core.regions_jit.cut_links`), where its direction is the first one's
+    and no link's step lies between the two cut thresholds
+    (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
+    own pass; none kept past the next ``share`` in the thread.
 
     Parameters
     ----------
@@ -277,6 +294,8 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
         As :func:`fringe_regions`.
     strong : (H, W) bool array, optional
         A mask whose pixels are counted per region (``Labelling.strong``).
+    share : bool
+        Keep the links for the next labelling of ``phi`` (without ``boundaries`` only).
 
     Returns
     -------
@@ -294,19 +313,26 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     [1, 1, 2, 2]
     """
     valid = np.ascontiguousarray(valid, dtype=bool)
-    if cut is None:
-        cut = default_cut(phi, valid)
     h, w = phi.shape
     noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
              else np.ascontiguousarray(phase_noise, dtype=np.float32))
-    if sign is None:
-        sign = fringe_direction(phi, valid)
     cut_v, cut_h = NO_CUTS, NO_CUTS
     if boundaries is not None:
         cut_v, cut_h = (np.ascontiguousarray(b, dtype=bool) for b in boundaries)
-    bits = link_bits(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
-                     float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
-                     boundaries is not None)
+    bits, cut, sign = _shared_links(phi, valid, noise, cut, sign, phase_noise)
+    if bits is not None:
+        if boundaries is not None:
+            bits = cut_links(bits, cut_v, cut_h)
+    else:
+        if cut is None:
+            cut = default_cut(phi, valid)
+        if sign is None:
+            sign = fringe_direction(phi, valid)
+        bits = link_bits(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
+                         float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
+                         boundaries is not None)
+        if share and boundaries is None and phase_noise is not None:
+            _SHARED.links = (weakref.ref(phi), weakref.ref(phase_noise), bits, cut, sign)
     del noise
     counted = strong is not None
     mask = np.ascontiguousarray(strong, dtype=bool) if counted else NO_CUTS
@@ -314,6 +340,41 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     # they still link to: three rounds
     labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE, 3)
     return Labelling(labels, roots, int(n), size, lit)
+
+
+_SHARED = threading.local()  # per thread: the links a labelling shared (label_fringes)
+
+
+def _shared_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray,
+                  cut: float | None, sign: int | None, phase_noise: np.ndarray | None
+                  ) -> tuple[np.ndarray | None, float | None, int | None]:
+    """The links :func:`label_fringes` shared for this ``phi`` and ``phase_noise``, taken
+    over and made for ``valid`` (``None`` where there are none, or where their direction
+    is not this labelling's or their cut threshold cuts a link otherwise), with the cut
+    and the direction; they are handed out once."""
+    shared = getattr(_SHARED, "links", None)
+    if shared is None or phase_noise is None:
+        return None, cut, sign
+    phi_ref, noise_ref, bits, cut0, sign0 = shared
+    if phi_ref() is not phi or noise_ref() is not phase_noise or bits.shape != phi.shape:
+        return None, cut, sign
+    _SHARED.links = None
+    changed = valid_changes(bits, valid)
+    if changed.any():
+        if cut is None:  # the mask changed: its own threshold and direction
+            cut = default_cut(phi, valid)
+        if sign is None:
+            sign = fringe_direction(phi, valid)
+    cut = cut0 if cut is None else cut
+    sign = sign0 if sign is None else sign
+    if int(sign) != int(sign0):
+        return None, cut, sign
+    low, high = sorted((float(np.float32(cut)), float(np.float32(cut0))))
+    if low != high and band_links(phi, valid, low, high) > 0:
+        return None, cut, sign  # (the two thresholds cut some link differently)
+    relink(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
+           float(np.float32(cut)), int(sign), 0.3, bits, changed)
+    return bits, cut, sign
 
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,

@@ -6,7 +6,10 @@ numbering, and the wraps between regions.
 
 A decode runs them in this order (:func:`bistair.core.regions.label_fringes`):
 
-1. :func:`link_bits`: one byte a pixel, ``LINK_RIGHT | LINK_DOWN | KEPT | VALID``;
+1. :func:`link_bits`: one byte a pixel, ``LINK_RIGHT | LINK_DOWN | KEPT | VALID`` (or,
+   where a labelling takes over the links of an earlier one of the same phase, the
+   tiles whose validity changed made again, :func:`valid_changes` and :func:`relink`, and
+   the codec's cuts added, :func:`cut_links`);
 2. :func:`label_kept`: provisional labels of the kept pixels (4-connected), their regions
    numbered ``1..n`` in raster order of each region's first pixel (as
    ``cv2.connectedComponents(kept, connectivity=4)`` numbers them), the valid pixels not
@@ -636,6 +639,206 @@ def link_bits(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float,
     for t in prange((h + TILE - 1) // TILE):
         _link_rows(phi, valid8, noise, cut, sign, relative, cut_v8, cut_h8, cuts, t * TILE,
                    min(t * TILE + TILE, h), out)
+    return out
+
+
+@kernel(parallel=True)
+def valid_changes(bits: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """The rows where :func:`link_bits`' ``VALID`` bits differ from ``valid``.
+
+    Parameters
+    ----------
+    bits : (H, W) uint8 array
+        :func:`link_bits` of some mask.
+    valid : (H, W) bool array
+        Another mask.
+
+    Returns
+    -------
+    (H,) uint8 array
+        1 where a pixel of the row differs.
+
+    Examples
+    --------
+    >>> valid_changes(np.uint8([[8, 0], [8, 8]]), np.array([[True, False], [True, False]]))
+    array([0, 1], dtype=uint8)
+    """
+    h, w = bits.shape
+    valid8 = valid.view(np.uint8)
+    changed = np.zeros(h, np.uint8)
+    for y in prange(h):
+        b = bits[y]
+        v = valid8[y]
+        d = np.uint8(0)
+        for x in range(w):
+            d |= ((b[x] >> 3) & np.uint8(1)) ^ v[x]
+        changed[y] = d
+    return changed
+
+
+@kernel(parallel=True)
+def band_links(phi: np.ndarray, valid: np.ndarray, low: float, high: float) -> int:
+    """The links between two valid neighbours whose phase step lies in ``(low, high]``
+    (float32, as :func:`link_bits` compares a step with its cut): where none does, a cut
+    threshold of ``low`` and one of ``high`` make the same links.
+
+    Parameters
+    ----------
+    phi : (H, W) float32 array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels to link.
+    low, high : float
+        The two thresholds (compared in float32).
+
+    Returns
+    -------
+    int
+        Links, along the rows and down the columns.
+
+    Examples
+    --------
+    >>> phi = np.float32([[0.0, 1.0, 1.5], [0.0, 0.2, 3.0]])
+    >>> band_links(phi, np.ones(phi.shape, bool), 0.9, 1.0)  # the step of 1.0 only
+    1
+    """
+    h, w = phi.shape
+    lo = np.float32(low)
+    hi = np.float32(high)
+    valid8 = valid.view(np.uint8)
+    count = np.zeros(h, np.int64)
+    for y in prange(h):
+        p = phi[y]
+        v = valid8[y]
+        c = 0
+        for x in range(w - 1):
+            a = abs(p[x + 1] - p[x])
+            c += (v[x] & v[x + 1]) & ((a > lo) & (a <= hi))
+        if y + 1 < h:
+            q = phi[y + 1]
+            u = valid8[y + 1]
+            for x in range(w):
+                a = abs(q[x] - p[x])
+                c += (v[x] & u[x]) & ((a > lo) & (a <= hi))
+        count[y] = c
+    return int(count.sum())
+
+
+@kernel(parallel=True)
+def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, sign: int,
+           relative: float, bits: np.ndarray, changed: np.ndarray) -> int:
+    """:func:`link_bits` (without a codec's cuts) of a ``valid`` mask, in place of the bytes
+    ``bits`` it gave for another mask of the same ``phi``, ``noise``, ``cut`` and ``sign``:
+    only the tiles of ``TILE`` rows whose inputs changed (a tile's bytes read the rows from
+    one above it to two below its last; ``changed``: :func:`valid_changes`). The same
+    bytes, bit for bit, as :func:`link_bits` of ``valid``.
+
+    Parameters
+    ----------
+    phi, valid, noise, cut, sign, relative
+        As :func:`link_bits`.
+    bits : (H, W) uint8 array
+        :func:`link_bits` of the same arguments but another mask (and no cuts), changed
+        in place.
+    changed : (H,) uint8 array
+        The rows whose validity changed.
+
+    Returns
+    -------
+    int
+        The tiles made again.
+
+    Examples
+    --------
+    >>> x = np.arange(64, dtype=np.float32)
+    >>> phi = np.tile(x * np.float32(0.3) % np.float32(2 * np.pi), (70, 1))
+    >>> noise = np.full(phi.shape, 0.02, np.float32)
+    >>> ok = np.ones(phi.shape, bool)
+    >>> bits = link_bits(phi, ok, noise, 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False)
+    >>> ok[63, 5] = False  # tiles of rows 32-63 and 64-69 read row 63
+    >>> relink(phi, ok, noise, 1.0, 1, 0.3, bits, valid_changes(bits, ok))
+    2
+    >>> np.array_equal(bits, link_bits(phi, ok, noise, 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False))
+    True
+    """
+    h, w = phi.shape
+    valid8 = valid.view(np.uint8)
+    tiles = (h + TILE - 1) // TILE
+    redo = np.zeros(tiles, np.uint8)
+    for t in range(tiles):
+        for y in range(max(t * TILE - 1, 0), min(t * TILE + TILE + 2, h)):
+            redo[t] |= changed[y]
+    none = np.zeros((0, 0), np.uint8)
+    for t in prange(tiles):
+        if redo[t]:
+            _link_rows(phi, valid8, noise, cut, sign, relative, none, none, False, t * TILE,
+                       min(t * TILE + TILE, h), bits)
+    return int(redo.sum())
+
+
+@kernel(parallel=True)
+def cut_links(bits: np.ndarray, cut_v: np.ndarray, cut_h: np.ndarray) -> np.ndarray:
+    """A codec's cuts added to :func:`link_bits`' bytes made without them: a link that
+    connects and is cut connects no more and drops both its pixels. The same bytes, bit
+    for bit, as :func:`link_bits` with the cuts (a codec's cut acts only on a link that
+    would connect: a wrap, a step, a backward run or a period jump cuts it anyway, and
+    the backward runs are found before the codec's cuts).
+
+    Parameters
+    ----------
+    bits : (H, W) uint8 array
+        :func:`link_bits` without cuts.
+    cut_v, cut_h : (H-1, W) and (H, W-1) bool arrays
+        Vertical and horizontal links the codec cuts.
+
+    Returns
+    -------
+    (H, W) uint8 array
+        The bytes with the cuts.
+
+    Examples
+    --------
+    >>> bits = np.full((2, 3), LINK_RIGHT | LINK_DOWN | KEPT | VALID, np.uint8)
+    >>> bits[:, 2] &= ~np.uint8(LINK_RIGHT)
+    >>> bits[1] &= ~np.uint8(LINK_DOWN)
+    >>> cut_links(bits, np.zeros((1, 3), bool),
+    ...           np.array([[False, True], [False, False]])).tolist()
+    [[15, 10, 10], [13, 13, 12]]
+    """
+    h, w = bits.shape
+    out = np.empty((h, w), np.uint8)
+    cv = cut_v.view(np.uint8)
+    ch = cut_h.view(np.uint8)
+    right = np.uint8(LINK_RIGHT)
+    down = np.uint8(LINK_DOWN)
+    every = np.uint8(255)
+    no_right = np.uint8(255 - LINK_RIGHT - KEPT)  # masks: the bits a cut leaves
+    no_down = np.uint8(255 - LINK_DOWN - KEPT)
+    no_kept = np.uint8(255 - KEPT)
+    for t in prange((h + TILE - 1) // TILE):
+        for y in range(t * TILE, min(t * TILE + TILE, h)):
+            b = bits[y]
+            o = out[y]
+            c = ch[y]
+            for x in range(w):  # a link cut where it connects: selects, a vector loop
+                o[x] = b[x]
+            for x in range(w - 1):
+                cr = (c[x] != 0) & ((b[x] & right) != 0)
+                o[x] &= no_right if cr else every
+            for x in range(1, w):
+                cl = (c[x - 1] != 0) & ((b[x - 1] & right) != 0)
+                o[x] &= no_kept if cl else every
+            if y < h - 1:
+                d = cv[y]
+                for x in range(w):
+                    cd = (d[x] != 0) & ((b[x] & down) != 0)
+                    o[x] &= no_down if cd else every
+            if y > 0:
+                u = cv[y - 1]
+                a = bits[y - 1]
+                for x in range(w):
+                    cu = (u[x] != 0) & ((a[x] & down) != 0)
+                    o[x] &= no_kept if cu else every
     return out
 
 
