@@ -281,8 +281,9 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     With ``share``, the links are kept for the next labelling of the same ``phi`` and
     ``phase_noise`` (the same arrays) in this thread (a decode labels its phase twice:
     the coherent dim pixels on the weak mask, then its regions on the valid pixels with
-    its own cuts): that labelling takes them over, makes again only the row tiles whose
-    validity changed (:func:`~bistair.core.regions_jit.relink`) and adds its cuts
+    its own cuts): that labelling takes them over, makes again only the rows that read
+    a row whose validity changed (:func:`~bistair.core.regions_jit.relink`; where those
+    are at most three quarters of the rows) and adds its cuts
     (:func:`~bistair.core.regions_jit.cut_links`), where its direction is the first one's
     and no link's step lies between the two cut thresholds
     (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
@@ -360,6 +361,9 @@ def _shared_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray,
         return None, cut, sign
     _SHARED.links = None
     changed = valid_changes(bits, valid)
+    reread = np.convolve(changed, np.ones(4, np.uint8))[2:2 + changed.size]  # rows y-1..y+2
+    if np.count_nonzero(reread) * 4 > 3 * changed.size:  # most rows: its own pass is cheaper
+        return None, cut, sign
     if changed.any():
         if cut is None:  # the mask changed: its own threshold and direction
             cut = default_cut(phi, valid)

@@ -8,8 +8,8 @@ A decode runs them in this order (:func:`bistair.core.regions.label_fringes`):
 
 1. :func:`link_bits`: one byte a pixel, ``LINK_RIGHT | LINK_DOWN | KEPT | VALID`` (or,
    where a labelling takes over the links of an earlier one of the same phase, the
-   tiles whose validity changed made again, :func:`valid_changes` and :func:`relink`, and
-   the codec's cuts added, :func:`cut_links`);
+   rows that read a row whose validity changed made again, :func:`valid_changes` and
+   :func:`relink`, and the codec's cuts added, :func:`cut_links`);
 2. :func:`label_kept`: provisional labels of the kept pixels (4-connected), their regions
    numbered ``1..n`` in raster order of each region's first pixel (as
    ``cv2.connectedComponents(kept, connectivity=4)`` numbers them), the valid pixels not
@@ -729,9 +729,9 @@ def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, si
            relative: float, bits: np.ndarray, changed: np.ndarray) -> int:
     """:func:`link_bits` (without a codec's cuts) of a ``valid`` mask, in place of the bytes
     ``bits`` it gave for another mask of the same ``phi``, ``noise``, ``cut`` and ``sign``:
-    only the tiles of ``TILE`` rows whose inputs changed (a tile's bytes read the rows from
-    one above it to two below its last; ``changed``: :func:`valid_changes`). The same
-    bytes, bit for bit, as :func:`link_bits` of ``valid``.
+    only the rows whose inputs changed (the bytes of row ``y`` read rows ``y-1 .. y+2``;
+    ``changed``: :func:`valid_changes`), in runs of up to ``TILE`` rows. The same bytes,
+    bit for bit, as :func:`link_bits` of ``valid``.
 
     Parameters
     ----------
@@ -746,7 +746,7 @@ def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, si
     Returns
     -------
     int
-        The tiles made again.
+        The rows made again.
 
     Examples
     --------
@@ -755,25 +755,37 @@ def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, si
     >>> noise = np.full(phi.shape, 0.02, np.float32)
     >>> ok = np.ones(phi.shape, bool)
     >>> bits = link_bits(phi, ok, noise, 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False)
-    >>> ok[63, 5] = False  # tiles of rows 32-63 and 64-69 read row 63
+    >>> ok[40, 5] = False  # rows 38 to 41 read row 40
     >>> relink(phi, ok, noise, 1.0, 1, 0.3, bits, valid_changes(bits, ok))
-    2
+    4
     >>> np.array_equal(bits, link_bits(phi, ok, noise, 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False))
     True
     """
     h, w = phi.shape
     valid8 = valid.view(np.uint8)
-    tiles = (h + TILE - 1) // TILE
-    redo = np.zeros(tiles, np.uint8)
-    for t in range(tiles):
-        for y in range(max(t * TILE - 1, 0), min(t * TILE + TILE + 2, h)):
-            redo[t] |= changed[y]
+    starts = np.empty(h, np.int64)  # runs of rows to make again, each up to TILE rows
+    ends = np.empty(h, np.int64)
+    runs = 0
+    made = 0
+    y = 0
+    while y < h:
+        hit = False
+        for r in range(max(y - 1, 0), min(y + 3, h)):
+            hit |= changed[r] != 0
+        if hit:
+            if runs > 0 and ends[runs - 1] == y and y - starts[runs - 1] < TILE:
+                ends[runs - 1] = y + 1
+            else:
+                starts[runs] = y
+                ends[runs] = y + 1
+                runs += 1
+            made += 1
+        y += 1
     none = np.zeros((0, 0), np.uint8)
-    for t in prange(tiles):
-        if redo[t]:
-            _link_rows(phi, valid8, noise, cut, sign, relative, none, none, False, t * TILE,
-                       min(t * TILE + TILE, h), bits)
-    return int(redo.sum())
+    for i in prange(runs):
+        _link_rows(phi, valid8, noise, cut, sign, relative, none, none, False, starts[i],
+                   ends[i], bits)
+    return made
 
 
 @kernel(parallel=True)
