@@ -20,8 +20,22 @@ from support.real_parts import parts
 import bistair
 from bistair.core.jit import set_threads
 from bistair.core.measure import coherent_pixels
-from bistair.core.regions import fringe_regions, period_jumps
-from bistair.core.regions_jit import NO_CUTS, TILE, label_kept, link_bits
+from bistair.core.regions import (
+    cut_reference,
+    default_cut,
+    fringe_regions,
+    period_jumps,
+)
+from bistair.core.regions_jit import (
+    NO_CUTS,
+    TILE,
+    cut_links,
+    cut_medians,
+    label_kept,
+    link_bits,
+    relink,
+    valid_changes,
+)
 from bistair.io.read import read_with_spec
 from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.presets import preset_spec
@@ -98,6 +112,143 @@ def test_links_are_the_old_passes(h, w, seed, noise, holes, sign, cut, nan, ties
     got = link_bits(phi, valid, sigma, float(np.float32(cut)), sign, 0.3,
                     *(edges if cuts else (NO_CUTS, NO_CUTS)), cuts)
     assert before.same_links(got, *want, valid)
+
+
+@PROPERTY
+@given(h=st.integers(1, 70), w=st.integers(1, 70), seed=st.integers(0, 2**32 - 1),
+       noise=st.sampled_from([0.0, 0.05, 3.0]), holes=st.sampled_from([0.0, 0.3, 0.97, 1.0]),
+       nan=st.booleans(), ties=st.booleans(), flip=st.booleans())
+def test_cut_is_numpys(h, w, seed, noise, holes, nan, ties, flip):
+    """default_cut of a float32 phase (compiled medians) gives what its NumPy reference
+    gives, bit for bit: odd and even counts, ties on a grid of pi/8 (differences on pi,
+    equal middle values), NaN phases at valid pixels, no pair at all."""
+    phi, valid, _ = field(h, w, seed, noise, holes if holes < 1 else 0.0, nan, ties)
+    if holes == 1.0:
+        valid[:] = False
+    if nan:  # NaN where it counts, now and then
+        valid |= np.random.default_rng(seed).random((h, w)) < 0.02
+    if flip:
+        phi = np.ascontiguousarray(phi[:, ::-1])
+    cut, want = default_cut(phi, valid), cut_reference(phi, valid)
+    assert cut == want or (np.isnan(cut) and np.isnan(want))
+
+
+def test_cut_medians_of_many_equal_and_spread_values():
+    """The medians' count by bins, then selection: a middle pair split across bins, all
+    values equal, values from 0 to pi (many exponents), large images (many per bin)."""
+    rng = np.random.default_rng(4)
+    for h, w in [(400, 600), (8, 8), (3, 2), (1000, 5)]:
+        for kind in range(4):
+            if kind == 0:
+                phi = rng.uniform(0, 2 * np.pi, (h, w))
+            elif kind == 1:
+                phi = np.full((h, w), 1.25)
+            elif kind == 2:  # differences of every size (tiny to pi)
+                phi = np.cumsum(10.0 ** rng.uniform(-7, 0.5, (h, w)), axis=1) % (2 * np.pi)
+            else:
+                phi = (np.arange(w) * 0.7 + np.arange(h)[:, None] * 0.2) % (2 * np.pi)
+            phi = phi.astype(np.float32)
+            valid = rng.random((h, w)) < 0.8
+            meds, counts, ok = cut_medians(phi, valid)
+            assert ok
+            gx = np.abs(phi[::4, 1::4] - phi[::4, :-1:4][:, :phi[::4, 1::4].shape[1]])
+            assert counts[0] == (valid[::4, :-1:4][:, :gx.shape[1]]
+                                 & valid[::4, 1::4]).sum()
+            assert default_cut(phi, valid) == cut_reference(phi, valid)
+
+
+@PROPERTY
+@given(h=st.integers(1, 100), w=st.integers(1, 60), seed=st.integers(0, 2**32 - 1),
+       noise=st.sampled_from([0.05, 0.3]), holes=st.sampled_from([0.0, 0.1]),
+       sign=st.sampled_from([1, -1]), change=st.sampled_from([0.0, 0.002, 0.05, 0.5]),
+       nan=st.booleans(), cuts=st.booleans())
+def test_links_taken_over_are_their_own(h, w, seed, noise, holes, sign, change, nan, cuts):
+    """The links of one mask made for another (relink: the tiles whose rows changed,
+    across tile edges) and a codec's cuts added (cut_links): link_bits' own of that mask
+    with those cuts, bit for bit."""
+    phi, weak, sigma = field(h, w, seed, noise, holes, nan)
+    rng = np.random.default_rng(seed + 3)
+    valid = weak & ~(rng.random((h, w)) < change)  # weak pixels dropped here and there
+    edges = (rng.random((h - 1, w)) < 0.05, rng.random((h, w - 1)) < 0.05) if cuts else None
+    bits = link_bits(phi, weak, sigma, 1.0, sign, 0.3, NO_CUTS, NO_CUTS, False)
+    relink(phi, valid, sigma, 1.0, sign, 0.3, bits, valid_changes(bits, valid))
+    if cuts:
+        bits = cut_links(bits, *edges)
+    want = link_bits(phi, valid, sigma, 1.0, sign, 0.3,
+                     *(edges if cuts else (NO_CUTS, NO_CUTS)), cuts)
+    assert np.array_equal(bits, want)
+
+
+def test_relink_makes_every_row_that_reads_a_changed_row():
+    """The bytes of row y read the rows y-1 .. y+2 (its vertical link's windows take the
+    gradients of row y+1, down to row y+2): one changed row makes every row that reads it
+    again (rarely does a single row change a link there, which the property test cannot
+    count on)."""
+    phi, valid, sigma = field(3 * TILE + 5, 40, 9)
+    bits = link_bits(phi, valid, sigma, 1.0, 1, 0.3, NO_CUTS, NO_CUTS, False)
+    h = phi.shape[0]
+    for r in range(h):
+        changed = np.zeros(h, np.uint8)
+        changed[r] = 1
+        want = min(r + 1, h - 1) - max(r - 2, 0) + 1
+        assert relink(phi, valid, sigma, 1.0, 1, 0.3, bits.copy(), changed) == want
+
+
+@PROPERTY
+@given(h=st.integers(2, 80), w=st.integers(2, 60), seed=st.integers(0, 2**32 - 1),
+       change=st.sampled_from([0.0, 0.001, 0.01, 0.3]), cuts=st.booleans(),
+       strong=st.sampled_from([0.0, 0.9]))
+def test_a_labelling_that_takes_links_over_is_its_own(h, w, seed, change, cuts, strong):
+    """A labelling of the coherent pixels shares its links; the decode's labelling of the
+    same phase and noise (another mask, its cuts, its own cut threshold and direction)
+    takes them over where it may: the same regions as its own pass; a third labelling
+    finds nothing to take."""
+    from bistair.core import regions
+
+    phi, weak, sigma = field(h, w, seed, 0.05, 0.1)
+    rng = np.random.default_rng(seed + 4)
+    valid = weak & ~((rng.random((h, w)) < change) & (rng.random((h, w)) > strong))
+    edges = (rng.random((h - 1, w)) < 0.05, rng.random((h, w - 1)) < 0.05) if cuts else None
+    want = regions.label_fringes(phi, valid, phase_noise=sigma, boundaries=edges)
+    regions.label_fringes(phi, weak, phase_noise=sigma, share=True)
+    assert regions._SHARED.links is not None
+    got = regions.label_fringes(phi, valid, phase_noise=sigma, boundaries=edges)
+    assert regions._SHARED.links is None
+    assert got.n == want.n and np.array_equal(got.size, want.size)
+    assert np.array_equal(got.roots[got.labels], want.roots[want.labels])
+
+
+def test_links_are_shared_only_for_the_same_phase_and_noise():
+    """A labelling of another phase, or of the same phase with another noise array (even
+    of equal values), makes its own links; a changed cut threshold that cuts a link
+    otherwise does too."""
+    from bistair.core import regions
+
+    phi, weak, sigma = field(64, 80, 5, 0.05, 0.1)
+    taken = []
+    original = regions._shared_links
+
+    def spy(*args):
+        out = original(*args)
+        taken.append(out[0] is not None)
+        return out
+
+    try:
+        regions._shared_links = spy
+        for other, noise in [(phi.copy(), sigma), (phi, sigma.copy()), (phi, sigma)]:
+            regions._SHARED.links = None
+            regions.label_fringes(phi, weak, phase_noise=sigma, share=True)
+            regions.label_fringes(other, weak, phase_noise=noise)
+        cut = regions.default_cut(phi, weak)
+        steps = np.abs(np.diff(phi, axis=1))[weak[:, 1:] & weak[:, :-1]]
+        other_cut = float(np.sort(steps[steps > cut])[0])  # cuts one link more or less
+        regions._SHARED.links = None
+        regions.label_fringes(phi, weak, phase_noise=sigma, share=True)
+        regions.label_fringes(phi, weak, cut=other_cut, phase_noise=sigma)
+    finally:
+        regions._shared_links = original
+        regions._SHARED.links = None
+    assert taken == [False, False, False, False, False, True, False, False]
 
 
 def masks(draw_rng: np.random.Generator, h: int, w: int, kind: str) -> np.ndarray:

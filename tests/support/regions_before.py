@@ -14,7 +14,8 @@ import numpy as np
 from numba import prange
 
 from bistair.core.jit import PI32, TWO_PI32
-from bistair.core.regions import default_cut, fringe_direction
+from bistair.core.regions import cut_reference as default_cut
+from bistair.core.regions import fringe_direction
 
 
 @numba.njit(inline="always", cache=True, error_model="numpy")
@@ -546,14 +547,15 @@ def coherent_before(phi, weak, strong, phase_noise, min_strong=10, min_size=100)
 class Watch:
     """While open (``with Watch() as seen``), every fringe-region labelling a decode runs
     is checked against the passes above on the same arguments: the links of each
-    ``link_bits`` call (``links_before``), the labels of each ``fringe_regions`` call
+    ``link_bits`` call and of the links a labelling takes over from another
+    (``links_before``), the labels of each ``fringe_regions`` call
     (``regions_before``) and the pixels of each ``coherent_pixels`` call
     (``coherent_before``). ``seen`` counts the calls per kind; ``differ`` lists the calls
     that did not give the same (a decode goes on with the new result)."""
 
     def __init__(self) -> None:
         self.seen = {"link_bits": 0, "fringe_regions": 0, "coherent_pixels": 0,
-                     "codec cuts": 0}
+                     "codec cuts": 0, "shared links": 0}
         self.differ: list[str] = []
         self._undo: list[tuple] = []
 
@@ -591,10 +593,28 @@ class Watch:
                 self.differ.append(f"coherent_pixels {phi.shape}")
             return got
 
+        def shared(phi, valid, noise, cut, sign, phase_noise):
+            bits, cut, sign = shared_links(phi, valid, noise, cut, sign, phase_noise)
+            if bits is not None:  # links taken over: those of the labelling's own pass
+                self.seen["shared links"] += 1
+                self.seen["link_bits"] += 1
+                vert, horiz, keep = links_before(phi, valid, cut, sign, noise, None)
+                if not same_links(bits, vert, horiz, keep, valid):
+                    self.differ.append(f"shared links {phi.shape}")
+            return bits, cut, sign
+
+        def cuts_added(bits, cut_v, cut_h):
+            self.seen["codec cuts"] += int(cut_v.any() or cut_h.any())
+            return cut_links(bits, cut_v, cut_h)
+
         link_bits = regions.link_bits
         fringe_regions = regions.fringe_regions
         coherent_pixels = measure.coherent_pixels
+        shared_links = regions._shared_links
+        cut_links = regions.cut_links
         self._patch(regions, "link_bits", links)
+        self._patch(regions, "_shared_links", shared)
+        self._patch(regions, "cut_links", cuts_added)
         for module in list(sys.modules.values()):  # where the codecs imported it
             if getattr(module, "__name__", "").startswith("bistair.") and \
                     getattr(module, "fringe_regions", None) is fringe_regions:

@@ -308,7 +308,8 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     (True, False)
     """
     # the regions fringe_regions drops as too small are left out here; the labelling
-    # counted each region's pixels and strong pixels: no relabelling, no counting pass
-    lab = label_fringes(phi, weak, phase_noise=phase_noise, strong=strong)
+    # counted each region's pixels and strong pixels: no relabelling, no counting pass.
+    # Its links are shared: the decode's own labelling of phi takes them over
+    lab = label_fringes(phi, weak, phase_noise=phase_noise, strong=strong, share=True)
     return keep_coherent(lab.labels, lab.roots, lab.size, lab.strong, strong, min_strong,
                          min_size, MIN_REGION)

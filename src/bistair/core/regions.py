@@ -20,12 +20,26 @@ Examples
 
 from __future__ import annotations
 
+import threading
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import NO_CUTS, TILE, label_kept, link_bits, relabel, wrap_links
+from .regions_jit import (
+    NO_CUTS,
+    TILE,
+    band_links,
+    cut_links,
+    cut_medians,
+    label_kept,
+    link_bits,
+    relabel,
+    relink,
+    valid_changes,
+    wrap_links,
+)
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -164,7 +178,10 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     """Cut threshold for phase steps: three times the median phase gradient, in [0.6, 2.2].
 
     The gradient is the hypotenuse of the median absolute wrapped neighbour differences
-    along the rows and down the columns, on every fourth row and column.
+    along the rows and down the columns, on every fourth row and column. A float32 phase
+    has its medians taken in one compiled pass
+    (:func:`~bistair.core.regions_jit.cut_medians`): the same threshold, bit for bit, as
+    :func:`cut_reference`.
 
     Parameters
     ----------
@@ -183,6 +200,44 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     >>> phi = np.tile(2 * np.pi * np.arange(40.0) / 10 % (2 * np.pi), (8, 1))
     >>> round(default_cut(phi, np.ones(phi.shape, bool)), 3), default_cut(phi, phi < 0)
     (1.885, 1.5)
+    >>> default_cut(phi.astype(np.float32), np.ones(phi.shape, bool)) == cut_reference(
+    ...     phi.astype(np.float32), np.ones(phi.shape, bool))
+    True
+    """
+    if phi.dtype != np.float32 or phi.ndim != 2:
+        return cut_reference(phi, valid)
+    meds, counts, ok = cut_medians(np.ascontiguousarray(phi),
+                                   np.ascontiguousarray(valid, dtype=bool))
+    if not ok:  # NaN (or differences of 4 and more): NumPy's median decides
+        return cut_reference(phi, valid)
+    if counts[0] + counts[1] == 0:
+        return 1.5
+    grad = np.hypot(meds[0], meds[1])  # float32, as the reference's (a median absent: 0)
+    return float(np.clip(3.0 * grad, 0.6, 2.2))
+
+
+def cut_reference(phi: np.ndarray, valid: np.ndarray) -> float:
+    """NumPy reference of :func:`default_cut` (of its compiled medians,
+    :func:`~bistair.core.regions_jit.cut_medians`): three times the hypotenuse of the
+    median wrapped neighbour differences on every fourth row and column, in [0.6, 2.2].
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in ``[0, 2*pi)``.
+    valid : (H, W) bool array
+        Pixels whose phase counts.
+
+    Returns
+    -------
+    float
+        The threshold in radians; 1.5 when no pair of valid neighbours is found.
+
+    Examples
+    --------
+    >>> phi = np.tile(2 * np.pi * np.arange(40.0) / 10 % (2 * np.pi), (8, 1))
+    >>> round(cut_reference(phi, np.ones(phi.shape, bool)), 3)
+    1.885
     """
     # Neighbour differences on every fourth row and column: plenty for a median.
     a, va = phi[::4, ::4], valid[::4, ::4]
@@ -216,11 +271,23 @@ class Labelling:
 def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                   phase_noise: np.ndarray | None = None,
                   boundaries: tuple[np.ndarray, np.ndarray] | None = None,
-                  sign: int | None = None, strong: np.ndarray | None = None) -> Labelling:
+                  sign: int | None = None, strong: np.ndarray | None = None,
+                  share: bool = False) -> Labelling:
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
     labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
     pixels labelled and the dropped ones reattached, with per-region counts
     (:func:`~bistair.core.regions_jit.label_kept`).
+
+    With ``share``, the links are kept for the next labelling of the same ``phi`` and
+    ``phase_noise`` (the same arrays) in this thread (a decode labels its phase twice:
+    the coherent dim pixels on the weak mask, then its regions on the valid pixels with
+    its own cuts): that labelling takes them over, makes again only the rows that read
+    a row whose validity changed (:func:`~bistair.core.regions_jit.relink`; where those
+    are at most three quarters of the rows) and adds its cuts
+    (:func:`~bistair.core.regions_jit.cut_links`), where its direction is the first one's
+    and no link's step lies between the two cut thresholds
+    (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
+    own pass; none kept past the next ``share`` in the thread.
 
     Parameters
     ----------
@@ -228,6 +295,8 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
         As :func:`fringe_regions`.
     strong : (H, W) bool array, optional
         A mask whose pixels are counted per region (``Labelling.strong``).
+    share : bool
+        Keep the links for the next labelling of ``phi`` (without ``boundaries`` only).
 
     Returns
     -------
@@ -245,19 +314,26 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     [1, 1, 2, 2]
     """
     valid = np.ascontiguousarray(valid, dtype=bool)
-    if cut is None:
-        cut = default_cut(phi, valid)
     h, w = phi.shape
     noise = (np.full((h, w), 0.02, np.float32) if phase_noise is None
              else np.ascontiguousarray(phase_noise, dtype=np.float32))
-    if sign is None:
-        sign = fringe_direction(phi, valid)
     cut_v, cut_h = NO_CUTS, NO_CUTS
     if boundaries is not None:
         cut_v, cut_h = (np.ascontiguousarray(b, dtype=bool) for b in boundaries)
-    bits = link_bits(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
-                     float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
-                     boundaries is not None)
+    bits, cut, sign = _shared_links(phi, valid, noise, cut, sign, phase_noise)
+    if bits is not None:
+        if boundaries is not None:
+            bits = cut_links(bits, cut_v, cut_h)
+    else:
+        if cut is None:
+            cut = default_cut(phi, valid)
+        if sign is None:
+            sign = fringe_direction(phi, valid)
+        bits = link_bits(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
+                         float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
+                         boundaries is not None)
+        if share and boundaries is None and phase_noise is not None:
+            _SHARED.links = (weakref.ref(phi), weakref.ref(phase_noise), bits, cut, sign)
     del noise
     counted = strong is not None
     mask = np.ascontiguousarray(strong, dtype=bool) if counted else NO_CUTS
@@ -265,6 +341,44 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     # they still link to: three rounds
     labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE, 3)
     return Labelling(labels, roots, int(n), size, lit)
+
+
+_SHARED = threading.local()  # per thread: the links a labelling shared (label_fringes)
+
+
+def _shared_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray,
+                  cut: float | None, sign: int | None, phase_noise: np.ndarray | None
+                  ) -> tuple[np.ndarray | None, float | None, int | None]:
+    """The links :func:`label_fringes` shared for this ``phi`` and ``phase_noise``, taken
+    over and made for ``valid`` (``None`` where there are none, or where their direction
+    is not this labelling's or their cut threshold cuts a link otherwise), with the cut
+    and the direction; they are handed out once."""
+    shared = getattr(_SHARED, "links", None)
+    if shared is None or phase_noise is None:
+        return None, cut, sign
+    phi_ref, noise_ref, bits, cut0, sign0 = shared
+    if phi_ref() is not phi or noise_ref() is not phase_noise or bits.shape != phi.shape:
+        return None, cut, sign
+    _SHARED.links = None
+    changed = valid_changes(bits, valid)
+    reread = np.convolve(changed, np.ones(4, np.uint8))[2:2 + changed.size]  # rows y-1..y+2
+    if np.count_nonzero(reread) * 4 > 3 * changed.size:  # most rows: its own pass is cheaper
+        return None, cut, sign
+    if changed.any():
+        if cut is None:  # the mask changed: its own threshold and direction
+            cut = default_cut(phi, valid)
+        if sign is None:
+            sign = fringe_direction(phi, valid)
+    cut = cut0 if cut is None else cut
+    sign = sign0 if sign is None else sign
+    if int(sign) != int(sign0):
+        return None, cut, sign
+    low, high = sorted((float(np.float32(cut)), float(np.float32(cut0))))
+    if low != high and band_links(phi, valid, low, high) > 0:
+        return None, cut, sign  # (the two thresholds cut some link differently)
+    relink(np.ascontiguousarray(phi, dtype=np.float32), valid, noise,
+           float(np.float32(cut)), int(sign), 0.3, bits, changed)
+    return bits, cut, sign
 
 
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
