@@ -78,21 +78,38 @@ def test_an_agreement_of_the_whole_image_alone_is_judged_there():
     assert (n, detached) == (2, 1) and np.unique(new[:, 90:]).tolist() == [2]
 
 
-@pytest.mark.parametrize("seed", [1])
-def test_a_rendered_decode_detaches_the_same_parts(seed):
-    from bistair.sim import Imaging, expose, preset, preset_spec, trace
+def _rendered(name, tmp_path):
+    if name == "objects-on-plane":
+        from bistair.sim import Imaging, expose, preset, preset_spec, trace
 
-    rig, scene = preset("objects-on-plane", camera_size=(640, 512))
-    spec = preset_spec("objects-on-plane", "bidirectional")
-    imaging = Imaging(seed=seed)
-    images = expose(trace(rig, scene, imaging), bistair.encode(spec), imaging)
+        rig, scene = preset(name, camera_size=(640, 512))
+        spec = preset_spec(name, "bidirectional")
+        imaging = Imaging(seed=1)
+        return expose(trace(rig, scene, imaging), bistair.encode(spec), imaging), spec
+    from click.testing import CliRunner
+
+    from bistair.app.cli import cli
+
+    # the README's first scan, as its command renders it
+    done = CliRunner().invoke(cli, ["simulate", "--scene", name, "--method", "bidirectional",
+                                    "--camera", "640x512", "--out", str(tmp_path / "tour")])
+    assert done.exit_code == 0, done.output
+    return bistair.read_captures(tmp_path / "tour" / "bidirectional")
+
+
+@pytest.mark.parametrize("name", ["objects-on-plane", "sphere-on-plane"])
+def test_a_rendered_decode_detaches_the_same_parts(name, tmp_path):
+    """The decode's split is the whole image's: on the README's sphere-on-plane, a split
+    judged from a sample (every second row and column) missed a part 5 rows tall and gave
+    its 38 pixels order 30 where the truth is 37, so no decoder judges parts from one."""
+    images, spec = _rendered(name, tmp_path)
     sampled = bistair.decode(images, spec, force=True)
     resolve.split_parts = split_disagreeing
     try:
         whole = bistair.decode(images, spec, force=True)
     finally:
         resolve.split_parts = split_parts
-    assert whole.info["regions_detached"] > 5
+    assert whole.info["regions_detached"] >= (6 if name == "objects-on-plane" else 1)
     assert sampled.info["regions_detached"] == whole.info["regions_detached"]
     assert np.array_equal(sampled.order, whole.order)
     assert np.array_equal(sampled.phase, whole.phase, equal_nan=True)

@@ -1,13 +1,16 @@
 """Parts of fringe regions whose pixels' own codes contradict their region's order, detached
-as regions of their own: detected on a 2 x 2 sample of the image, split at full resolution
-only inside each flagged part's box.
+as regions of their own: over the whole image, or (for an agreement marked :func:`windowed`)
+detected on a 2 x 2 sample and split at full resolution inside each flagged part's box.
 
 Where two surfaces meet with a phase step close to a whole number of fringes, a fringe of
 one joins a fringe of the other into one region, and the larger part's order wins; the
 smaller part's codes then disagree with it. :func:`split_disagreeing` finds such parts over
-the whole image (the reference); :func:`split_parts`, what the decoders run, finds the same
-parts from a sample and the full-resolution pixels of a few boxes
-(:func:`sample_boxes`, :func:`split_in_boxes`).
+the whole image (the reference); :func:`split_parts`, what the decoders run, finds them
+from a sample and the full-resolution pixels of a few boxes
+(:func:`sample_boxes`, :func:`split_in_boxes`) for an agreement marked :func:`windowed`,
+and over the whole image for any other. No codec marks its agreement so: the sample (every
+second row and column) missed a part 5 rows tall on the README's sphere-on-plane render and
+left its pixels an order 7 fringes off (``tests/test_parts.py``).
 
 Examples
 --------
