@@ -43,9 +43,8 @@ def test_occlusion_edges_are_not_taken_for_a_wrong_spec(camera, coverage):
     truth = traced.truth
     m = score(result, truth.coord(spec), truth.mask, truth.object_id)
     assert m["order_error_rate"] <= 0.002 and m["coverage"] >= coverage
-    info = result.info
-    judged = info["code_windows"] - info["edge_windows"]
-    assert judged >= 20 and info["unknown_windows"] - info["edge_windows"] <= 0.05 * judged
+    info = result.info  # the figures the check judged
+    assert info["code_windows"] >= 50 and info["unknown_windows"] <= 0.05 * info["code_windows"]
 
 
 @pytest.mark.parametrize("change", [{"period": 45.0}, {"width": 3413, "levels": 5},

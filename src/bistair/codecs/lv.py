@@ -205,7 +205,8 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     each order, weighted by the least sure code in the window. ``info`` receives how many
     complete windows were read surely (``code_windows``: every member's code at least
     ``sure``), how many of them the sequence does not hold (``unknown_windows``; the spec
-    check of :func:`order_columns` judges these two) and how many windows ran through a
+    check of :func:`order_columns` judges these two, less the windows across an edge of two
+    surfaces, :func:`edge_windows`) and how many windows ran through a
     region whose code is split (``unsure_windows``: two surfaces in one region at an
     occlusion edge, or a region a few pixels wide; they still vote, by their weight, but
     their codes say nothing about the spec).
@@ -408,14 +409,17 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     -------
     Orders
         (H, W) fringe order per pixel (-1 where invalid) and ``info``: the camera noise,
-        the fringes, the code windows read and unknown, the region counts and the phase
-        jumps across which the orders do not step by one.
+        the fringes, the code windows the spec check judges (``code_windows``) and the
+        unknown among them (``unknown_windows``), the windows it leaves out (through a
+        region whose code is split, ``unsure_windows``; across an edge of two surfaces,
+        ``edge_windows``: see :func:`window_evidence`, :func:`edge_windows`), the region
+        counts and the phase jumps across which the orders do not step by one.
 
     Raises
     ------
     BistairError
-        Of 20 or more code windows read, over 15% are not in the spec's sequence (the spec
-        does not fit the captures).
+        Of 20 or more code windows judged, over 15% are not in the spec's sequence (the
+        spec does not fit the captures).
 
     Examples
     --------
@@ -463,18 +467,18 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
 
     info: dict = {"noise": fs.noise, "fringes": spec.fringes}
     order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
-    if unknown:
+    if unknown:  # windows across an edge of two surfaces are not judged
         chains, last = unknown
         region_order = np.full(int(last.max()) + 1, -1, np.int64)
         region_order[last.ravel()] = order.ravel()  # every pixel of a region has its order
         region_order[0] = -1
-        info["edge_windows"] = int(edge_windows(chains, region_order).sum())
-    edges = info.get("edge_windows", 0)
-    windows = info.get("code_windows", 0) - edges
-    unknown_share = (info.get("unknown_windows", 0) - edges) / max(windows, 1)
-    if windows >= 20 and unknown_share > 0.15:
+        edges = int(edge_windows(chains, region_order).sum())
+        info.update(code_windows=info["code_windows"] - edges,
+                    unknown_windows=info["unknown_windows"] - edges, edge_windows=edges)
+    windows, unknown_count = info.get("code_windows", 0), info.get("unknown_windows", 0)
+    if windows >= 20 and unknown_count > 0.15 * windows:
         refuse(
-            f"{100 * unknown_share:.0f}% of the "
+            f"{100 * unknown_count / windows:.0f}% of the "
             f"{windows} code windows read are not in the spec's code sequence: does the spec "
             "fit (period, projector size, levels, window)?")
     return Orders(order, info)
