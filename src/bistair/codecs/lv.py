@@ -467,14 +467,15 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
 
     info: dict = {"noise": fs.noise, "fringes": spec.fringes}
     order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
-    if unknown:  # windows across an edge of two surfaces are not judged
+    edges = 0  # windows across an edge of two surfaces are not judged
+    if unknown and len(unknown[0]):
         chains, last = unknown
         region_order = np.full(int(last.max()) + 1, -1, np.int64)
         region_order[last.ravel()] = order.ravel()  # every pixel of a region has its order
         region_order[0] = -1
         edges = int(edge_windows(chains, region_order).sum())
-        info.update(code_windows=info["code_windows"] - edges,
-                    unknown_windows=info["unknown_windows"] - edges, edge_windows=edges)
+    info.update(code_windows=info.get("code_windows", 0) - edges,
+                unknown_windows=info.get("unknown_windows", 0) - edges, edge_windows=edges)
     windows, unknown_count = info.get("code_windows", 0), info.get("unknown_windows", 0)
     if windows >= 20 and unknown_count > 0.15 * windows:
         refuse(
