@@ -500,17 +500,20 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
     kept : int
         The dim pixels kept.
     """
-    dim = (read >= 0) & (carried < 0)
-    if not dim.any():
+    read_any = read >= 0
+    dim = np.flatnonzero(read_any & (carried < 0))
+    if not dim.size:
         return carried, 0
-    labels, n = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
+    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise)
     shares = code_evidence(labels, n, carried, fringes)
     strong = np.bincount(labels[carried >= 0], minlength=n + 1)
     order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),
                      shares.argmax(axis=1), -1)
     order[0] = -1
-    keep = dim & (read == order[labels])
-    return np.where(keep, read, carried).astype(np.int32), int(np.count_nonzero(keep))
+    kept = dim[read.ravel()[dim] == order[labels.ravel()[dim]]]
+    out = np.array(carried, dtype=np.int32, order="C")  # a copy
+    out.ravel()[kept] = read.ravel()[kept]
+    return out, int(kept.size)
 
 
 def measure_columns(prepared: Prepared, spec: GrayCodeSpec,
