@@ -499,6 +499,22 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
         (H, W) int32, ``carried`` with the kept dim pixels' orders.
     kept : int
         The dim pixels kept.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30, complementary=1)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> read = code_columns(cols, spec, fs).code
+    >>> carried = read.copy()
+    >>> carried[:, 40:50] = -1  # dim pixels in fringe 1
+    >>> read[:16, 40:50] = 2  # half of them read another order than their region's
+    >>> orders, kept = region_carry(fs, read, carried, spec.fringes)
+    >>> kept, int(orders[16:, 40:50].min()), int(orders[:16, 40:50].max())
+    (160, 1, -1)
     """
     read_any = read >= 0
     dim = np.flatnonzero(read_any & (carried < 0))
