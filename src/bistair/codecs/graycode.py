@@ -95,6 +95,10 @@ from .graycode_jit import code_bits, orders_fit, read_orders
 CLEAR_NOISE = 3.0
 CLEAR_SHARE = 0.5
 EDGE_REACH = 0.5
+# A dim pixel (read, not carried) is kept where its fringe region's strong pixels settle
+# its order: over SETTLED of at least MIN_STRONG of them read it (:func:`region_carry`)
+SETTLED = 0.99
+MIN_STRONG = 50
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -438,6 +442,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
         # the orders the pixels' own evidence carries (all read ones where it is not judged)
         carried = code.maps.get("carried")
         k = read if carried is None else np.where(carried, read, -1)
+        if carried is not None and spec.steps:
+            k, info["region_carried"] = region_carry(fs, read, k, spec.fringes)
         if carried is not None:
             info["left_out"] = int(np.count_nonzero(read >= 0)) - int(np.count_nonzero(k >= 0))
         if spec.steps == 0:  # no phase to check the cells against: their direction
@@ -460,6 +466,70 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     order = orders_from_regions(fs.phi, fs.valid & (read >= 0), labels, evidence_of, agrees,
                                 info)
     return Orders(order, info)
+
+
+def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: int,
+                 settled: float = SETTLED, min_strong: int = MIN_STRONG
+                 ) -> tuple[np.ndarray, int]:
+    """Keep the orders read where the pixel's own evidence does not carry them but its
+    fringe region's strong pixels settle the same order.
+
+    A fringe region (between phase wraps) holds one order; where at least ``min_strong``
+    of its pixels carry their orders and over ``settled`` of them read the same one, a dim
+    pixel of the region (read, not carried) that reads that order is kept.
+
+    Parameters
+    ----------
+    fs : FringeSet
+        Stage 1: the phase, validity and phase noise the regions are cut by.
+    read : numpy.ndarray
+        (H, W) int32 orders as read (-1 where none).
+    carried : numpy.ndarray
+        (H, W) int32 orders the pixels' own evidence carries (-1 elsewhere).
+    fringes : int
+        Fringes across the coded axis (the orders' range).
+    settled : float, default SETTLED
+        Share of a region's strong pixels that must read one order.
+    min_strong : int, default MIN_STRONG
+        Strong pixels a region needs.
+
+    Returns
+    -------
+    orders : numpy.ndarray
+        (H, W) int32, ``carried`` with the kept dim pixels' orders.
+    kept : int
+        The dim pixels kept.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30, complementary=1)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> read = code_columns(cols, spec, fs).code
+    >>> carried = read.copy()
+    >>> carried[:, 40:50] = -1  # dim pixels in fringe 1
+    >>> read[:16, 40:50] = 2  # half of them read another order than their region's
+    >>> orders, kept = region_carry(fs, read, carried, spec.fringes)
+    >>> kept, int(orders[16:, 40:50].min()), int(orders[:16, 40:50].max())
+    (160, 1, -1)
+    """
+    read_any = read >= 0
+    dim = np.flatnonzero(read_any & (carried < 0))
+    if not dim.size:
+        return carried, 0
+    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise)
+    shares = code_evidence(labels, n, carried, fringes)
+    strong = np.bincount(labels[carried >= 0], minlength=n + 1)
+    order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),
+                     shares.argmax(axis=1), -1)
+    order[0] = -1
+    kept = dim[read.ravel()[dim] == order[labels.ravel()[dim]]]
+    out = np.array(carried, dtype=np.int32, order="C")  # a copy
+    out.ravel()[kept] = read.ravel()[kept]
+    return out, int(kept.size)
 
 
 def measure_columns(prepared: Prepared, spec: GrayCodeSpec,

@@ -41,6 +41,10 @@ from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
 
+# The share of a region's weight its code needs for the windows through it to be judged by
+# the spec check: a region holding two surfaces reads two codes about half and half
+SURE_CODE = 0.75
+
 
 @lru_cache(maxsize=64)
 def code_sequence(length: int, levels: int, window: int) -> tuple[int, ...]:
@@ -189,7 +193,8 @@ def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:
 
 
 def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.ndarray,
-                    spec: LvSpec, info: dict | None = None) -> np.ndarray:
+                    spec: LvSpec, info: dict | None = None, sure: float = SURE_CODE,
+                    unknown: list | None = None) -> np.ndarray:
     """Votes of every chain of ``window`` adjacent regions for its members' orders.
 
     Each region starts a window (itself and the next ``window - 1`` regions up); the window's
@@ -198,8 +203,13 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     before or after it is contradicted and does not vote; one with neighbours must be
     confirmed by one of them. A region's evidence is the share of its windows voting for
     each order, weighted by the least sure code in the window. ``info`` receives how many
-    complete windows were read (``code_windows``) and how many of them the sequence does
-    not hold (``unknown_windows``).
+    complete windows were read surely (``code_windows``: every member's code at least
+    ``sure``), how many of them the sequence does not hold (``unknown_windows``; the spec
+    check of :func:`order_columns` judges these two, less the windows across an edge of two
+    surfaces, :func:`edge_windows`) and how many windows ran through a
+    region whose code is split (``unsure_windows``: two surfaces in one region at an
+    occlusion edge, or a region a few pixels wide; they still vote, by their weight, but
+    their codes say nothing about the spec).
 
     Parameters
     ----------
@@ -213,7 +223,13 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     spec : LvSpec
         The spec: ``sequence``, ``levels``, ``window`` and ``fringes`` are used.
     info : dict, optional
-        Receives ``code_windows`` and ``unknown_windows``.
+        Receives ``code_windows``, ``unknown_windows`` and ``unsure_windows``.
+    sure : float, default SURE_CODE
+        The least share of its weight a region's code needs for the windows through it to
+        be judged against the sequence.
+    unknown : list, optional
+        Receives (in place of its contents) the (u, window) int64 regions of the ``u``
+        judged windows the sequence does not hold, in chain order.
 
     Returns
     -------
@@ -232,7 +248,7 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     >>> info = {}
     >>> ev = window_evidence(region_code, np.ones(17), succ, spec, info)
     >>> ev.shape, ev[1:].argmax(axis=1).tolist() == list(range(16)), info
-    ((17, 16), True, {'code_windows': 13, 'unknown_windows': 0})
+    ((17, 16), True, {'code_windows': 13, 'unknown_windows': 0, 'unsure_windows': 0})
     >>> region_code[5] = 3  # a misread: the windows through region 5 are not in the sequence
     >>> ev = window_evidence(region_code, np.ones(17), succ, spec, info)
     >>> ev[1:10].max(axis=1).round(2).tolist(), info["unknown_windows"]
@@ -254,7 +270,12 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     ok[0] = False
     start = np.where(ok, table[_window_key(region_code[safe], spec.levels)], -1)
     if info is not None:
-        info.update(code_windows=int(ok.sum()), unknown_windows=int((ok & (start < 0)).sum()))
+        judged = ok & (confidence[safe].min(axis=1) >= sure)
+        info.update(code_windows=int(judged.sum()),
+                    unknown_windows=int((judged & (start < 0)).sum()),
+                    unsure_windows=int((ok & ~judged).sum()))
+        if unknown is not None:
+            unknown[:] = [chain[judged & (start < 0)]]
     ok &= start >= 0
     pred = np.full(n_reg + 1, -1, np.int64)
     has_succ = succ >= 0
@@ -273,6 +294,39 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     for j in range(spec.window):
         np.add.at(votes, (chain[rows, j], start[rows] + j), weight)
     return votes / np.maximum(seen, 1.0)[:, None]
+
+
+def edge_windows(chains: np.ndarray, region_order: np.ndarray) -> np.ndarray:
+    """Which windows run across an edge of two surfaces, as the decoded orders show.
+
+    A window chains each region to its strongest neighbour across a wrap, taken as one
+    order up; where a wrap joins two surfaces (one in front of the other) the chain hops to
+    a fringe of other order and the window's codes are not in the sequence, rightly. Such
+    a window has two neighbours in its chain whose decoded orders (both decided) do not
+    step by one.
+
+    Parameters
+    ----------
+    chains : numpy.ndarray
+        (u, window) int, the regions of each window in chain order (``unknown`` of
+        :func:`window_evidence`).
+    region_order : numpy.ndarray
+        (n_regions + 1,) int, each region's decoded order (-1 where undecided).
+
+    Returns
+    -------
+    numpy.ndarray
+        (u,) bool, the windows across such an edge.
+
+    Examples
+    --------
+    >>> order = np.array([-1, 24, 25, 26, 23, 24, -1])
+    >>> edge_windows(np.array([[1, 2, 3, 4], [3, 4, 5, 6], [4, 5, 6, 1]]), order).tolist()
+    [True, True, False]
+    """
+    k = region_order[chains]
+    both = (k[:, :-1] >= 0) & (k[:, 1:] >= 0)
+    return (both & (np.diff(k, axis=1) != 1)).any(axis=1)
 
 
 def _window_key(codes: np.ndarray, levels: int) -> np.ndarray:
@@ -355,14 +409,17 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     -------
     Orders
         (H, W) fringe order per pixel (-1 where invalid) and ``info``: the camera noise,
-        the fringes, the code windows read and unknown, the region counts and the phase
-        jumps across which the orders do not step by one.
+        the fringes, the code windows the spec check judges (``code_windows``) and the
+        unknown among them (``unknown_windows``), the windows it leaves out (through a
+        region whose code is split, ``unsure_windows``; across an edge of two surfaces,
+        ``edge_windows``: see :func:`window_evidence`, :func:`edge_windows`), the region
+        counts and the phase jumps across which the orders do not step by one.
 
     Raises
     ------
     BistairError
-        Of 20 or more code windows read, over 15% are not in the spec's sequence (the spec
-        does not fit the captures).
+        Of 20 or more code windows judged, over 15% are not in the spec's sequence (the
+        spec does not fit the captures).
 
     Examples
     --------
@@ -385,12 +442,17 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
     weight = core_weight(fs.phi)
 
+    unknown: list = []  # the last labels and the chains of their unknown windows
+
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         shares = code_evidence(labels, n, codes, spec.levels, weight)
         region_code = np.where(shares.max(axis=1) > 0, shares.argmax(axis=1), -1)
         region_code[0] = -1
         succ = _successors(region_links(fs.phi, labels), n)
-        return labels, n, window_evidence(region_code, shares.max(axis=1), succ, spec, info)
+        evidence = window_evidence(region_code, shares.max(axis=1), succ, spec, info,
+                                   unknown=unknown)
+        unknown.append(labels)
+        return labels, n, evidence
 
     sequence = np.asarray(spec.sequence, np.int32)
 
@@ -405,10 +467,19 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
 
     info: dict = {"noise": fs.noise, "fringes": spec.fringes}
     order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
-    windows, unknown = info.get("code_windows", 0), info.get("unknown_windows", 0)
-    if windows >= 20 and unknown > 0.15 * windows:
+    edges = 0  # windows across an edge of two surfaces are not judged
+    if unknown and len(unknown[0]):
+        chains, last = unknown
+        region_order = np.full(int(last.max()) + 1, -1, np.int64)
+        region_order[last.ravel()] = order.ravel()  # every pixel of a region has its order
+        region_order[0] = -1
+        edges = int(edge_windows(chains, region_order).sum())
+    info.update(code_windows=info.get("code_windows", 0) - edges,
+                unknown_windows=info.get("unknown_windows", 0) - edges, edge_windows=edges)
+    windows, unknown_count = info.get("code_windows", 0), info.get("unknown_windows", 0)
+    if windows >= 20 and unknown_count > 0.15 * windows:
         refuse(
-            f"{100 * unknown / windows:.0f}% of the "
+            f"{100 * unknown_count / windows:.0f}% of the "
             f"{windows} code windows read are not in the spec's code sequence: does the spec "
             "fit (period, projector size, levels, window)?")
     return Orders(order, info)
