@@ -221,6 +221,12 @@ def precision_needed(periods: tuple[float, ...], length: int) -> float:
     return (1.0 / top - 1.0 / length) / slope
 
 
+def _as_written(period: float) -> str:
+    """A period with all its digits (``30``, ``33.10344828``)."""
+    text = repr(float(period))
+    return text[:-2] if text.endswith(".0") else text
+
+
 def check_beat(periods: tuple[float, ...], length: int) -> None:
     """Refuse periods whose top beat falls short of the coded axis, unless their stated
     precision explains the shortfall and it is under half a projector pixel.
@@ -244,12 +250,12 @@ def check_beat(periods: tuple[float, ...], length: int) -> None:
     >>> check_beat((1919 / 64, 1919 / 58, 1919 / 53), 1920)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    bistair.errors.BistairError: the beat of periods (29.9844, 33.0862, 36.2075) is 1919 px, ...
+    bistair.errors.BistairError: the beat of periods (29.984375, 33.08620689655172, ...
     """
     top, reach = beat_reach(periods)
     if covers(top, length) or (top >= length - HALF_PIXEL and covers(reach, length)):
         return
-    shown = ", ".join(format_period(t) for t in periods)
+    shown = ", ".join(_as_written(t) for t in periods)
     stated = max(stated_precision(t) for t in periods)
     need = precision_needed(periods, length)
     repeat = " by more than half a pixel, so patterns with these periods repeat within it" \
