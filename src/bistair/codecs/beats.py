@@ -206,7 +206,19 @@ def beat_reach(periods: tuple[float, ...],
 
 def precision_needed(periods: tuple[float, ...], length: int) -> float:
     """The one precision (projector pixels, every period) at which the periods' top beat
-    can reach ``length``: 0 when their beat already covers it.
+    can reach ``length``: 0 when their beat already covers it (to first order).
+
+    Parameters
+    ----------
+    periods : tuple of float
+        Fringe periods in projector pixels, as written.
+    length : int
+        The coded axis in projector pixels.
+
+    Returns
+    -------
+    float
+        The half-width, projector pixels.
 
     Examples
     --------
