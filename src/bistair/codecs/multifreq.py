@@ -44,79 +44,12 @@ from ..core.phase import TWO_PI, order_from_reference
 from ..errors import BistairError
 from ..spec import BaseSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, shift_patterns
+from .beats import ambiguous, beat, beat_tree, check_beat, covers
 from .multifreq_jit import agreed_orders, unwrap_chain
 
 # An unwrapping step's order is carried where the next order fits the step's miss worse by
 # CLEAR_NOISE**2 sigmas squared of its noise: odds of exp(-4.5), 1.1%, at the most
 CLEAR_NOISE = 3.0
-
-
-def beat_tree(periods: tuple[float, ...]) -> list[list[float]]:
-    """Levels of beat periods: level 0 the periods ascending, each next the beats of
-    neighbours of the one below (:func:`beat`), ascending, up to a single period.
-
-    Parameters
-    ----------
-    periods : tuple of float
-        Fringe periods in projector pixels, any order, all different.
-
-    Returns
-    -------
-    list of list of float
-        The levels, each ascending; the last holds one period (the widest beat).
-
-    Raises
-    ------
-    BistairError
-        Two beats come out equal, or a beat equals a period: their phases cannot be told
-        apart.
-
-    Examples
-    --------
-    >>> beat_tree((48, 42, 45))
-    [[42.0, 45.0, 48.0], [630.0, 720.0], [5040.0]]
-    >>> beat_tree((42, 45, 50))  # the beats of 42 & 45 and 45 & 50 are 630 and 450
-    [[42.0, 45.0, 50.0], [450.0, 630.0], [1575.0]]
-    >>> beat_tree((40, 60, 120))  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    bistair.errors.BistairError: the periods (40, 60, 120) give two equal beats or a beat ...
-    """
-    levels = [sorted(float(p) for p in periods)]
-    seen = set(levels[0])
-    while len(levels[-1]) > 1:
-        low = levels[-1]
-        beats = sorted(beat(a, b) for a, b in zip(low[:-1], low[1:], strict=True))
-        same = [t for i, t in enumerate(beats) if t in seen or t in beats[:i]]
-        if same:
-            shown = ", ".join(format_period(p) for p in periods)
-            raise BistairError(f"the periods ({shown}) give two equal beats or a beat equal to "
-                               f"a period ({same[0]:.0f} px): their phases cannot be told apart")
-        seen.update(beats)
-        levels.append(beats)
-    return levels
-
-
-def beat(shorter: float, longer: float) -> float:
-    """The beat period of two fringe periods: the period of the difference of their
-    phases.
-
-    Parameters
-    ----------
-    shorter, longer : float
-        The two periods in projector pixels, ``shorter < longer``.
-
-    Returns
-    -------
-    float
-        ``shorter * longer / (longer - shorter)``.
-
-    Examples
-    --------
-    >>> beat(42.0, 45.0)
-    630.0
-    """
-    return shorter * longer / (longer - shorter)
 
 
 def miss_peak(worst: np.ndarray, valid: np.ndarray) -> float:
@@ -149,31 +82,6 @@ def miss_peak(worst: np.ndarray, valid: np.ndarray) -> float:
     w = np.abs(np.asarray(worst)[::4, ::4])[np.asarray(valid)[::4, ::4]]
     quarter = int(np.count_nonzero(w < 0.25))
     return float(np.count_nonzero(w < 0.125) / quarter) if quarter else 1.0
-
-
-def covers(period: float, length: int) -> bool:
-    """Whether a period (or beat) spans ``length`` projector pixels, to within float
-    rounding: the beat of ``1920/58`` and ``1920/53`` computes as 1919.99999999998.
-
-    Parameters
-    ----------
-    period : float
-        A period or beat in projector pixels.
-    length : int
-        The coded axis in projector pixels.
-
-    Returns
-    -------
-    bool
-        ``period >= length`` up to a relative 1e-9.
-
-    Examples
-    --------
-    >>> top = beat_tree((1920 / 64, 1920 / 58, 1920 / 53))[-1][0]
-    >>> top < 1920, covers(top, 1920), covers(1919.0, 1920)
-    (True, True, False)
-    """
-    return period >= length * (1.0 - 1e-9)
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -214,12 +122,7 @@ class MultiFreqSpec(BaseSpec):
                 f"axis; the longest is {max(self.periods)} (use heterodyne)"
             )
         if self.unwrap == "heterodyne":
-            top = beat_tree(self.periods)[-1][0]
-            if not covers(top, self.coded_length):
-                raise BistairError(
-                    f"the beat of periods {self.periods} is {top:.0f} px, narrower than the "
-                    f"{self.coded_length}-px coded axis"
-                )
+            check_beat(self.periods, self.coded_length)
 
     @property
     def period(self) -> float:
@@ -422,6 +325,11 @@ def code_columns(prepared: Prepared, spec: MultiFreqSpec, fs: FringeSet,
                 parent = beat(low[j], low[j + 1])
                 absolute[t] = unwrap(phase_of[t], absolute[parent], parent / t)
     order = order_from_reference(fs.phi, absolute[shortest])
+    if spec.unwrap == "heterodyne":  # pixels a top beat read across its wrap can move
+        twice = ambiguous(absolute[shortest] * (shortest / TWO_PI), spec.periods,
+                          spec.coded_length)
+        if twice is not None:
+            order[twice] = np.nan
     code = np.where(valid & np.isfinite(order), order, -1).astype(np.int32)
     return CodeMap(code, {"worst": np.broadcast_to(unwrap.worst, valid.shape), "valid": valid,
                           "residual": np.broadcast_to(unwrap.last, valid.shape),
