@@ -78,3 +78,19 @@ def test_windows_across_a_surface_edge_are_found_by_their_orders():
     order = np.array([-1, 10, 11, 12, 30, 31, 32, 33, -1])
     chains = np.array([[1, 2, 3, 4], [2, 3, 4, 5], [4, 5, 6, 7], [5, 6, 7, 8]])
     assert lv.edge_windows(chains, order).tolist() == [True, True, False, False]
+
+
+def test_another_methods_captures_read_through_split_regions_are_refused():
+    """Bidirectional captures read as lv: every window passes through a region of no one code
+    (99 of 99 on objects-on-plane), so none is judged; before UNSURE, that decode answered
+    for no pixel with exit 0 instead of saying the spec does not fit."""
+    rig, geometry = preset("objects-on-plane", camera_size=(480, 384))
+    imaging = Imaging(read_noise=0.01, camera_blur=1.0, seed=1)
+    w, h = rig.projector.size
+    other = bistair.make_spec("bidirectional", width=w, height=h, gamma=imaging.gamma,
+                              **bistair.get_codec("bidirectional").comparable(w, h, 30, 4))
+    images = expose(trace(rig, geometry, imaging), bistair.encode(other), imaging)
+    spec = bistair.make_spec("lv", width=w, height=h, gamma=imaging.gamma,
+                             **lv.comparable(w, h, 30, 4))
+    with pytest.raises(bistair.BistairError, match="pass through a fringe region that reads"):
+        bistair.decode(images, spec)
