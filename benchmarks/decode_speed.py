@@ -230,10 +230,15 @@ def main() -> None:
     parser.add_argument("--no-compile", action="store_true",
                         help="skip the fresh processes that compile every kernel (minutes)")
     parser.add_argument("--codecs", default=None,
-                        help="comma-separated indices of the codecs to time (default: all)")
+                        help="comma-separated indices of the codecs to time, 0 the default "
+                             "(default: all)")
     parser.add_argument("--markdown", type=Path, default=None,
                         help="also write the page of the results (e.g. docs/results/speed.md)")
     args = parser.parse_args()
+    if args.codecs is not None and not all(
+            i.strip().isdigit() and int(i) < len(CASES) for i in args.codecs.split(",")):
+        parser.error(f"--codecs takes indices 0-{len(CASES) - 1} of: "
+                     + ", ".join(case.label for case in CASES))
     found: dict[str, dict] = {}
     with markdown_page(args.markdown, TITLE, ABOUT, lambda: page_sections(found, args.runs),
                        machine_line):
