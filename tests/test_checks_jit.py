@@ -8,7 +8,7 @@ import numpy as np
 from support.arrays import same
 
 from bistair.codecs.bidirectional.stairs_jit import decoded_sample
-from bistair.core.checks_jit import code_steps, wrap_step_counts
+from bistair.core.checks_jit import wrap_step_counts
 from bistair.core.phase import (
     TWO_PI,
 )
@@ -16,17 +16,19 @@ from bistair.core.phase import (
 RNG = np.random.default_rng(7)
 
 
-def test_code_steps_and_sample_are_numpys():
-    phi = RNG.uniform(0, TWO_PI, (30, 41)).astype(np.float32)
-    code = np.repeat(RNG.integers(-1, 5, (30, 21)), 2, axis=1)[:, :41].astype(np.int32)
-    valid = RNG.random(phi.shape) < 0.9
-    e = np.where(valid, code, -1)
+def code_steps(phi, edges, valid):
+    """The steps of a code along the rows between runs of at least two equal codes, in raster
+    order: the phase before and after each step and the code's change (NumPy)."""
+    e = np.where(valid, edges, -1)
     a0, a, b, b1 = e[:, :-3], e[:, 1:-2], e[:, 2:-1], e[:, 3:]
     ok = (a >= 0) & (b >= 0) & (a != b) & (a0 == a) & (b1 == b)
-    pa, pb, step = code_steps(phi, code, valid)
-    assert same(pa, phi[:, 1:-2][ok].astype(np.float64))
-    assert same(pb, phi[:, 2:-1][ok].astype(np.float64))
-    assert same(step, (b - a)[ok].astype(np.int64))
+    return (phi[:, 1:-2][ok].astype(np.float64), phi[:, 2:-1][ok].astype(np.float64),
+            (b - a)[ok].astype(np.int64))
+
+
+def test_decoded_sample_is_numpys():
+    code = np.repeat(RNG.integers(-1, 5, (30, 21)), 2, axis=1)[:, :41].astype(np.int32)
+    valid = RNG.random(code.shape) < 0.9
     for samples in (1, 7, 100, 10**6):
         idx = np.flatnonzero(valid & (code >= 0))
         assert same(decoded_sample(valid, code, samples),
@@ -72,7 +74,7 @@ def test_wrap_steps_are_numpys():
 
 
 def _edge_alignment_before(phi, edges, valid, edge_phase=0.0, levels=None):
-    """checks.edge_alignment as it was: NumPy on the arrays of code_steps."""
+    """checks.edge_alignment as it was: NumPy on the steps' arrays (code_steps)."""
     from bistair.core.checks import EdgeCheck
     from bistair.core.phase import wrap
 

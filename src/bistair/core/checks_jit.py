@@ -22,76 +22,6 @@ prange = range  # numba's prange once the first kernel of this module compiles
 
 
 @kernel(parallel=True)
-def _code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    h, w = edges.shape
-    counts = np.zeros(h + 1, np.int64)
-    for y in prange(h):
-        m = 0
-        for j in range(w - 3):
-            a = edges[y, j + 1] if valid[y, j + 1] else -1
-            b = edges[y, j + 2] if valid[y, j + 2] else -1
-            if a < 0 or b < 0 or a == b:
-                continue
-            a0 = edges[y, j] if valid[y, j] else -1
-            b1 = edges[y, j + 3] if valid[y, j + 3] else -1
-            if a0 == a and b1 == b:
-                m += 1
-        counts[y + 1] = m
-    start = np.cumsum(counts)
-    total = start[h]
-    pa = np.empty(total, np.float64)
-    pb = np.empty(total, np.float64)
-    step = np.empty(total, np.int64)
-    for y in prange(h):
-        i = start[y]
-        for j in range(w - 3):
-            a = edges[y, j + 1] if valid[y, j + 1] else -1
-            b = edges[y, j + 2] if valid[y, j + 2] else -1
-            if a < 0 or b < 0 or a == b:
-                continue
-            a0 = edges[y, j] if valid[y, j] else -1
-            b1 = edges[y, j + 3] if valid[y, j + 3] else -1
-            if a0 == a and b1 == b:
-                pa[i] = np.float64(phi[y, j + 1])
-                pb[i] = np.float64(phi[y, j + 2])
-                step[i] = np.int64(b - a)
-                i += 1
-    return pa, pb, step
-
-
-def code_steps(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The steps of a code along the rows between runs of at least two equal codes (the
-    pairs :func:`~bistair.core.checks.edge_alignment` judges), in raster order.
-
-    Parameters
-    ----------
-    phi : (H, W) float array
-        Wrapped phase in ``[0, 2*pi)``.
-    edges : (H, W) int array
-        The code per pixel, -1 where not read.
-    valid : (H, W) bool array
-        Pixels whose phase counts (the others read as -1).
-
-    Returns
-    -------
-    pa, pb : float64 arrays
-        The phase of the last pixel before each step and of the first after it.
-    step : int64 array
-        The code after the step less the code before it.
-
-    Examples
-    --------
-    >>> phi = np.float32([[0.1, 0.2, 0.3, 0.4, 0.5, 0.6]])
-    >>> code = np.int32([[1, 1, 2, 2, 2, 5]])
-    >>> [a.round(3).tolist() for a in code_steps(phi, code, np.ones((1, 6), bool))]
-    [[0.2], [0.3], [1]]
-    """
-    return _code_steps(phi, edges, np.asarray(valid, bool))
-
-
-@kernel(parallel=True)
 def _step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase: float,
                levels: int, every: int) -> tuple[int, float, float, int]:
     h, w = edges.shape
@@ -154,14 +84,15 @@ def _step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase
 def step_sums(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray, edge_phase: float = 0.0,
               levels: int | None = None, every: int = 1) -> tuple[int, float, float, int]:
     """What :func:`~bistair.core.checks.edge_alignment` needs of the code steps of
-    :func:`code_steps` (on every ``every``-th row), summed in one pass with no list of the
+    the code's steps (on every ``every``-th row), summed in one pass with no list of the
     steps: their count, the sums of the cosine and sine of the phase between the two pixels
     of each less ``edge_phase``, and how many steps the phase falls across where the code
     grows (a step of a code of ``levels`` values grows when it is less than half a cycle,
     modulo ``levels``). The phase between ``pa`` and ``pb`` is ``pa + wrap(pb - pa) / 2``,
     ``angle(exp(i pa) + exp(i pb))`` but for a whole turn, with one sine and cosine a step
     instead of seven trigonometric calls; the sums are added row by row. Against NumPy on
-    :func:`code_steps`' arrays: the counts the same, the sums within 1e-12 per step.
+    the steps' arrays (tests/test_checks_jit.py): the counts the same, the sums within
+    1e-12 per step.
 
     Parameters
     ----------
