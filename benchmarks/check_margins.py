@@ -68,8 +68,8 @@ def main() -> None:
                  "| " + " | ".join("---" for _ in head[:-1]) + " |"]
         lines += ["| " + " | ".join(str(v) for v in row[:-1]) + " |" for row in rows]
         lines += ["", f"{len(rows)} decodes; refused by a check: {refused} (kamino's rows "
-                  "axis as a plain 3-step + Gray code by regions: 47% of its pixels one order "
-                  "off the rig's own decode, a right refusal)."]
+                  "axis as a plain 3-step + Gray code by regions, judged before the decoder "
+                  "drops the regions its neighbours deny: see the checks guide)."]
         args.markdown.write_text("\n".join(lines) + "\n")
         print(f"wrote {args.markdown}")
 
