@@ -67,9 +67,7 @@ def main() -> None:
                  "", "| " + " | ".join(head[:-1]) + " |",
                  "| " + " | ".join("---" for _ in head[:-1]) + " |"]
         lines += ["| " + " | ".join(str(v) for v in row[:-1]) + " |" for row in rows]
-        lines += ["", f"{len(rows)} decodes; refused by a check: {refused} (kamino's rows "
-                  "axis as a plain 3-step + Gray code by regions, judged before the decoder "
-                  "drops the regions its neighbours deny: see the checks guide)."]
+        lines += ["", f"{len(rows)} decodes; refused by a check: {refused}."]
         args.markdown.write_text("\n".join(lines) + "\n")
         print(f"wrote {args.markdown}")
 

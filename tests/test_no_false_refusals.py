@@ -16,14 +16,10 @@ from bistair.io.atomic import write_image
 from bistair.io.read import read_with_spec
 
 PARTS = list(parts())
-# the one part a check refuses: kamino's rows axis as a plain 3-step + Gray code decoded by
-# fringe regions. Its regions merge fringes across gamma-distorted wraps; the decoder drops the
-# three whose neighbours deny their orders and ends 0.13% of its pixels one order off the rig's
-# full decode, but the orders judged before that drop do not step by one across 10.3% of the
-# phase jumps (limit 10%): a borderline refusal of an answer that ends right (it was 47% wrong
-# before parts were detached only on carried codes). Its pixel decode is accepted (its orders
-# as read step wrong across 7% of the jumps, a warning; those pixels are left out).
-WRONG = {"kamino/T100+gray region (rows)"}
+# no part is refused (kamino's rows axis as a plain 3-step + Gray code by regions was, rightly,
+# while parts of regions were decoded on codes their pixels' evidence did not carry: 47% of its
+# pixels one order off; tests/test_graycode_region_real.py holds both axes to the rig's decode)
+WRONG: set[str] = set()
 
 
 @pytest.mark.skipif(not PARTS, reason="no real captures under ../shared/data")

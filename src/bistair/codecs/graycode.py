@@ -99,6 +99,10 @@ EDGE_REACH = 0.5
 # its order: over SETTLED of at least MIN_STRONG of them read it (:func:`region_carry`)
 SETTLED = 0.99
 MIN_STRONG = 50
+# A part detached from its fringe region for codes that deny the region's order is decoded
+# on its own where at least PART_CARRIED of its read pixels carry their code
+# (:func:`part_carried`)
+PART_CARRIED = 0.1
 
 
 def gray_to_binary(gray: np.ndarray) -> np.ndarray:
@@ -457,23 +461,45 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
-    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
-        return labels, n, code_evidence(labels, n, read, spec.fringes, weight)
-
-    # a part of a region whose pixels' codes deny the region's order is detached and decoded
-    # alone (split_parts): a code its pixel's own evidence does not carry abstains there
-    # (kamino's columns read as a plain 3-step + Gray code: a 69470-pixel part read one
-    # order up, 0.1% of it carried, was detached and decoded wrong: 4.6% of the valid
-    # pixels one order off, not refused; now 0.08%)
     carried = code.maps.get("carried")
+    first = int(labels.max())
+
+    def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
+        evidence = code_evidence(labels, n, read, spec.fringes, weight)
+        if n > first and carried is not None:
+            evidence[first + 1:][~part_carried(labels, first, n, read, carried)] = 0.0
+        return labels, n, evidence
 
     def agrees(order: np.ndarray) -> np.ndarray:
-        ok = (read == order) | (read < 0)
-        return ok if carried is None else ok | ~carried
+        return (read == order) | (read < 0)
 
     order = orders_from_regions(fs.phi, fs.valid & (read >= 0), labels, evidence_of, agrees,
                                 info)
     return Orders(order, info)
+
+
+def part_carried(labels: np.ndarray, first: int, n: int, read: np.ndarray,
+                 carried: np.ndarray, share: float = PART_CARRIED) -> np.ndarray:
+    """Which parts detached from their regions (labels ``first + 1 .. n``) have codes their
+    own pixels' evidence carries: at least ``share`` of the part's read pixels carried.
+
+    A part is detached where its codes deny its region's order (two surfaces in one
+    region); where that denial rests on codes no pixel's evidence carries, the part is a
+    misread, not a surface, and is left undecided rather than decoded on it.
+
+    Examples
+    --------
+    >>> labels = np.array([[1, 1, 2, 2, 3, 3]])
+    >>> read = np.array([[0, 0, 1, 1, 1, 1]])
+    >>> carried = np.array([[1, 1, 1, 0, 0, 0]], bool)
+    >>> part_carried(labels, 1, 3, read, carried).tolist()
+    [True, False]
+    """
+    parts = labels > first
+    index = labels[parts] - (first + 1)
+    reads = np.bincount(index, weights=read[parts] >= 0, minlength=n - first)
+    strong = np.bincount(index, weights=carried[parts] & (read[parts] >= 0), minlength=n - first)
+    return strong >= share * np.maximum(reads, 1)
 
 
 def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: int,
