@@ -141,14 +141,16 @@ def window_phases(frames: np.ndarray, steps: int, shift_sign: int = 1,
     return phi, mod
 
 
-def pair_mean(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def pair_mean(a: np.ndarray, b: np.ndarray, reduce: bool = True) -> np.ndarray:
     """The mean of two wrapped phases across the wrap: ``a + wrap(b - a) / 2`` in
     ``[0, 2*pi)`` (float32; NaN where either is).
 
     Parameters
     ----------
     a, b : ndarray
-        Wrapped phases in radians, of one shape.
+        Wrapped phases in radians, of one shape (any multiple of ``2*pi`` off).
+    reduce : bool
+        Bring the mean into ``[0, 2*pi)`` (else it lies within ``pi/2`` of ``a``).
 
     Returns
     -------
@@ -162,7 +164,7 @@ def pair_mean(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """
     a = np.asarray(a, np.float32)
     mean = a + np.asarray(wrap(np.asarray(b, np.float32) - a), np.float32) / np.float32(2)
-    return np.mod(mean, np.float32(TWO_PI)).astype(np.float32)
+    return np.mod(mean, np.float32(TWO_PI)).astype(np.float32) if reduce else mean
 
 
 def compensate(phases: np.ndarray, order: int) -> np.ndarray:
@@ -198,8 +200,8 @@ def compensate(phases: np.ndarray, order: int) -> np.ndarray:
     level = np.asarray(phases, np.float32)
     if level.shape[0] <= order:
         raise ValueError(f"order {order} needs {order + 1} windows, got {level.shape[0]}")
-    for _ in range(order):
-        level = pair_mean(level[:-1], level[1:])
+    for k in range(order):
+        level = pair_mean(level[:-1], level[1:], reduce=k == order - 1)
     return level
 
 
@@ -236,7 +238,8 @@ class PhaseStream:
     Keeps the last ``N`` frames, the running sums of the newest window (float64; a new
     frame adds its difference to the frame ``N`` before it, which has the same shift:
     two multiply-adds a pixel instead of a whole set's ``N``) and, for order ``K``, the
-    newest value of each round of pairwise means (``K`` means a frame).
+    newest value of each round of pairwise means of the phases and of the modulations
+    (``K`` of each a frame).
 
     Examples
     --------
@@ -266,7 +269,7 @@ class PhaseStream:
         self._num: np.ndarray | None = None
         self._den: np.ndarray | None = None
         self._levels: list[np.ndarray | None] = [None] * (order + 1)  # newest of each round
-        self._mods: list[np.ndarray] = []
+        self._mods: list[np.ndarray | None] = [None] * (order + 1)
 
     @property
     def lag(self) -> float:
@@ -298,23 +301,19 @@ class PhaseStream:
 
     def _compensated(self, phi: np.ndarray, mod: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray] | None:
-        """Feed the newest window into the rounds of pairwise means."""
-        self._mods = (self._mods + [mod])[-(self.order + 1):]
-        new = phi
-        ready = True
+        """Feed the newest window into the rounds of pairwise means (of the phases across
+        the wrap, brought into ``[0, 2*pi)`` at the last round; of the modulations)."""
+        new, new_mod = phi, mod
         for level in range(self.order + 1):
-            previous = self._levels[level]
-            self._levels[level] = new
+            previous, previous_mod = self._levels[level], self._mods[level]
+            self._levels[level], self._mods[level] = new, new_mod
             if level == self.order:
-                break
+                return new, new_mod
             if previous is None:
-                ready = False
-                break
-            new = pair_mean(previous, new)
-        if not ready or len(self._mods) < self.order + 1:
-            return None
-        return self._levels[self.order], compensate_modulation(np.stack(self._mods),
-                                                               self.order)[0]
+                return None
+            new = pair_mean(previous, new, reduce=level == self.order - 1)
+            new_mod = (previous_mod + new_mod) * np.float32(0.5)
+        return None  # pragma: no cover - the loop returns
 
 
 def _check_order(order: int) -> None:
