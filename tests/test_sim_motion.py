@@ -60,6 +60,16 @@ def test_a_still_motion_renders_what_a_still_render_gives():
     assert np.array_equal(truths[2].coord_x, truth.coord_x, equal_nan=True)
 
 
+def test_a_moving_render_is_deterministic_for_a_seed():
+    rig, scene = preset("sphere-on-plane", camera_size=(40, 32))
+    pats = np.random.default_rng(1).uniform(0, 1, (3, 1080, 1920))
+    m = parse_motion("0.5,0,1mm,0,2,0deg")
+    a, _ = render_moving(pats, rig, scene, m, Imaging(seed=3))
+    b, _ = render_moving(pats, rig, scene, m, Imaging(seed=3))
+    c, _ = render_moving(pats, rig, scene, m, Imaging(seed=4))
+    assert np.array_equal(a, b) and not np.array_equal(a, c)
+
+
 def test_a_velocity_in_pixels_moves_the_object_that_many_pixels():
     """1 px/frame along the coded axis: a point of the sphere at the median depth of its
     pixels moves 1 camera px per frame (its silhouette, farther, a little less)."""
