@@ -7,7 +7,8 @@ own pose. Plain four-step (the first window) and binomial self-compensation of o
 (windows 0..K, Zhang et al., ECCV 2024) are scored against the truth traced at the time
 each describes ((N+K-1)/2 frames): the RMS of the phase error and the amplitude of its
 ripple at twice the fringe frequency (a lock-in over about a fringe,
-:func:`bistair.evaluation.motion.ripple`), in radians, over the sphere's pixels that the
+:func:`bistair.evaluation.motion.ripple`), in radians (and the ripple in depth along the
+camera rays, mm, for plain and order 4), over the sphere's pixels that the
 truth keeps at every frame used. Median of the seeds; default optics (1% read noise, 1 px
 camera blur, gamma 2.2 compensated) and, with --clean, no noise (the ripple alone).
 
@@ -35,7 +36,8 @@ CLEAN = dict(DEFAULT, read_noise=0.0, full_well=0.0)
 
 def table(camera: tuple[int, int], period: float, seeds: int, clean: bool,
           speeds=SPEEDS, orders=ORDERS) -> dict[float, dict[str, dict[int, float]]]:
-    """speed -> {"rms": {order: rad}, "ripple": {order: rad}}, median of the seeds."""
+    """speed -> {"rms": {order: rad}, "ripple": {order: rad}, "ripple_mm": {order: mm}},
+    median of the seeds."""
     rig, scene = preset("sphere-on-plane", camera_size=camera)
     optics = CLEAN if clean else DEFAULT
     out = {}
@@ -44,7 +46,7 @@ def table(camera: tuple[int, int], period: float, seeds: int, clean: bool,
                               orders=orders, imaging=Imaging(**optics, seed=seed))
                 for seed in range(seeds)]
         out[speed] = {key: {k: statistics.median(getattr(r, key)[k] for r in runs)
-                            for k in orders} for key in ("rms", "ripple")}
+                            for k in orders} for key in ("rms", "ripple", "ripple_mm")}
         out[speed]["pixels"] = runs[0].pixels[max(orders)]
         out[speed]["period_px"] = runs[0].period_px
     return out
@@ -70,12 +72,13 @@ def main(argv: list[str] | None = None) -> int:
           f"{'no noise' if args.clean else 'default optics'}, median of {args.seeds} seeds; "
           f"radians; {first['pixels']} sphere pixels at rest")
     head = " | ".join(f"{'plain' if k == 0 else f'K={k}'}" for k in ORDERS)
-    print(f"| px/frame | RMS: {head} | ripple: {head} |")
-    print("|---:|" + "---:|" * (2 * len(ORDERS)))
+    print(f"| px/frame | RMS: {head} | ripple: {head} | ripple mm: plain | K=4 |")
+    print("|---:|" + "---:|" * (2 * len(ORDERS) + 2))
     for speed, row in rows.items():
         rms = " | ".join(f"{row['rms'][k]:.4f}" for k in ORDERS)
         rip = " | ".join(f"{row['ripple'][k]:.4f}" for k in ORDERS)
-        print(f"| {speed:g} | {rms} | {rip} |")
+        mm = " | ".join(f"{row['ripple_mm'][k]:.4f}" for k in (0, max(ORDERS)))
+        print(f"| {speed:g} | {rms} | {rip} | {mm} |")
     one = rows[1.0]["ripple"]
     print(f"at 1 px/frame the order-4 ripple is {one[4] / one[0]:.3f} of plain four-step's "
           f"(done when at most 0.1); {time.perf_counter() - start:.0f} s")

@@ -5,7 +5,8 @@ whose objects move (:mod:`bistair.sim.motion`), takes the phase of the first win
 (plain N-step) and the binomial self-compensation of orders 1..K
 (:mod:`bistair.core.motion`), and scores each against the truth traced at the time it
 describes (``(N+K-1)/2``): the RMS of the phase error and the amplitude of its ripple at
-twice the fringe frequency (:func:`ripple`), over the pixels of the moving objects that
+twice the fringe frequency (:func:`ripple`), in radians and in depth along the camera rays
+(:func:`depth_per_pixel`), over the pixels of the moving objects that
 the truth keeps at every frame used.
 
 Examples
@@ -63,13 +64,39 @@ def ripple(error: np.ndarray, phase: np.ndarray, mask: np.ndarray, sigma: float)
     return float(np.mean(2.0 * np.hypot(c[keep], s[keep]) / weight[keep]))
 
 
+def depth_per_pixel(rig: Rig, points: np.ndarray, orientation: str = "columns",
+                    step: float = 0.5) -> np.ndarray:
+    """How far (mm, along z) a point moves along its camera ray per projector pixel of the
+    coded axis: the depth a phase error of ``2*pi/T`` rad costs (NaN where unknown).
+
+    ``points`` are ``(H, W, 3)`` world points of the camera frame (the truth's); the ray
+    through the camera centre (the origin) is followed ``step`` mm deeper.
+
+    Examples
+    --------
+    >>> rig = Rig.default(camera_size=(64, 48))
+    >>> mm = depth_per_pixel(rig, np.array([[[0.0, 0.0, 600.0]]]))
+    >>> # 2000 px focal length, 632 mm away, the rays 18.4 degrees apart: 2000 sin / 632
+    >>> round(float(mm[0, 0]), 2)
+    1.0
+    """
+    p = np.asarray(points, float)
+    deeper = p * ((p[..., 2:] + step) / p[..., 2:])
+    axis = 0 if orientation == "columns" else 1
+    with np.errstate(invalid="ignore", divide="ignore"):
+        moved = rig.projector.project(deeper)[..., axis] - rig.projector.project(p)[..., axis]
+        return np.abs(step / moved)
+
+
 @dataclass
 class StreamErrors:
     """Per compensation order (0: plain N-step): phase error RMS and 2x ripple (radians),
-    the pixels scored, and the fringe period in camera pixels."""
+    the ripple in depth (mm, along the camera rays), the pixels scored, and the fringe
+    period in camera pixels."""
 
     rms: dict[int, float]
     ripple: dict[int, float]
+    ripple_mm: dict[int, float]
     pixels: dict[int, int]
     period_px: float
 
@@ -108,7 +135,7 @@ def stream_errors(rig: Rig, scene: Scene, motion: Motion, period: float, steps: 
     times = sorted({(steps + k - 1) / 2 for k in orders})
     at = dict(zip(times, trace_frames(rig, scene, motion, times, imaging), strict=True))
     ids = [scene.ids[i] for i in moving(scene, motion.whole)]
-    rms, rip, count = {}, {}, {}
+    rms, rip, rip_mm, count = {}, {}, {}, {}
     period_px = float("nan")
     for k in orders:
         truth = at[(steps + k - 1) / 2].truth
@@ -126,5 +153,8 @@ def stream_errors(rig: Rig, scene: Scene, motion: Motion, period: float, steps: 
             period_px = float(period / np.nanmedian(grad[mask])) if mask.any() else 8.0
         rms[k] = float(np.sqrt(np.mean(error[mask] ** 2))) if mask.any() else float("nan")
         rip[k] = ripple(error, true_phase, mask, period_px)
+        mm = error * (period / TWO_PI) * depth_per_pixel(rig, truth.points, orientation)
+        rip_mm[k] = ripple(np.where(mask, mm, 0.0), true_phase, mask & np.isfinite(mm),
+                           period_px)
         count[k] = int(mask.sum())
-    return StreamErrors(rms, rip, count, period_px)
+    return StreamErrors(rms, rip, rip_mm, count, period_px)
