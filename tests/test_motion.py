@@ -84,6 +84,12 @@ def test_stream_equals_the_batch_form(steps, order):
         assert np.abs(wrap(p - wp)).max() < 1e-5
         assert np.allclose(m, wm, atol=1e-5)
     assert s.lag == (steps + order - 1) / 2
+    buffer = np.empty_like(frames[0])  # a camera grabbing every frame into one buffer
+    reused = PhaseStream(steps, order)
+    for f in frames:
+        buffer[...] = f
+        last = reused.push(buffer)
+    assert np.abs(wrap(last[0] - want_phi[-1])).max() < 1e-5
 
 
 def test_refusals():

@@ -277,19 +277,21 @@ class PhaseStream:
         return (self.steps + self.order - 1) / 2
 
     def push(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-        """Add the next frame; the wrapped phase and modulation (float32) of the newest
-        window, compensated to order ``K``, once ``N + K`` frames are in, else None."""
+        """Add the next frame (copied: the caller may reuse its buffer); the wrapped phase
+        and modulation (float32) of the newest window, compensated to order ``K``, once
+        ``N + K`` frames are in, else None."""
         frame = np.asarray(frame)
         n, k = self.steps, self.count % self.steps
         if self._num is None:
             self._num = np.zeros(frame.shape, np.float64)
             self._den = np.zeros(frame.shape, np.float64)
+        kept = frame.copy()  # a camera may grab every frame into one buffer
         if len(self._frames) < n:
             diff = frame.astype(np.float64)
-            self._frames.append(frame)
+            self._frames.append(kept)
         else:
             diff = frame.astype(np.float64) - self._frames[k]
-            self._frames[k] = frame
+            self._frames[k] = kept
         self._num -= self._sin[k] * diff
         self._den += self._cos[k] * diff
         self.count += 1
