@@ -172,3 +172,28 @@ def test_bad_motion_options_exit_2_in_one_line_and_write_nothing(tmp_path, monke
                            "graycode", "--camera", "32x24", *args, "--out", out)
     assert code == 2 and message in err and len(err.strip().splitlines()) == 1, err
     assert not out.exists()
+
+
+def test_both_cameras_see_the_same_motion(tmp_path):
+    """--cameras 2: at every frame the right camera's truth lies on the sphere where the
+    left camera's motion put it (the velocity in pixels converted once, at the left
+    camera's depth)."""
+    from bistair.app.simulate_motion import simulate_motion
+
+    out = simulate_motion("sphere-on-plane", ["graycode"], tmp_path / "pair", "3px",
+                          cameras=2, camera_size=(96, 80))
+    about = json.loads((out / "scene.json").read_text())
+    step = np.array(about["motion"]["translation_mm"])
+    assert step[0] > 0 and about["motion"]["pixels"] == [3.0, 0.0]
+    for side, cam in (("L", about["rig"]["left"]), ("R", about["rig"]["right"])):
+        k_inv = np.linalg.inv(np.array(cam["K"]))
+        rot, t = np.array(cam["R"]), np.array(cam["t"])
+        for frame in (0, 5, 10):
+            folder = out / "truth" / side / f"frame-{frame:04d}"
+            depth = np.load(folder / "depth.npy")
+            v, u = np.nonzero(np.load(folder / "object_id.npy") == 1)
+            rays = np.stack([u, v, np.ones_like(u)], axis=1) @ k_inv.T
+            world = (rays * depth[v, u, None] - t) @ rot  # X = R^T (X_cam - t)
+            centre = np.array([0.0, 0.0, 520.0]) + frame * step
+            assert len(u) > 200
+            assert np.abs(np.linalg.norm(world - centre, axis=1) - 50.0).max() < 1e-6
