@@ -99,7 +99,7 @@ def test_a_velocity_in_pixels_moves_the_object_that_many_pixels():
 
 @pytest.mark.parametrize("text", ["", "1", "px", "1 px", "1,2,3px", "1mm", "1,2mm",
                                   "1,2,3mm,1deg", "1,2,3px,0,0,1deg", "nan,0,0mm", "1deg,2mm",
-                                  "1,,2,3mm", "inf px"])
+                                  "1,,2,3mm", "inf px", "1e999,0,0mm", "1e-3e2px"])
 def test_a_malformed_motion_is_refused_in_one_line(text):
     with pytest.raises(BistairError) as err:
         parse_motion(text)
