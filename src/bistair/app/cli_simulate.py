@@ -65,23 +65,47 @@ from .cli_options import (
               help="2: a second camera (OUT/<method>/L and R, stereo.json, truth/L and R)")
 @click.option("--baseline", type=float, default=200.0, show_default=True,
               help="with --cameras 2: mm between the cameras (the projector between them)")
+# -- things that move (issue 34): one block --------------------------------------------------
+@click.option("--motion", default=None, metavar="MOTION",
+              help="a rigid motion per frame, each frame rendered at its own pose (truth of "
+              "each frame in OUT/truth/frame-NNNN/, frame 0 the reference pose): 1px (camera "
+              "pixels along the coded axis, in mm at the moving surfaces' depth), 1,0.5px "
+              "(x,y pixels), 0.4,0,0mm (x,y,z mm), 0.4,0,0mm,0,0.2,0deg (and a rotation "
+              "vector in degrees about the body's centre) or 0,0.2,0deg")
+@click.option("--motion-of", "motion_of", type=click.Choice(["objects", "scene"]),
+              default="objects", show_default=True,
+              help="what --motion moves: the objects (every surface but the planes, each "
+              "about its centre) or the whole scene (about its centre)")
+@click.option("--frames", type=int, default=None,
+              help="with --continuous: the stream's length in frames")
+@click.option("--continuous", is_flag=True,
+              help="a stream of --frames N whose shift advances one step per frame (frame i "
+              "shows shift i mod 4 of one 4-step set of period 30; --method multifreq; "
+              "OUT/multifreq/0000.png ..., spec.json of that single period)")
 @_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
              vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
-             both_axes: bool, cameras: int, baseline: float, quiet: bool) -> None:
+             both_axes: bool, cameras: int, baseline: float, motion: str | None,
+             motion_of: str, frames: int | None, continuous: bool, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
     of workers), each varied as --vary says. With --cameras 2, two cameras and the
-    projector between them, for 'bistair stereo'."""
+    projector between them, for 'bistair stereo'. With --motion, things move between
+    frames; with --frames N --continuous, a stream whose shift advances every frame."""
     from ..codecs import REGISTRY
 
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
     imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
                    bits=int(bits))
+    if motion is not None or continuous or frames is not None:
+        _simulate_motion(scene, chosen, out, camera, compensated, seed, count, vary,
+                         no_white or both_axes, cameras, baseline, motion, motion_of, frames,
+                         continuous, quiet, imaging)
+        return
     if cameras == 2:
         if no_white or both_axes:
             raise CliError("--no-white and --both-axes are for one camera's --scene "
@@ -137,6 +161,37 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
     if report.failed:
         raise CliError(f"{len(report.failed)} of {count} scenes failed (listed above)")
 
+
+def _simulate_motion(scene: str | None, methods: list[str], out: Path,
+                     camera: tuple[int, int] | None, compensated: bool, seed: int,
+                     count: int | None, vary: str | None, boards: bool, cameras: int,
+                     baseline: float, motion: str | None, motion_of: str, frames: int | None,
+                     continuous: bool, quiet: bool, imaging: dict[str, Any]) -> None:
+    """``bistair simulate --motion`` / ``--frames N --continuous``."""
+    from .progress import Progress
+    from .simulate_motion import simulate_motion
+
+    if count is not None or vary is not None:
+        raise CliError("--motion and --continuous render one scene: leave out --count and "
+                       "--vary")
+    if scene is None or scene == "calibration":
+        raise CliError("--motion and --continuous render a preset scene: name one with "
+                       "--scene (not calibration)")
+    if boards:
+        raise CliError("--no-white and --both-axes are for --scene calibration")
+    with Progress(quiet) as say:
+        simulate_motion(scene, methods, out, motion, moves=motion_of, frames=frames,
+                        continuous=continuous, cameras=cameras, baseline=baseline,
+                        camera_size=camera, compensated=compensated, progress=say,
+                        seed=seed, **imaging)
+    if quiet:
+        return
+    what = (f"a stream of {frames} frames" if continuous
+            else f"{', '.join(methods)} captures")
+    moved = f"{motion_of} moving {motion} per frame" if motion else "nothing moving"
+    cams = " from two cameras" if cameras == 2 else ""
+    click.echo(f"wrote {what} of {scene} ({moved}){cams} and the truth of every frame to "
+               f"{out}")
 
 
 def _simulate_stereo(scene: str | None, methods: list[str], out: Path,

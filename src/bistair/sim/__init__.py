@@ -6,7 +6,8 @@ with camera occlusion and projector shadows (:mod:`~bistair.sim.shapes`); image 
 with projector gamma and defocus, Lambertian shading, ambient light, camera defocus, shot and
 read noise, saturation and quantisation (:mod:`~bistair.sim.render`); named scenes of the
 paper's experiments (:mod:`~bistair.sim.presets`); board captures and views for calibration
-(:mod:`~bistair.sim.boards`); and a fast 2-D warp of the patterns without geometry for
+(:mod:`~bistair.sim.boards`); things that move, a rigid motion per frame and a trace per
+pose (:mod:`~bistair.sim.motion`); and a fast 2-D warp of the patterns without geometry for
 tests (:mod:`~bistair.sim.warp`). Units are millimetres.
 
 Examples
