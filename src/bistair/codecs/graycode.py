@@ -139,16 +139,19 @@ class GrayCodeSpec(PeriodSpec):
     gray_offset: float = field(0.0, "where the code's edges sit, as a fraction of a period "
                                "after the phase jumps: 0, or 0.5 for the shifted Gray code",
                                choices=(0.0, 0.5))
+    gray_wrap: int = field(0, "1: the shifted code wraps cyclically over the fringes (the first "
+                           "half period and the last share code 0; SLMaster's "
+                           "SinusShiftGrayCodePattern), with gray_offset 0.5", choices=(0, 1))
     second_period: float = field(0.0, "period of a second N-step set that checks the code's "
                                  "orders next to its edges (0: none)")
 
     @property
     def levels(self) -> int:
-        """Code levels: the fringes, one more for the shifted code, twice for the
-        complementary one."""
+        """Code levels: the fringes, one more for the shifted code (unless it wraps
+        cyclically), twice for the complementary one."""
         if self.complementary:
             return 2 * self.fringes
-        return self.fringes + (1 if self.gray_offset else 0)
+        return self.fringes + (1 if self.gray_offset and not self.gray_wrap else 0)
 
     @property
     def code_bits(self) -> int:
@@ -175,13 +178,16 @@ class GrayCodeSpec(PeriodSpec):
         super().validate()
         if self.steps == 0:
             self._validate_alone()
-        for name in ("complementary", "inverse"):
+        for name in ("complementary", "inverse", "gray_wrap"):
             if getattr(self, name) not in (0, 1):
                 raise BistairError(f"{name} must be 0 or 1, got {getattr(self, name)}")
         if self.gray_offset not in (0.0, 0.5):
             raise BistairError(f"gray_offset must be 0 or 0.5, got {self.gray_offset}")
         if self.gray_offset and self.complementary:
             raise BistairError("a shifted Gray code (gray_offset 0.5) cannot be complementary")
+        if self.gray_wrap and self.gray_offset != 0.5:
+            raise BistairError("gray_wrap 1 wraps the shifted Gray code: it needs gray_offset "
+                               f"0.5, got {self.gray_offset}")
         if self.second_period:
             if not (math.isfinite(self.second_period) and self.second_period >= 4):
                 raise BistairError(f"second_period must be 0 (none) or at least 4 projector "
@@ -255,6 +261,8 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     else:
         level = np.floor(np.arange(spec.coded_length) / spec.period + spec.gray_offset
                          + 1e-9).astype(np.int64)
+        if spec.gray_wrap:  # the last half fringe shares the first one's code
+            level %= spec.fringes
     gray = level ^ (level >> 1)
     bits = (gray[None, :] >> np.arange(n_bits - 1, -1, -1)[:, None]) & 1
     codes = spec.offset + spec.amplitude * (2.0 * bits - 1.0)
@@ -322,7 +330,7 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
         del code, ref
     maps: dict[str, np.ndarray] = {}
-    mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
+    mode = 1 if spec.complementary else (3 if spec.gray_wrap else 2) if spec.gray_offset else 0
     # the noise of a bit's margin (frame minus inverse, or minus the average of n frames),
     # and of the phase times the modulation
     evidence = (fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n),
@@ -331,7 +339,7 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         code, maps["edges"], maps["carried"], beyond = read_orders(
             prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse), fs.phi,
             fs.mod, valid, mode, spec.fringes, *evidence)
-        return CodeMap(code, maps, edge_phase=np.pi if mode == 2 else 0.0, beyond=beyond)
+        return CodeMap(code, maps, edge_phase=np.pi if mode >= 2 else 0.0, beyond=beyond)
     # each bit: the code frame brighter than the average (or its inverse), in one pass
     gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     if spec.complementary:
@@ -342,6 +350,8 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     elif spec.gray_offset:
         g = gray_to_binary(gray)
         k = np.where(fs.phi < np.pi, g, g - 1)
+        if spec.gray_wrap:  # code 0 past the phase's middle: the last fringe
+            k = np.where(g >= spec.fringes, spec.fringes, np.where(k < 0, spec.fringes - 1, k))
         edges, edge_phase = g, np.pi
     else:
         k = edges = gray_to_binary(gray)
