@@ -83,6 +83,7 @@ from .base import (
     shift_patterns,
 )
 from .graycode_alone import code_alone, measure_alone
+from .graycode_edges import edge_orders
 from .graycode_jit import code_bits, orders_fit, read_orders
 
 # The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
@@ -453,7 +454,13 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
         carried = code.maps.get("carried")
         k = read if carried is None else np.where(carried, read, -1)
         if carried is not None and spec.steps:
-            k, info["region_carried"] = region_carry(fs, read, k, spec.fringes)
+            regions = fringe_regions(fs.phi, fs.valid & (read >= 0),
+                                     phase_noise=fs.phase_noise)
+            k, info["region_carried"] = region_carry(fs, read, k, spec.fringes,
+                                                     regions=regions)
+            if spec.gray_offset:  # beside the shifted code's edges: the region's order
+                k, info["edge_orders"] = edge_orders(fs, read, k, spec.fringes,
+                                                     bool(spec.gray_wrap), regions)
         if carried is not None:
             info["left_out"] = int(np.count_nonzero(read >= 0)) - int(np.count_nonzero(k >= 0))
         if spec.steps == 0:  # no phase to check the cells against: their direction
@@ -479,7 +486,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
 
 
 def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: int,
-                 settled: float = SETTLED, min_strong: int = MIN_STRONG
+                 settled: float = SETTLED, min_strong: int = MIN_STRONG,
+                 regions: tuple[np.ndarray, int] | None = None
                  ) -> tuple[np.ndarray, int]:
     """Keep the orders read where the pixel's own evidence does not carry them but its
     fringe region's strong pixels settle the same order.
@@ -502,6 +510,8 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
         Share of a region's strong pixels that must read one order.
     min_strong : int, default MIN_STRONG
         Strong pixels a region needs.
+    regions : tuple of (numpy.ndarray, int), optional
+        The fringe regions of ``fs`` over the pixels read, if already cut.
 
     Returns
     -------
@@ -530,7 +540,8 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
     dim = np.flatnonzero(read_any & (carried < 0))
     if not dim.size:
         return carried, 0
-    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise)
+    labels, n = regions or fringe_regions(fs.phi, fs.valid & read_any,
+                                          phase_noise=fs.phase_noise)
     shares = code_evidence(labels, n, carried, fringes)
     strong = np.bincount(labels[carried >= 0], minlength=n + 1)
     order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),
