@@ -17,6 +17,7 @@ import bistair
 from bistair.app.cli import cli
 from bistair.errors import BistairError
 from bistair.evaluation.metrics import score
+from bistair.io.read import load_spec
 from bistair.sim import Imaging, preset, trace
 from bistair.sim.render import expose
 
@@ -123,3 +124,33 @@ def test_shifted_codes_decode_right_and_complete_per_pixel(optics, errors):
         assert found[name]["order_error_rate"] <= errors, (name, found[name])
         assert found[name]["coverage"] >= found["complementary"]["coverage"] - 0.02, \
             (name, found[name]["coverage"], found["complementary"]["coverage"])
+
+
+def test_simulate_renders_the_set_a_spec_describes(tmp_path):
+    """``simulate --method graycode --spec shifted.json``: the cyclic shifted set itself (its
+    9 frames on its 1920-px projector), decoded right against the written truth; another
+    method than the spec's is refused in one line, exit 2, nothing written."""
+    _, spec = written(tmp_path / "pats", "--width", "1920", "--height", "1080", "--steps", "4",
+                      "--period", "60", "--gray-offset", "0.5", "--gray-wrap", "1",
+                      "--phase-offset", "-pi")
+    path = tmp_path / "pats" / "spec.json"
+    out = tmp_path / "sim"
+    done = CliRunner().invoke(cli, ["simulate", "--scene", "paper-sim", "--method", "graycode",
+                                    "--spec", str(path), "--camera", "320x256", "--out",
+                                    str(out)])
+    assert done.exit_code == 0, done.output
+    rendered = load_spec(out / "graycode" / "spec.json")
+    assert rendered == bistair.spec_from_dict(spec) and rendered.frame_count == 9
+    images = np.stack([iio.imread(p) for p in sorted((out / "graycode").glob("*.png"))])
+    result = bistair.decode(images, rendered)
+    mask = np.load(out / "truth" / "mask.npy")
+    truth = np.load(out / "truth" / "coord.npy")
+    found = mask & result.mask
+    assert found.sum() > 0.98 * mask.sum()
+    assert np.abs(result.coord - truth)[found].max() < 30  # no pixel an order off
+    refused = CliRunner().invoke(cli, ["simulate", "--scene", "paper-sim", "--method",
+                                       "bidirectional", "--spec", str(path), "--out",
+                                       str(tmp_path / "other")])
+    assert refused.exit_code == 2 and not (tmp_path / "other").exists()
+    assert "--spec describes a graycode set: --method bidirectional does not match it" \
+        in refused.output
