@@ -6,6 +6,7 @@ the virtual rig against ground truth; ``simulate --spec``."""
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -154,3 +155,62 @@ def test_simulate_renders_the_set_a_spec_describes(tmp_path):
     assert refused.exit_code == 2 and not (tmp_path / "other").exists()
     assert "--spec describes a graycode set: --method bidirectional does not match it" \
         in refused.output
+
+
+def _rendered(spec, traced, imaging):
+    return expose(traced, bistair.encode(spec), imaging)
+
+
+def _off(result, truth, spec) -> tuple[float, float]:
+    """How far the decoded truth pixels are off, in periods: the median, and the share more
+    than half a period off."""
+    found = truth.mask & result.mask
+    err = np.abs(result.coord - truth.coord(spec))[found] / spec.period
+    return float(np.median(err)), float((err > 0.5).mean())
+
+
+def test_the_hint_names_both_readings_the_captures_fit():
+    """Issue 33 item 2: SLMaster's captures (cyclic shifted code, phase_offset -pi) described
+    as a plain code with phase_offset -pi are refused, and the hint names both readings
+    that fit them: a plain code with phase_offset 0, and the shifted one with -pi. Plain
+    captures (phase_offset 0) described the same way get the same hint. Each reading
+    decodes right the captures it is right for, and the other half a period off (accepted:
+    the captures cannot tell the two apart, hence the two-reading hint)."""
+    rig, scene = preset("paper-sim", camera_size=(320, 256), projector_size=(1920, 1080))
+    imaging = Imaging(**DEFAULT, seed=0)
+    traced = trace(rig, scene, imaging)
+    plain = bistair.make_spec("graycode", width=1920, height=1080, period=60, gamma=2.2)
+    slmaster = plain.replace(gray_offset=0.5, gray_wrap=1, phase_offset=-np.pi)
+    described = plain.replace(phase_offset=-np.pi)
+    first, second = plain, slmaster  # the readings the hint names, in its order
+    hint = (r"is phase_offset 0( \(measured -?0\.\d+\))?, or gray_offset 0\.5 and gray_wrap 1 "
+            r"with phase_offset -pi( \(measured -3\.\d+\))? \(the captures fit both "
+            r"readings alike\)\?$")
+    for truth_spec, right in ((slmaster, second), (plain, first)):
+        images = _rendered(truth_spec, traced, imaging)
+        with pytest.raises(BistairError, match="the code steps where the wrapped phase is"
+                                               ) as refused:
+            bistair.decode(images, described)
+        assert re.search(hint, str(refused.value)), str(refused.value)
+        for reading in (first, second):
+            median, beyond = _off(bistair.decode(images, reading), traced.truth, truth_spec)
+            if reading is right:
+                assert median < 0.01 and beyond < 0.001, (reading, median, beyond)
+            else:  # every pixel half a period off
+                assert abs(median - 0.5) < 0.01, (reading, median)
+
+
+def test_a_shifted_spec_on_plain_captures_names_the_plain_reading():
+    """The reverse: plain captures (phase_offset 0) described as SLMaster's code with
+    phase_offset 0 (instead of -pi) name the shifted code with -pi and the plain code with
+    0, the one these captures are."""
+    rig, scene = preset("paper-sim", camera_size=(320, 256), projector_size=(1920, 1080))
+    imaging = Imaging(**DEFAULT, seed=0)
+    traced = trace(rig, scene, imaging)
+    plain = bistair.make_spec("graycode", width=1920, height=1080, period=60, gamma=2.2)
+    described = plain.replace(gray_offset=0.5, gray_wrap=1)
+    with pytest.raises(BistairError) as refused:
+        bistair.decode(_rendered(plain, traced, imaging), described)
+    assert str(refused.value).endswith(
+        "is phase_offset pi, or gray_offset 0 (gray_wrap 0) with phase_offset 0 (the "
+        "captures fit both readings alike)?"), str(refused.value)

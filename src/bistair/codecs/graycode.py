@@ -200,6 +200,36 @@ class GrayCodeSpec(PeriodSpec):
                     "close to a whole number: a period off would not show in the second phase")
 
 
+    def half_period_reading(self) -> str:
+        """The spec fields that read the same frames with the code's edges half a period
+        over (shifted for a plain code, plain for a shifted one), which explains captures
+        equally with the phase offset pi away; ``""`` where no such reading has this spec's
+        frames (complementary, a second period, no phase shifts).
+
+        Examples
+        --------
+        >>> spec = GrayCodeSpec(width=1920, height=1080, period=60)
+        >>> spec.half_period_reading()  # 32 fringes: 5 frames only if the code wraps
+        'gray_offset 0.5 and gray_wrap 1'
+        >>> spec.replace(period=40).half_period_reading()  # 48 fringes, 49 shifted levels
+        'gray_offset 0.5'
+        >>> spec.replace(complementary=1).half_period_reading()
+        ''
+        >>> spec.replace(gray_offset=0.5, gray_wrap=1).half_period_reading()
+        'gray_offset 0 (gray_wrap 0)'
+        """
+        if self.steps == 0 or self.complementary or self.second_period:
+            return ""
+        if self.gray_offset:
+            plain = self.replace(gray_offset=0.0, gray_wrap=0, frame_order=())
+            return ("" if plain.code_bits != self.code_bits else
+                    "gray_offset 0" + (" (gray_wrap 0)" if self.gray_wrap else ""))
+        for cyclic, text in ((0, "gray_offset 0.5"), (1, "gray_offset 0.5 and gray_wrap 1")):
+            if self.replace(gray_offset=0.5, gray_wrap=cyclic, frame_order=()).code_bits \
+                    == self.code_bits:
+                return text
+        return ""
+
     def _validate_alone(self) -> None:
         """A Gray code without phase shifts: no second period, no complementary or shifted
         code (they refine a phase), and something to read the bits against."""
