@@ -140,9 +140,13 @@ class GrayCodeSpec(PeriodSpec):
     gray_offset: float = field(0.0, "where the code's edges sit, as a fraction of a period "
                                "after the phase jumps: 0, or 0.5 for the shifted Gray code",
                                choices=(0.0, 0.5))
+    # a spec file may leave gray_wrap out (0): the specs written before it existed mean 0,
+    # and read against cyclic captures 0 is never wrong (their last half fringe, code 0
+    # past the phase's middle, reads order -1: left out) or refused by the frame count
     gray_wrap: int = field(0, "1: the shifted code wraps cyclically over the fringes (the first "
                            "half period and the last share code 0; SLMaster's "
-                           "SinusShiftGrayCodePattern), with gray_offset 0.5", choices=(0, 1))
+                           "SinusShiftGrayCodePattern), with gray_offset 0.5; may be left "
+                           "out of a spec file (0)", shapes=False, choices=(0, 1))
     second_period: float = field(0.0, "period of a second N-step set that checks the code's "
                                  "orders next to its edges (0: none)")
 
