@@ -307,8 +307,8 @@ def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, frin
         k, _ = _order_of(g ^ flips, p, mode, fringes)
         if k >= 0 and k < fringes:
             u = unit * (k + frac) + shift  # the pixel's place in code cells
-            if mode == 3:
-                u = u % fringes
+            if mode == 3 and u >= fringes:  # past the wrap (u < fringes + 1/2)
+                u -= fringes
             fits = True
             for b in range(bits):
                 if not (unclear >> b) & 1:
