@@ -16,7 +16,10 @@ Shifted (``gray_offset = 0.5``; Wu Z. et al., Opt. Express 27(16), 2019): the co
 sit half a period off the phase jumps, ``g = floor(x/T + 1/2)`` over ``fringes + 1``
 levels; ``k = g`` where ``phi < pi`` and ``g - 1`` where ``phi >= pi``. Its misreads move
 from the phase jumps to mid-fringe, where the phase is continuous: the region strategy
-outvotes them.
+outvotes them, and per pixel they take their fringe region's order
+(:mod:`~bistair.codecs.graycode_edges`). With ``gray_wrap = 1`` (SLMaster's
+``SinusShiftGrayCodePattern``) the code wraps cyclically, ``g = floor(x/T + 1/2) mod
+fringes`` in ``ceil(log2(fringes))`` bits: ``g - 1 = -1`` is the last fringe.
 
 Second period (``second_period = T2``; the layout of kamino410/phase-shifting, with OpenCV's
 Gray code): the order read from the code is checked against the phase of a second N-step
