@@ -88,15 +88,22 @@ def test_gray_wrap_needs_the_shifted_code():
     assert bistair.spec_from_dict(spec.to_dict()) == spec
 
 
-def test_the_last_half_fringe_decodes_as_the_last_fringe():
-    """Code 0 past the phase's middle is fringe ``fringes - 1``: every column of the clean
-    patterns decodes, the last half period included (SLMaster's own decoder leaves it 0)."""
-    spec = bistair.make_spec("graycode", width=1920, height=8, period=60, gray_offset=0.5,
-                             gray_wrap=1, phase_offset=-np.pi)
+@pytest.mark.parametrize("orientation", ["columns", "rows"])
+def test_the_last_half_fringe_decodes_as_the_last_fringe(orientation):
+    """Code 0 past the phase's middle is fringe ``fringes - 1``: every column (row) of the
+    clean patterns decodes, the last half period included (SLMaster's own decoder leaves it
+    0)."""
+    size = dict(width=1920, height=8) if orientation == "columns" else dict(width=8,
+                                                                          height=1920)
+    spec = bistair.make_spec("graycode", **size, period=60, gray_offset=0.5, gray_wrap=1,
+                             phase_offset=-np.pi, orientation=orientation)
     result = bistair.decode(bistair.encode(spec), spec)
+    coord, order = result.coord, result.order
+    if orientation == "rows":
+        coord, order = coord.T, order.T
     assert result.mask.all()
-    assert np.abs(result.coord - np.arange(1920)).max() < 1e-2
-    assert (result.order[:, -30:] == 31).all() and (result.order[:, :30] == 0).all()
+    assert np.abs(coord - np.arange(1920)).max() < 1e-2
+    assert (order[:, -30:] == 31).all() and (order[:, :30] == 0).all()
 
 
 DEFAULT = dict(gamma=2.2, read_noise=0.01, camera_blur=1.0, projector_blur=0.5, ambient=0.05)
