@@ -276,3 +276,24 @@ def test_the_rule_beside_the_edges_beats_slmasters_own():
     assert their_errors > 0.001, their_errors
     assert found["order_error_rate"] < 0.1 * their_errors
     assert found["coverage"] > 0.99 * float((mask & kept).sum() / mask.sum())
+
+
+def test_simulate_a_spec_of_both_axes(tmp_path):
+    """``simulate --spec`` of a spec of both axes: the truth of both, each axis decoded right
+    (its rows 1080 px: 18 fringes, 5 bits, cyclic)."""
+    spec = bistair.make_spec("graycode", width=1920, height=1080, period=60, gray_offset=0.5,
+                             gray_wrap=1, orientation="both")
+    path = tmp_path / "spec.json"
+    path.write_text(spec.to_json())
+    out = tmp_path / "sim"
+    done = CliRunner().invoke(cli, ["simulate", "--scene", "paper-sim", "--spec", str(path),
+                                    "--camera", "160x128", "--out", str(out)])
+    assert done.exit_code == 0, done.output
+    images = np.stack([iio.imread(p) for p in sorted((out / "graycode").glob("*.png"))])
+    result = bistair.decode(images, load_spec(out / "graycode" / "spec.json"))
+    mask = np.load(out / "truth" / "mask.npy")
+    for axis, coord in (("x", result.coord_x), ("y", result.coord_y)):
+        truth = np.load(out / "truth" / f"coord_{axis}.npy")
+        found = mask & np.isfinite(coord)
+        assert found.sum() > 0.99 * mask.sum(), axis
+        assert np.abs(coord - truth)[found].max() < 30, axis

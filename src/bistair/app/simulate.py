@@ -173,8 +173,11 @@ def write_truth(folder: Path, truth: Truth, spec: BaseSpec) -> None:
     """Write the ground truth into the new folder ``folder``: ``coord.npy`` (the projector
     coordinate along the spec's coded axis), ``order.npy`` (int32 ``floor(coord/period)``,
     -1 outside the mask), ``coord_x.npy``, ``coord_y.npy``, ``depth.npy`` (mm, camera
-    frame), ``object_id.npy`` and ``mask.npy``."""
+    frame), ``object_id.npy`` and ``mask.npy``; a spec of both axes writes the columns'
+    ``coord`` and ``order``."""
     folder.mkdir()
+    if spec.orientation == "both":
+        spec = spec.replace(orientation="columns", frame_order=())
     coord = truth.coord(spec)
     order = np.full(coord.shape, -1, np.int32)
     ok = truth.mask & np.isfinite(coord)
