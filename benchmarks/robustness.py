@@ -16,6 +16,7 @@ wholly on one surface, not grazing), and the worst share decoded right of the sm
 (paper, 121 fringes) or of the surfaces (occlusion). Camera 1280 x 1024 unless --camera.
 
     python benchmarks/robustness.py [--camera 1280x1024] [--seeds 3] [--cases paper,hard]
+        [--methods "graycode,graycode (shifted, cyclic)"]
     python benchmarks/robustness.py --sweeps [--out bench-out]   # one factor at a time
 """
 
@@ -24,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import re
 import statistics
 import time
 from pathlib import Path
@@ -46,7 +48,11 @@ CASES = {
     "occlusion": ("mugs-on-wall", DEFAULT, True, 30, (8, 8), "surfaces"),
 }
 METHODS = ["bidirectional", "bidirectional (paper decoder)", "lv", "phase-coding", "graycode",
-           "multifreq"]
+           "graycode (shifted)", "graycode (shifted, cyclic)", "multifreq"]
+# the shifted Gray codes beside the comparable (complementary) one: Wu et al.'s, over
+# fringes + 1 levels, and SLMaster's cyclic one over the fringes
+SHIFTED = {"graycode (shifted)": dict(gray_offset=0.5),
+           "graycode (shifted, cyclic)": dict(gray_offset=0.5, gray_wrap=1)}
 TARGETS = {"paper": (0.001, 0.99, 0.99), "hard": (0.005, 0.97, 0.95),
            "121 fringes": (0.005, 0.97, None), "occlusion": (0.005, None, 0.98)}
 
@@ -58,6 +64,8 @@ def case_specs(projector: tuple[int, int], period: int, parts_stairs: tuple[int,
     for label in ("bidirectional", "bidirectional (paper decoder)"):
         spec, options = specs[label]
         specs[label] = (spec.replace(partitions=p, stairs=s), options)
+    for label, fields in SHIFTED.items():
+        specs[label] = (specs["graycode"][0].replace(complementary=0, **fields), {})
     return specs
 
 
@@ -66,7 +74,8 @@ def run_case(name: str, camera: tuple[int, int], seed: int) -> dict[str, dict]:
     rig, scene = preset(scene_name, camera_size=camera)
     imaging = Imaging(**optics, seed=seed)
     traced = trace(rig, scene, imaging)
-    comp = run(traced, case_specs(rig.projector.size, period, ps, compensated))
+    specs = case_specs(rig.projector.size, period, ps, compensated)
+    comp = run(traced, {label: specs[label] for label in METHODS})
     out = {}
     for row in comp.rows:
         objects = row.scores.get("objects", {})
@@ -107,6 +116,8 @@ def table(camera: tuple[int, int], seeds: int, cases: list[str]) -> dict:
     for name in cases:
         for m in METHODS:
             print(f"| {name} | {m} | {cells(results[name][m])} |")
+    if "bidirectional" not in METHODS:
+        return results
     print("\ntargets (default bidirectional decoder):")
     for name in cases:
         err, cov, worst = TARGETS[name]
@@ -169,18 +180,23 @@ def print_sweep(rows, factor: str, key: str) -> None:
     values = sorted({r["value"] for r in rows if r["factor"] == factor})
     print(f"\n{factor}: {key}")
     print(f"{'method':<30}" + "".join(f"{v:>10}" for v in values))
-    for method in METHODS:
+    for method in _swept(rows, factor):
         found = [next(r for r in rows if r["factor"] == factor and r["value"] == v and
                       r["method"] == method) for v in values]
         print(f"{method:<30}" + "".join("   refused" if r["refused"] else
                                          f"{100 * r[key]:9.3f}%" for r in found))
 
 
+def _swept(rows, factor: str) -> list[str]:
+    """The methods of ``METHODS`` a sweep ran (the table's extra rows run in its cases)."""
+    return [m for m in METHODS if any(r["factor"] == factor and r["method"] == m for r in rows)]
+
+
 def plot(rows, factor: str, key: str, out: Path, label: str) -> Path:
     """One line per method, a refused decode drawn as refused; the file name a slug."""
     curves = {method: [(r["value"], None if r["refused"] else r[key]) for r in rows
                        if r["factor"] == factor and r["method"] == method]
-              for method in METHODS}
+              for method in _swept(rows, factor)}
     path = out / f"{slug(factor)}-{key}.png"
     sweep_figure(curves, factor, label).savefig(path, dpi=90)
     return path
@@ -227,6 +243,8 @@ def main() -> None:
     parser.add_argument("--camera", default="1280x1024")
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--cases", default=",".join(CASES))
+    parser.add_argument("--methods", default=None,
+                        help="the rows to run, comma-separated (default: every method)")
     parser.add_argument("--sweeps", action="store_true", help="one factor at a time instead")
     parser.add_argument("--out", type=Path, default=Path("bench-out"))
     args = parser.parse_args()
@@ -236,6 +254,12 @@ def main() -> None:
 
 def measure_all(args: argparse.Namespace) -> None:
     camera = tuple(int(v) for v in args.camera.lower().split("x"))
+    if args.methods:  # a comma and a space stay within a label: "graycode (shifted, cyclic)"
+        chosen = re.split(r",(?=\S)", args.methods)
+        unknown = set(chosen) - set(METHODS)
+        if unknown:
+            raise SystemExit(f"unknown method(s) {sorted(unknown)} (known: {METHODS})")
+        METHODS[:] = [m for m in METHODS if m in chosen]
     if args.sweeps:
         sweeps(args.out, camera)
     else:

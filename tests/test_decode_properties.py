@@ -55,9 +55,10 @@ def _spec_options(draw: st.DrawFn, method: str) -> dict[str, Any]:
         if draw(st.integers(0, 3)) == 0:  # a Gray code alone
             return {**common, "steps": 0, "period": draw(st.sampled_from([1.0, 4.0, 10.0])),
                     "inverse": draw(st.integers(0, 1)), "white": draw(st.integers(0, 1))}
+        offset = draw(st.sampled_from([0.0, 0.5]))
         return {**common, "period": period, "complementary": draw(st.integers(0, 1)),
-                "inverse": draw(st.integers(0, 1)),
-                "gray_offset": draw(st.sampled_from([0.0, 0.5]))}
+                "inverse": draw(st.integers(0, 1)), "gray_offset": offset,
+                "gray_wrap": draw(st.integers(0, 1)) if offset else 0}
     if method == "lv":
         return {**common, "period": period, "levels": draw(st.integers(3, 5)),
                 "window": draw(st.integers(2, 4))}

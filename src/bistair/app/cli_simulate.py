@@ -12,6 +12,7 @@ import click
 
 from .cli_options import (
     CliError,
+    Input,
     Output,
     _LazyHelp,
     _method_help,
@@ -26,9 +27,13 @@ from .cli_options import (
               "two-masks, mask-prism, two-sculptures, plane, sphere-on-plane, "
               "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
               "checkerboard in eight poses)")
-@click.option("--method", "methods", required=True, multiple=True, metavar="METHOD",
+@click.option("--method", "methods", multiple=True, metavar="METHOD",
               cls=_LazyHelp, help_from=_method_help,
-              help="method to render (repeatable): {} or all")
+              help="method to render (repeatable): {} or all; with --spec, its method or "
+              "none")
+@click.option("--spec", "spec_path", type=Input(), default=None,
+              help="render the set this spec.json describes (its size, code and gamma) "
+              "instead of the method's comparable set")
 @click.option("--out", "-o", required=True, type=Output(),
               help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
               "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
@@ -89,19 +94,34 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
              vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
              both_axes: bool, cameras: int, baseline: float, motion: str | None,
-             motion_of: str, frames: int | None, continuous: bool, quiet: bool) -> None:
+             motion_of: str, frames: int | None, continuous: bool, spec_path: Path | None,
+             quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
     of workers), each varied as --vary says. With --cameras 2, two cameras and the
-    projector between them, for 'bistair stereo'. With --motion, things move between
-    frames; with --frames N --continuous, a stream whose shift advances every frame."""
+    projector between them, for 'bistair stereo'. With --spec, the set the spec describes
+    (--method may then be left out). With --motion, things move between frames; with
+    --frames N --continuous, a stream whose shift advances every frame."""
     from ..codecs import REGISTRY
 
+    if not methods and spec_path is None:
+        raise CliError("name a --method to render (or give --spec)")
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
+    spec = None
+    if spec_path is not None:
+        from ..io.read import load_spec
+
+        if cameras == 2 or count is not None:
+            raise CliError("--spec renders one scene with one camera: leave out --count and "
+                           "--cameras 2")
+        spec = load_spec(spec_path)
     imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
                    bits=int(bits))
     if motion is not None or continuous or frames is not None:
+        if spec is not None:
+            raise CliError("--spec renders a still scene: --motion and --continuous render "
+                           "the comparable sets (leave out --spec)")
         _simulate_motion(scene, chosen, out, camera, compensated, seed, count, vary,
                          no_white or both_axes, cameras, baseline, motion, motion_of, frames,
                          continuous, quiet, imaging)
@@ -125,7 +145,10 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
-                progress=say, white=not no_white, both_axes=both_axes, **imaging)
+                progress=say, white=not no_white, both_axes=both_axes, spec=spec,
+                **imaging)
+        if spec is not None:
+            chosen = [spec.method]
         if quiet:
             return
         if scene == "calibration":

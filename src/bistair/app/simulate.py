@@ -70,8 +70,12 @@ from .engine import (
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
              camera_size: tuple[int, int] | None = None, compensated: bool = True,
              progress: Callable[[str], None] | None = None, white: bool = True,
-             both_axes: bool = False, **imaging: Any) -> Path:
+             both_axes: bool = False, spec: BaseSpec | None = None, **imaging: Any) -> Path:
     """Render ``scene`` for each of ``methods`` and write the capture folders into ``out``.
+
+    With ``spec`` the set that spec describes is rendered (``methods`` empty or its method
+    alone; the projector takes the spec's size, its patterns the spec's own gamma, whatever
+    ``compensated`` says) instead of each method's comparable set.
 
     ``imaging`` goes to :class:`bistair.sim.Imaging` (``gamma``, ``read_noise``,
     ``camera_blur``, ``bits``, ``seed``, ...); with ``compensated`` the patterns pre-compensate
@@ -92,34 +96,58 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
     if scene not in (*scene_names(), "calibration"):
         raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
                            "calibration)")
+    if spec is not None:
+        methods = _spec_methods(methods, spec)
     methods = _check_methods(methods)
     im = _imaging(compensated, imaging)
+    if spec is not None and scene == "calibration":
+        raise BistairError("--spec renders a preset scene; board captures (scene "
+                           "calibration) take each method's comparable set")
     if scene == "calibration":
         return _calibration(methods, out, camera_size, compensated, im, white, both_axes,
                             progress)
     if not white or both_axes:
         raise BistairError("board captures without a white frame or of both axes at once "
                            "are for --scene calibration")
-    rig, geometry = preset(scene, **({} if camera_size is None else {"camera_size": camera_size}))
+    sizes = {} if camera_size is None else {"camera_size": camera_size}
+    if spec is not None:
+        sizes["projector_size"] = (spec.width, spec.height)
+    rig, geometry = preset(scene, **sizes)
     say = progress or (lambda stage: None)
     with output_folder(out) as tmp:
         write_scene(tmp, rig, geometry, im, methods, compensated,
                     {"scene": scene, "methods": methods, "compensated": compensated},
-                    progress=say)
+                    progress=say, spec=spec)
     return Path(out)
+
+
+def _spec_methods(methods: Iterable[str], spec: BaseSpec) -> list[str]:
+    """The methods to render with ``spec``: none named, or the spec's alone."""
+    other = sorted(set(methods) - {spec.method})
+    if other:
+        raise BistairError(f"--spec describes a {spec.method} set: --method "
+                           f"{', '.join(other)} does not match it (leave --method out, or "
+                           f"name {spec.method})")
+    return [spec.method]
 
 
 def write_scene(folder: Path, rig: Rig, geometry: Scene, imaging: Imaging,
                 methods: Sequence[str], compensated: bool, about: dict[str, Any],
                 threads: int | None = None,
-                progress: Callable[[str], None] | None = None) -> None:
+                progress: Callable[[str], None] | None = None,
+                spec: BaseSpec | None = None) -> None:
     """Render ``geometry`` for each method into the existing ``folder``: the capture
     folders, ``truth/``, ``calibration.json`` and ``scene.json`` (``about``, the imaging and
     the rig). ``threads`` for ray casting and exposure (default: the cores; the images do
-    not depend on it). ``progress`` is called with each stage's name as it starts."""
+    not depend on it). ``progress`` is called with each stage's name as it starts. With
+    ``spec``, its set is rendered (into ``folder/<its method>``) instead of the methods'
+    comparable sets."""
     say = progress or (lambda stage: None)
-    specs = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
-                         methods=methods)
+    if spec is not None:
+        specs = {spec.method: (spec, {})}
+    else:
+        specs = method_specs(rig.projector.size, gamma=imaging.gamma if compensated else 1.0,
+                             methods=methods)
     say(f"tracing the scene ({rig.camera.size[0]}x{rig.camera.size[1]})")
     traced = trace(rig, geometry, imaging, workers=threads)
     for method, (spec, _) in specs.items():
@@ -145,8 +173,11 @@ def write_truth(folder: Path, truth: Truth, spec: BaseSpec) -> None:
     """Write the ground truth into the new folder ``folder``: ``coord.npy`` (the projector
     coordinate along the spec's coded axis), ``order.npy`` (int32 ``floor(coord/period)``,
     -1 outside the mask), ``coord_x.npy``, ``coord_y.npy``, ``depth.npy`` (mm, camera
-    frame), ``object_id.npy`` and ``mask.npy``."""
+    frame), ``object_id.npy`` and ``mask.npy``; a spec of both axes writes the columns'
+    ``coord`` and ``order``."""
     folder.mkdir()
+    if spec.orientation == "both":
+        spec = spec.replace(orientation="columns", frame_order=())
     coord = truth.coord(spec)
     order = np.full(coord.shape, -1, np.int32)
     ok = truth.mask & np.isfinite(coord)

@@ -532,8 +532,10 @@ def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     check = code.check or edge_alignment(fs.phi, code.edges, fs.valid, code.edge_phase,
                                          code.cycle)
     pair = tuple(f for f in spec.method_frames() if f.endswith(("-cos", "-sin")))
+    # a reading of the same frames with the code half a period over (a Gray code's)
+    half = getattr(spec, "half_period_reading", lambda: "")()
     problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase,
-                                 pair)
+                                 pair, half)
     if problem is None:
         return []
     kind, message = problem

@@ -16,7 +16,10 @@ Shifted (``gray_offset = 0.5``; Wu Z. et al., Opt. Express 27(16), 2019): the co
 sit half a period off the phase jumps, ``g = floor(x/T + 1/2)`` over ``fringes + 1``
 levels; ``k = g`` where ``phi < pi`` and ``g - 1`` where ``phi >= pi``. Its misreads move
 from the phase jumps to mid-fringe, where the phase is continuous: the region strategy
-outvotes them.
+outvotes them, and per pixel they take their fringe region's order
+(:mod:`~bistair.codecs.graycode_edges`). With ``gray_wrap = 1`` (SLMaster's
+``SinusShiftGrayCodePattern``) the code wraps cyclically, ``g = floor(x/T + 1/2) mod
+fringes`` in ``ceil(log2(fringes))`` bits: ``g - 1 = -1`` is the last fringe.
 
 Second period (``second_period = T2``; the layout of kamino410/phase-shifting, with OpenCV's
 Gray code): the order read from the code is checked against the phase of a second N-step
@@ -83,6 +86,7 @@ from .base import (
     shift_patterns,
 )
 from .graycode_alone import code_alone, measure_alone
+from .graycode_edges import edge_orders
 from .graycode_jit import code_bits, orders_fit, read_orders
 
 # The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
@@ -143,16 +147,23 @@ class GrayCodeSpec(PeriodSpec):
     gray_offset: float = field(0.0, "where the code's edges sit, as a fraction of a period "
                                "after the phase jumps: 0, or 0.5 for the shifted Gray code",
                                choices=(0.0, 0.5))
+    # a spec file may leave gray_wrap out (0): the specs written before it existed mean 0,
+    # and read against cyclic captures 0 is never wrong (their last half fringe, code 0
+    # past the phase's middle, reads order -1: left out) or refused by the frame count
+    gray_wrap: int = field(0, "1: the shifted code wraps cyclically over the fringes (the first "
+                           "half period and the last share code 0; SLMaster's "
+                           "SinusShiftGrayCodePattern), with gray_offset 0.5; may be left "
+                           "out of a spec file (0)", shapes=False, choices=(0, 1))
     second_period: float = field(0.0, "period of a second N-step set that checks the code's "
                                  "orders next to its edges (0: none)")
 
     @property
     def levels(self) -> int:
-        """Code levels: the fringes, one more for the shifted code, twice for the
-        complementary one."""
+        """Code levels: the fringes, one more for the shifted code (unless it wraps
+        cyclically), twice for the complementary one."""
         if self.complementary:
             return 2 * self.fringes
-        return self.fringes + (1 if self.gray_offset else 0)
+        return self.fringes + (1 if self.gray_offset and not self.gray_wrap else 0)
 
     @property
     def code_bits(self) -> int:
@@ -179,13 +190,16 @@ class GrayCodeSpec(PeriodSpec):
         super().validate()
         if self.steps == 0:
             self._validate_alone()
-        for name in ("complementary", "inverse"):
+        for name in ("complementary", "inverse", "gray_wrap"):
             if getattr(self, name) not in (0, 1):
                 raise BistairError(f"{name} must be 0 or 1, got {getattr(self, name)}")
         if self.gray_offset not in (0.0, 0.5):
             raise BistairError(f"gray_offset must be 0 or 0.5, got {self.gray_offset}")
         if self.gray_offset and self.complementary:
             raise BistairError("a shifted Gray code (gray_offset 0.5) cannot be complementary")
+        if self.gray_wrap and self.gray_offset != 0.5:
+            raise BistairError("gray_wrap 1 wraps the shifted Gray code: it needs gray_offset "
+                               f"0.5, got {self.gray_offset}")
         if self.second_period:
             if not (math.isfinite(self.second_period) and self.second_period >= 4):
                 raise BistairError(f"second_period must be 0 (none) or at least 4 projector "
@@ -196,6 +210,36 @@ class GrayCodeSpec(PeriodSpec):
                     f"period / second_period = {self.period / self.second_period:.3f} is too "
                     "close to a whole number: a period off would not show in the second phase")
 
+
+    def half_period_reading(self) -> str:
+        """The spec fields that read the same frames with the code's edges half a period
+        over (shifted for a plain code, plain for a shifted one), which explains captures
+        equally with the phase offset pi away; ``""`` where no such reading has this spec's
+        frames (complementary, a second period, no phase shifts).
+
+        Examples
+        --------
+        >>> spec = GrayCodeSpec(width=1920, height=1080, period=60)
+        >>> spec.half_period_reading()  # 32 fringes: 5 frames only if the code wraps
+        'gray_offset 0.5 and gray_wrap 1'
+        >>> spec.replace(period=40).half_period_reading()  # 48 fringes, 49 shifted levels
+        'gray_offset 0.5'
+        >>> spec.replace(complementary=1).half_period_reading()
+        ''
+        >>> spec.replace(gray_offset=0.5, gray_wrap=1).half_period_reading()
+        'gray_offset 0 (gray_wrap 0)'
+        """
+        if self.steps == 0 or self.complementary or self.second_period:
+            return ""
+        if self.gray_offset:
+            plain = self.replace(gray_offset=0.0, gray_wrap=0, frame_order=())
+            return ("" if plain.code_bits != self.code_bits else
+                    "gray_offset 0" + (" (gray_wrap 0)" if self.gray_wrap else ""))
+        for cyclic, text in ((0, "gray_offset 0.5"), (1, "gray_offset 0.5 and gray_wrap 1")):
+            if self.replace(gray_offset=0.5, gray_wrap=cyclic, frame_order=()).code_bits \
+                    == self.code_bits:
+                return text
+        return ""
 
     def _validate_alone(self) -> None:
         """A Gray code without phase shifts: no second period, no complementary or shifted
@@ -259,6 +303,8 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     else:
         level = np.floor(np.arange(spec.coded_length) / spec.period + spec.gray_offset
                          + 1e-9).astype(np.int64)
+        if spec.gray_wrap:  # the last half fringe shares the first one's code
+            level %= spec.fringes
     gray = level ^ (level >> 1)
     bits = (gray[None, :] >> np.arange(n_bits - 1, -1, -1)[:, None]) & 1
     codes = spec.offset + spec.amplitude * (2.0 * bits - 1.0)
@@ -326,7 +372,7 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         valid = valid & (np.median(np.abs(code - ref), axis=0) >= 2.0 * fs.threshold)
         del code, ref
     maps: dict[str, np.ndarray] = {}
-    mode = 1 if spec.complementary else 2 if spec.gray_offset else 0
+    mode = 1 if spec.complementary else (3 if spec.gray_wrap else 2) if spec.gray_offset else 0
     # the noise of a bit's margin (frame minus inverse, or minus the average of n frames),
     # and of the phase times the modulation
     evidence = (fs.noise * math.sqrt(2.0 if spec.inverse else 1.0 + 1.0 / n),
@@ -335,7 +381,7 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
         code, maps["edges"], maps["carried"], beyond = read_orders(
             prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse), fs.phi,
             fs.mod, valid, mode, spec.fringes, *evidence)
-        return CodeMap(code, maps, edge_phase=np.pi if mode == 2 else 0.0, beyond=beyond)
+        return CodeMap(code, maps, edge_phase=np.pi if mode >= 2 else 0.0, beyond=beyond)
     # each bit: the code frame brighter than the average (or its inverse), in one pass
     gray = code_bits(prepared.raw, start, n_bits, prepared.scale, fs.avg, bool(spec.inverse))
     if spec.complementary:
@@ -346,6 +392,8 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     elif spec.gray_offset:
         g = gray_to_binary(gray)
         k = np.where(fs.phi < np.pi, g, g - 1)
+        if spec.gray_wrap:  # code 0 past the phase's middle: the last fringe
+            k = np.where(g >= spec.fringes, spec.fringes, np.where(k < 0, spec.fringes - 1, k))
         edges, edge_phase = g, np.pi
     else:
         k = edges = gray_to_binary(gray)
@@ -447,7 +495,13 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
         carried = code.maps.get("carried")
         k = read if carried is None else np.where(carried, read, -1)
         if carried is not None and spec.steps:
-            k, info["region_carried"] = region_carry(fs, read, k, spec.fringes)
+            regions = fringe_regions(fs.phi, fs.valid & (read >= 0),
+                                     phase_noise=fs.phase_noise)
+            k, info["region_carried"] = region_carry(fs, read, k, spec.fringes,
+                                                     regions=regions)
+            if spec.gray_offset:  # beside the shifted code's edges: the region's order
+                k, info["edge_orders"] = edge_orders(fs, read, k, spec.fringes,
+                                                     bool(spec.gray_wrap), regions)
         if carried is not None:
             info["left_out"] = int(np.count_nonzero(read >= 0)) - int(np.count_nonzero(k >= 0))
         if spec.steps == 0:  # no phase to check the cells against: their direction
@@ -503,7 +557,8 @@ def part_carried(labels: np.ndarray, first: int, n: int, read: np.ndarray,
 
 
 def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: int,
-                 settled: float = SETTLED, min_strong: int = MIN_STRONG
+                 settled: float = SETTLED, min_strong: int = MIN_STRONG,
+                 regions: tuple[np.ndarray, int] | None = None
                  ) -> tuple[np.ndarray, int]:
     """Keep the orders read where the pixel's own evidence does not carry them but its
     fringe region's strong pixels settle the same order.
@@ -526,6 +581,8 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
         Share of a region's strong pixels that must read one order.
     min_strong : int, default MIN_STRONG
         Strong pixels a region needs.
+    regions : tuple of (numpy.ndarray, int), optional
+        The fringe regions of ``fs`` over the pixels read, if already cut.
 
     Returns
     -------
@@ -554,7 +611,8 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
     dim = np.flatnonzero(read_any & (carried < 0))
     if not dim.size:
         return carried, 0
-    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise)
+    labels, n = regions or fringe_regions(fs.phi, fs.valid & read_any,
+                                          phase_noise=fs.phase_noise)
     shares = code_evidence(labels, n, carried, fringes)
     strong = np.bincount(labels[carried >= 0], minlength=n + 1)
     order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),

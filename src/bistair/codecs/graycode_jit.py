@@ -233,7 +233,8 @@ THREE32 = np.float32(1.5 * math.pi)
 
 
 @_numba_inline
-def _order_of(g: np.int64, p: np.float32, mode: int) -> tuple[np.int64, np.int64]:
+def _order_of(g: np.int64, p: np.float32, mode: int, fringes: int
+              ) -> tuple[np.int64, np.int64]:
     """The order the code word ``g`` gives at wrapped phase ``p`` (the rule of ``mode``)
     and the code whose steps mark the edges."""
     if mode == 1:  # complementary: the three-zone rule
@@ -243,6 +244,10 @@ def _order_of(g: np.int64, p: np.float32, mode: int) -> tuple[np.int64, np.int64
     e = _binary(g)
     if mode == 2:  # the code shifted by half a fringe
         return (e if p < HALF32 else e - 1), e
+    if mode == 3:  # shifted and cyclic: code 0 past the phase's middle is the last fringe
+        if e >= fringes:
+            return np.int64(fringes), e
+        return (e if p < HALF32 else (e - 1 if e > 0 else np.int64(fringes - 1))), e
     return e, e
 
 
@@ -292,23 +297,23 @@ def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, frin
         return False
     sigma = phase_noise / mod  # the wrapped phase's noise, radians
     unit = 2.0 if mode == 1 else 1.0  # code cells per fringe
-    shift = 0.5 if mode == 2 else 0.0  # the code's cells start half a fringe later
+    shift = 0.5 if mode >= 2 else 0.0  # the code's cells start half a fringe later
     slack = z * sigma / (2.0 * math.pi)  # in fringes
     limit = (reach + slack) * unit
     frac = np.float64(p) / (2.0 * math.pi)
     found = False
     flips = unclear
     while True:  # every reading of the unclear bits: the order it gives, if it fits
-        k, _ = _order_of(g ^ flips, p, mode)
+        k, _ = _order_of(g ^ flips, p, mode, fringes)
         if k >= 0 and k < fringes:
             u = unit * (k + frac) + shift  # the pixel's place in code cells
+            if mode == 3 and u >= fringes:  # past the wrap (u < fringes + 1/2)
+                u -= fringes
             fits = True
             for b in range(bits):
                 if not (unclear >> b) & 1:
                     continue
-                span = np.float64(1 << b)
-                r = (u / span - 1.0) % 2.0
-                if span * min(r, 2.0 - r) <= limit:
+                if _edge_distance(u, b, mode, fringes) <= limit:
                     continue  # beside its edge: a bit may read anything
                 # away from its edge: a flipped bit only where noise could flip it, a
                 # faint one not at all
@@ -335,6 +340,11 @@ def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, frin
     level = _binary(g)
     low = _edge_margin(d, level, c_pos, c_neg) if level > 0 else -1.0
     high = _edge_margin(d, level + 1, c_pos, c_neg)
+    if mode == 3 and fringes == 1 << bits:  # the cyclic code's wrap: its top bit's edge
+        if level == 0:
+            low = _edge_margin(d, np.int64(1 << (bits - 1)), c_pos, c_neg)
+        if level == fringes - 1:
+            high = _edge_margin(d, np.int64(1 << (bits - 1)), c_pos, c_neg)
     if low < 0 or high < 0:
         return True  # a cell at the end of the code: one edge only
     if cell > 1.0 - slack and high > low:
@@ -342,6 +352,21 @@ def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, frin
     if cell < slack and low > high:
         return False
     return True
+
+
+@_numba_inline
+def _edge_distance(u: float, b: int, mode: int, fringes: int) -> float:
+    """How far, in code cells, place ``u`` lies from the nearest edge of bit ``b`` (LSB 0):
+    the Gray code's bit ``b`` steps at the odd multiples of ``2**b``; the cyclic code's
+    (``mode`` 3) also at its wrap, ``0 = fringes``, where the last level's code has it set."""
+    span = np.float64(1 << b)
+    r = (u / span - 1.0) % 2.0
+    dist = span * min(r, 2.0 - r)
+    if mode == 3:
+        last = fringes - 1
+        if ((last ^ (last >> 1)) >> b) & 1:
+            dist = min(dist, u, fringes - u)
+    return dist
 
 
 @_numba_inline
@@ -382,7 +407,7 @@ def _read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.n
                 d[b] = v - ref
                 g = (g << 1) | (1 if v > ref else 0)
             p = phi[y, x]
-            k, e = _order_of(g, p, mode)
+            k, e = _order_of(g, p, mode, fringes)
             ok = valid[y, x]
             inside = ok and k >= 0 and k < fringes
             code[y, x] = k if inside else -1
@@ -445,7 +470,8 @@ def read_orders(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.nd
     valid : (H, W) bool array
         Pixels to decode.
     mode : int
-        0 plain, 1 complementary, 2 shifted by half a fringe.
+        0 plain, 1 complementary, 2 shifted by half a fringe, 3 shifted and cyclic (code 0
+        past the phase's middle is fringe ``fringes - 1``).
     fringes : int
         Fringes across the projector (orders from 0 to ``fringes - 1``).
     noise_d : float

@@ -235,8 +235,8 @@ def edge_alignment(phi: np.ndarray, edges: np.ndarray, valid: np.ndarray,
 
 
 def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
-                       edge_phase: float = 0.0, code_pair: tuple[str, ...] = ()
-                       ) -> tuple[str, str] | None:
+                       edge_phase: float = 0.0, code_pair: tuple[str, ...] = (),
+                       half_period: str = "") -> tuple[str, str] | None:
     """What a check says of the spec's phase convention: ``None`` when it fits (or the
     evidence is too thin), else ``("refuse" | "warn", one-line message)``.
 
@@ -257,6 +257,11 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     code_pair : tuple of str
         The names of a cos/sin pair of code frames, if the code has one: exchanged, they
         reverse the code as reversed shifts do, so the message names them too.
+    half_period : str
+        The spec fields of another reading of the same frames whose code's edges sit half a
+        period from this one's (a plain Gray code's shifted twin, or the other way round),
+        if there is one: with the phase offset pi from the one suggested it explains the
+        captures exactly as well, so the message names both readings.
 
     Returns
     -------
@@ -278,6 +283,9 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     'warn'
     >>> convention_problem(EdgeCheck(20, 3.1, 0.9, 20, 0.0), 0.0, 1) is None  # too few steps
     True
+    >>> convention_problem(EdgeCheck(500, 3.14, 0.9, 20, 0.1), -np.pi, 1, 0.0, (),
+    ...                    "gray_offset 0.5")[1].split(": ")[1]  # doctest: +ELLIPSIS
+    'is phase_offset 0, or gray_offset 0.5 with phase_offset -pi (the captures fit both ...)?'
     """
     if check.edges < MIN_EDGES:
         return None
@@ -290,18 +298,31 @@ def convention_problem(check: EdgeCheck, phase_offset: float, shift_sign: int,
     if check.spread < 0.5 or abs(check.crossing) <= 0.25:
         return None
     guess = (phase_offset + check.crossing + np.pi) % TWO_PI - np.pi
-    named = {0.0: "0", np.pi: "pi", -np.pi: "-pi", np.pi / 2: "pi/2", -np.pi / 2: "-pi/2",
-             2 * np.pi / 3: "2*pi/3", -2 * np.pi / 3: "-2*pi/3"}
-    # the steps' crossing reads short of a large offset (kamino's -2*pi/3 read as -1.851
-    # from 0): a named offset within half the gap between two of them is suggested, with
-    # the measured one beside it when they differ
-    near = [(value, name) for value, name in named.items() if abs(guess - value) < 0.25]
-    suggestion = f"{guess:.3f}" if not near else (
-        near[0][1] if abs(guess - near[0][0]) < 0.05 else f"{near[0][1]} (measured {guess:.3f})")
+    suggestion = f"is phase_offset {_offset_name(guess)}"
+    if half_period:  # the same captures, read with the code half a period over
+        other = guess % TWO_PI - np.pi  # guess - pi, in [-pi, pi)
+        near_spec = float(wrap(np.array(other - phase_offset)))
+        if abs(near_spec) < 0.25:  # next to the spec's own offset, as it writes it (-pi)
+            other = phase_offset + near_spec
+        suggestion += (f", or {half_period} with phase_offset {_offset_name(other)} (the "
+                       "captures fit both readings alike)")
     message = (f"the code steps where the wrapped phase is "
                f"{wrap(check.crossing + edge_phase) % TWO_PI:.2f} rad, not at "
-               f"{edge_phase:.2f} rad: is phase_offset {suggestion}?")
+               f"{edge_phase:.2f} rad: {suggestion}?")
     return ("refuse" if abs(check.crossing) > np.pi / 3 else "warn", message)
+
+
+def _offset_name(value: float) -> str:
+    """A phase offset as a hint names it: a named one (pi, -pi/2, ...) where ``value`` is
+    within 0.05 rad of it, beside the measured value where it is within 0.25 rad (the
+    steps' crossing reads short of a large offset: kamino's -2*pi/3 read as -1.851 from 0),
+    else the value."""
+    named = {0.0: "0", np.pi: "pi", -np.pi: "-pi", np.pi / 2: "pi/2", -np.pi / 2: "-pi/2",
+             2 * np.pi / 3: "2*pi/3", -2 * np.pi / 3: "-2*pi/3"}
+    near = [(v, name) for v, name in named.items() if abs(value - v) < 0.25]
+    if not near:
+        return f"{value:.3f}"
+    return near[0][1] if abs(value - near[0][0]) < 0.05 else f"{near[0][1]} (measured {value:.3f})"
 
 
 def axis_rates(sample: Sample) -> tuple[float, float] | None:
