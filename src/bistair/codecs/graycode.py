@@ -454,7 +454,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     # every pixel read votes (votes from only the pixels whose evidence carries their order
     # leave regions without votes to their neighbours: on the rendered presets 0.03-0.3% of
     # the pixels wrong became 0.06-4%)
-    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise,
+                               links=fs.links)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
@@ -520,7 +521,8 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
     dim = np.flatnonzero(read_any & (carried < 0))
     if not dim.size:
         return carried, 0
-    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise)
+    labels, n = fringe_regions(fs.phi, fs.valid & read_any, phase_noise=fs.phase_noise,
+                               links=fs.links)
     shares = code_evidence(labels, n, carried, fringes)
     strong = np.bincount(labels[carried >= 0], minlength=n + 1)
     order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),

@@ -650,7 +650,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     bistair.errors.BistairError: the captures do not fit the spec: 81% of the 21 code windows ...
     """
     codes = code.code
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise, links=fs.links)
     weight = core_weight(fs.phi)
 
     judged: list = []  # the judged windows of the last labelling, and its labels

@@ -410,11 +410,11 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
         if not (compiled and GATHER):
             return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise,
-                                  boundaries=edges, sign=direction)[0]
+                                  boundaries=edges, sign=direction, links=fs.links)[0]
         # the final numbering writes the labels and sums the stair values per (region,
         # row) in one scan: the first evidence reads those sums
         lab = label_fringes(fs.phi, fs.valid, phase_noise=phase_noise, boundaries=edges,
-                            sign=direction)
+                            sign=direction, links=fs.links)
         remap, n = kept_regions(lab)
         gathered.append((lab.labels, relabel_stair_profiles(
             lab.labels, lab.roots, remap, fs.phi, theta, stair_mod, fs.mod, n)))
