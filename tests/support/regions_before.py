@@ -575,9 +575,9 @@ class Watch:
             return bits
 
         def fringes(phi, valid, cut=None, min_size=20, phase_noise=None, boundaries=None,
-                    sign=None):
+                    sign=None, links=None):
             labels, n = fringe_regions(phi, valid, cut, min_size, phase_noise, boundaries,
-                                       sign)
+                                       sign, links)
             want, n_want = regions_before(phi, valid, cut, min_size, phase_noise, boundaries,
                                           sign)
             self.seen["fringe_regions"] += 1
@@ -586,15 +586,16 @@ class Watch:
             return labels, n
 
         def coherent(phi, weak, strong, phase_noise, min_strong=10, min_size=100):
-            got = coherent_pixels(phi, weak, strong, phase_noise, min_strong, min_size)
+            got, links = coherent_pixels(phi, weak, strong, phase_noise, min_strong,
+                                         min_size)
             self.seen["coherent_pixels"] += 1
             if not np.array_equal(got, coherent_before(phi, weak, strong, phase_noise,
                                                        min_strong, min_size)):
                 self.differ.append(f"coherent_pixels {phi.shape}")
-            return got
+            return got, links
 
-        def shared(phi, valid, noise, cut, sign, phase_noise):
-            bits, cut, sign = shared_links(phi, valid, noise, cut, sign, phase_noise)
+        def shared(links, phi, valid, noise, cut, sign, phase_noise):
+            bits, cut, sign = shared_links(links, phi, valid, noise, cut, sign, phase_noise)
             if bits is not None:  # links taken over: those of the labelling's own pass
                 self.seen["shared links"] += 1
                 self.seen["link_bits"] += 1

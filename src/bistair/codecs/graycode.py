@@ -496,7 +496,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
         k = read if carried is None else np.where(carried, read, -1)
         if carried is not None and spec.steps:
             regions = fringe_regions(fs.phi, fs.valid & (read >= 0),
-                                     phase_noise=fs.phase_noise)
+                                     phase_noise=fs.phase_noise, links=fs.links)
             k, info["region_carried"] = region_carry(fs, read, k, spec.fringes,
                                                      regions=regions)
             if spec.gray_offset:  # beside the shifted code's edges: the region's order
@@ -512,7 +512,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     # every pixel read votes (votes from only the pixels whose evidence carries their order
     # leave regions without votes to their neighbours: on the rendered presets 0.03-0.3% of
     # the pixels wrong became 0.06-4%)
-    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid & (read >= 0), phase_noise=fs.phase_noise,
+                               links=fs.links)
     weight = core_weight((fs.phi - np.float32(code.edge_phase)) % np.float32(TWO_PI))
 
     carried = code.maps.get("carried")
@@ -612,7 +613,7 @@ def region_carry(fs: FringeSet, read: np.ndarray, carried: np.ndarray, fringes: 
     if not dim.size:
         return carried, 0
     labels, n = regions or fringe_regions(fs.phi, fs.valid & read_any,
-                                          phase_noise=fs.phase_noise)
+                                          phase_noise=fs.phase_noise, links=fs.links)
     shares = code_evidence(labels, n, carried, fringes)
     strong = np.bincount(labels[carried >= 0], minlength=n + 1)
     order = np.where((shares.max(axis=1) > settled) & (strong >= min_strong),

@@ -48,6 +48,26 @@ SURE_CODE = 0.75
 # fit: right decodes reach 0.23 (the 1280 x 1024 occlusion render; 0.19 on mugs-on-wall under
 # hard optics), another method's captures read as lv 1.0 (tests/test_lv_windows.py)
 UNSURE = 0.5
+# the limits of window_problem, measured by benchmarks/lv_margins.py on 54 right decodes
+# (the presets at 640 x 512, default and hard optics, two seeds; 16 scenes of `simulate
+# --count 16 --vary optics,objects,pose`; paper-sim, mugs-on-wall, objects-on-plane at
+# 1280 x 1024) and 533 wrong specs: over this share of the judged windows unknown to the
+# sequence, when no one misread region explains them (right decodes: at most 0.092, 14 of
+# 152 on objects-on-plane's 121 fringes; the wrong specs it refuses: 0.16 to 1.0) ...
+UNKNOWN = 0.15
+# ... this many windows or more past the spec's last fringe (right decodes: none; a period
+# x1.5 seen through 19 windows: 3; one past, mask-prism's period x1.5, is let through) ...
+PAST = 2
+# ... over this share contradicted by their neighbours, and over window + 2 of them (right
+# decodes: at most 0.104, 14 of 135; a window one short: 0.72, 18 of 25)
+CONTRADICTED = 0.3
+# the code phases fit another count of levels better than the spec's: a misfit on the
+# spec's levels over MISFIT_RATIO times the best other count's and over MISFIT_FLOOR (right
+# decodes: at most 0.95 times, objects-on-plane's 16-px fringes under hard optics; codes of
+# 4 levels read as 5: 2.6 to 9.1 times, those of 5 as 6 under hard optics at 16 px: 1.05, left
+# to the windows)
+MISFIT_RATIO = 1.5
+MISFIT_FLOOR = 0.15
 
 
 @lru_cache(maxsize=64)
@@ -198,7 +218,7 @@ def _successors(links: RegionLinks, n_regions: int) -> np.ndarray:
 
 def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.ndarray,
                     spec: LvSpec, info: dict | None = None, sure: float = SURE_CODE,
-                    unknown: list | None = None) -> np.ndarray:
+                    judged_out: list | None = None) -> np.ndarray:
     """Votes of every chain of ``window`` adjacent regions for its members' orders.
 
     Each region starts a window (itself and the next ``window - 1`` regions up); the window's
@@ -231,9 +251,11 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     sure : float, default SURE_CODE
         The least share of its weight a region's code needs for the windows through it to
         be judged against the sequence.
-    unknown : list, optional
-        Receives (in place of its contents) the (u, window) int64 regions of the ``u``
-        judged windows the sequence does not hold, in chain order.
+    judged_out : list, optional
+        Receives (in place of its contents) the judged windows: their (j, window) int64
+        regions in chain order, their (j,) places in the sequence (-1 where it does not
+        hold them) and (j,) bool, which of those found are contradicted by a neighbour
+        (:func:`window_problem` judges these).
 
     Returns
     -------
@@ -273,20 +295,21 @@ def window_evidence(region_code: np.ndarray, confidence: np.ndarray, succ: np.nd
     ok = (chain >= 0).all(axis=1) & (region_code[safe] >= 0).all(axis=1) & distinct
     ok[0] = False
     start = np.where(ok, table[_window_key(region_code[safe], spec.levels)], -1)
-    if info is not None:
-        judged = ok & (confidence[safe].min(axis=1) >= sure)
-        info.update(code_windows=int(judged.sum()),
-                    unknown_windows=int((judged & (start < 0)).sum()),
-                    unsure_windows=int((ok & ~judged).sum()))
-        if unknown is not None:
-            unknown[:] = [chain[judged & (start < 0)]]
-    ok &= start >= 0
     pred = np.full(n_reg + 1, -1, np.int64)
     has_succ = succ >= 0
     pred[succ[has_succ]] = np.flatnonzero(has_succ)
     after = np.where(succ >= 0, start[np.maximum(succ, 0)], -1)
     before = np.where(pred >= 0, start[np.maximum(pred, 0)], -1)
     contradicted = ((after >= 0) & (after != start + 1)) | ((before >= 0) & (before != start - 1))
+    if info is not None:
+        judged = ok & (confidence[safe].min(axis=1) >= sure)
+        info.update(code_windows=int(judged.sum()),
+                    unknown_windows=int((judged & (start < 0)).sum()),
+                    unsure_windows=int((ok & ~judged).sum()))
+        if judged_out is not None:
+            judged_out[:] = [chain[judged], start[judged],
+                             (contradicted & (start >= 0))[judged]]
+    ok &= start >= 0
     confirmed = (after == start + 1) | (before == start - 1)
     neighbours = (after >= 0) | (before >= 0)
     vote = ok & ~contradicted & (confirmed | ~neighbours)
@@ -331,6 +354,183 @@ def edge_windows(chains: np.ndarray, region_order: np.ndarray) -> np.ndarray:
     k = region_order[chains]
     both = (k[:, :-1] >= 0) & (k[:, 1:] >= 0)
     return (both & (np.diff(k, axis=1) != 1)).any(axis=1)
+
+
+def past_windows(chains: np.ndarray, region_order: np.ndarray, spec: LvSpec) -> np.ndarray:
+    """Which windows run past the spec's last fringe (or before its first), as the decoded
+    orders of their members place them.
+
+    A member of decided order ``k`` at place ``j`` of its chain puts the window's start at
+    ``k - j``; a start below 0 or above ``fringes - window`` names fringes the projector
+    does not have. With the right spec no lit region lies beyond the last fringe, so such
+    a window (its codes all read surely) says the spec has too few fringes: a period too
+    long, a projector too narrow.
+
+    Parameters
+    ----------
+    chains : numpy.ndarray
+        (j, window) int, the regions of each window in chain order.
+    region_order : numpy.ndarray
+        (n_regions + 1,) int, each region's decoded order (-1 where undecided).
+    spec : LvSpec
+        ``fringes`` and ``window`` are used.
+
+    Returns
+    -------
+    numpy.ndarray
+        (j,) bool.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("lv", width=480, height=64, period=30)  # 16 fringes
+    >>> order = np.array([-1, 11, 12, 13, 14, 15, -1, -1])
+    >>> past_windows(np.array([[1, 2, 3, 4], [2, 3, 4, 5], [3, 4, 5, 6]]), order,
+    ...              spec).tolist()
+    [False, False, True]
+    """
+    k = region_order[chains]
+    start = np.where(k >= 0, k - np.arange(chains.shape[1]), 0)
+    return ((start < 0) | (start > spec.fringes - spec.window)).any(axis=1)
+
+
+def misread_regions(chains: np.ndarray) -> int:
+    """How many regions, misread, it takes to make these windows unknown: 0 for none, 1
+    when one region lies in all of them, else (a greedy cover, the region in most windows
+    first) 2 or more.
+
+    Parameters
+    ----------
+    chains : numpy.ndarray
+        (u, window) int, the regions of each unknown window.
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> misread_regions(np.array([[1, 2, 3, 4], [2, 3, 4, 5], [4, 5, 6, 7]]))
+    1
+    >>> misread_regions(np.array([[1, 2, 3, 4], [5, 6, 7, 8]]))
+    2
+    """
+    left, count = np.asarray(chains), 0
+    while len(left):
+        ids, seen = np.unique(left, return_counts=True)
+        left = left[~(left == ids[seen.argmax()]).any(axis=1)]
+        count += 1
+    return count
+
+
+def window_problem(info: dict, spec: LvSpec) -> str | None:
+    """The reason to refuse the captures from their code windows, or ``None``.
+
+    Judged over the windows whose codes were all read surely, less those across an edge of
+    two surfaces (``info`` of :func:`order_columns`): more unknown to the sequence than
+    :data:`UNKNOWN` of them, when no one region lies in all of them (``unknown_regions``:
+    how many misread regions it takes to make them unknown, :func:`misread_regions`; one
+    misread code makes up to ``window`` windows unknown: a handful of windows can refuse,
+    one misread region cannot);
+    more contradicted by their neighbour than :data:`CONTRADICTED` of them and than
+    ``window + 2`` (found in the sequence, but not next to where the next window along the
+    chain was found: a spec whose sequence holds nearly every window, e.g. a window too
+    short; one misread code can contradict the windows through it and their two
+    neighbours); :data:`PAST` or more running past the spec's last fringe
+    (:func:`past_windows`, none with the right spec); or, of at least 20 windows read,
+    over :data:`UNSURE` through a region that reads no one code (checked first).
+
+    Parameters
+    ----------
+    info : dict
+        ``code_windows``, ``unknown_windows``, ``unknown_regions`` (missing: the fewest
+        regions that can make that many windows unknown), ``unsure_windows``,
+        ``past_windows``, ``contradicted_windows`` (missing: 0).
+    spec : LvSpec
+        ``window`` is used.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("lv", width=1080, height=64, period=30)
+    >>> window_problem({"code_windows": 13, "unknown_windows": 4, "unknown_regions": 1},
+    ...                spec) is None  # one misread region
+    True
+    >>> window_problem({"code_windows": 13, "unknown_windows": 4, "unknown_regions": 2},
+    ...                spec)[:40]
+    '31% of the 13 code windows read are not '
+    """
+    windows, unknown = info.get("code_windows", 0), info.get("unknown_windows", 0)
+    unsure = info.get("unsure_windows", 0)
+    read = windows + unsure
+    fit = "does the spec fit (period, projector size, levels, window)?"
+    if read >= 20 and unsure > UNSURE * read:  # no window judged is no evidence of a fit
+        return (f"{100 * unsure / read:.0f}% of the {read} code windows read pass through a "
+                "fringe region that reads no one code: does the spec fit (method, period, "
+                "projector size, levels, window)?")
+    misread = info.get("unknown_regions", -(-unknown // spec.window))
+    if unknown > UNKNOWN * windows and misread >= 2:
+        return (f"{100 * unknown / windows:.0f}% of the {windows} code windows read are not "
+                f"in the spec's code sequence: {fit}")
+    contradicted = info.get("contradicted_windows", 0)
+    if contradicted > max(CONTRADICTED * windows, spec.window + 2):
+        return (f"{100 * contradicted / windows:.0f}% of the {windows} code windows read are "
+                f"found in the spec's code sequence apart from their neighbours': {fit}")
+    past = info.get("past_windows", 0)
+    if past >= PAST:
+        return (f"{past} of the {windows} code windows read run past the spec's "
+                f"{spec.fringes} fringes: is the period (or the projector size) right?")
+    return None
+
+
+def levels_fit(theta: np.ndarray, fs: FringeSet, levels: int) -> tuple[float, float, int]:
+    """How well the code phases sit on ``levels`` stair levels, and on the best other count.
+
+    The misfit (:func:`bistair.core.checks.stair_misfit`, pass 0's sample: 0 on the levels,
+    1 halfway between two) on ``levels`` and on every other count of 2 to 32 levels. With
+    the right levels every other count fits worse (its grid either misses the codes or is
+    finer, so the same noise is a larger share of its step: 3 levels per level on a grid
+    three times as fine holds the same phases, three times the misfit).
+
+    Parameters
+    ----------
+    theta : numpy.ndarray
+        (H, W) code phase, radians (``code_phase`` of :func:`code_columns`).
+    fs : FringeSet
+        Stage 1: its sample and valid pixels.
+    levels : int
+        The spec's levels.
+
+    Returns
+    -------
+    (misfit, other, other_levels) : tuple of float, float, int
+        The misfit on ``levels``, the least misfit of another count and that count.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("lv", width=480, height=32, period=20)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> theta = code_columns(cols, spec, fs).maps["code_phase"]
+    >>> misfit, other, count = levels_fit(theta, fs, 5)  # 4-level codes read as 5
+    >>> round(misfit, 2), round(other, 2), count
+    (0.5, 0.0, 4)
+    """
+    t, ok = stair_sample(fs.sample, theta, fs.valid)
+
+    def misfit(count: int) -> float:
+        return stair_misfit(t, ok, stair_level_phase(np.arange(count), count))
+
+    others = {count: misfit(count) for count in range(2, 33) if count != levels}
+    best = min(others, key=others.__getitem__)
+    return misfit(levels), others[best], best
 
 
 def _window_key(codes: np.ndarray, levels: int) -> np.ndarray:
@@ -416,15 +616,21 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
         the fringes, the code windows the spec check judges (``code_windows``) and the
         unknown among them (``unknown_windows``), the windows it leaves out (through a
         region whose code is split, ``unsure_windows``; across an edge of two surfaces,
-        ``edge_windows``: see :func:`window_evidence`, :func:`edge_windows`), the region
-        counts and the phase jumps across which the orders do not step by one.
+        ``edge_windows``: see :func:`window_evidence`, :func:`edge_windows`), those
+        contradicted by their neighbours and those past the spec's fringes
+        (``contradicted_windows``, ``past_windows``), the code phases' misfit on the
+        spec's levels and on the best other count (``code_misfit``, ``other_misfit``,
+        ``other_levels``: :func:`levels_fit`), the region counts and the phase jumps
+        across which the orders do not step by one.
 
     Raises
     ------
     BistairError
-        Of 20 or more code windows judged, over 15% are not in the spec's sequence, or of
-        20 or more read, over half pass through a region that reads no one code
-        (:data:`UNSURE`): the spec does not fit the captures.
+        The code windows say the spec does not fit (:func:`window_problem`: too many
+        unknown to the sequence, past its last fringe, contradicted by their neighbours,
+        or through regions of no one code), or the code phases fit another count of levels
+        clearly better than the spec's (:func:`levels_fit`: a misfit over
+        :data:`MISFIT_RATIO` times the other count's and over :data:`MISFIT_FLOOR`).
 
     Examples
     --------
@@ -444,10 +650,10 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     bistair.errors.BistairError: the captures do not fit the spec: 81% of the 21 code windows ...
     """
     codes = code.code
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise, links=fs.links)
     weight = core_weight(fs.phi)
 
-    unknown: list = []  # the last labels and the chains of their unknown windows
+    judged: list = []  # the judged windows of the last labelling, and its labels
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:
         shares = code_evidence(labels, n, codes, spec.levels, weight)
@@ -455,8 +661,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
         region_code[0] = -1
         succ = _successors(region_links(fs.phi, labels), n)
         evidence = window_evidence(region_code, shares.max(axis=1), succ, spec, info,
-                                   unknown=unknown)
-        unknown.append(labels)
+                                   judged_out=judged)
+        judged.append(labels)
         return labels, n, evidence
 
     sequence = np.asarray(spec.sequence, np.int32)
@@ -473,26 +679,26 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: LvSpec) -> Orders:
     info: dict = {"noise": fs.noise, "fringes": spec.fringes}
     order = orders_from_regions(fs.phi, fs.valid, labels, evidence_of, agrees, info)
     edges = 0  # windows across an edge of two surfaces are not judged
-    if unknown and len(unknown[0]):
-        chains, last = unknown
+    if judged and len(judged[0]):
+        chains, starts, contra, last = judged
         region_order = np.full(int(last.max()) + 1, -1, np.int64)
         region_order[last.ravel()] = order.ravel()  # every pixel of a region has its order
         region_order[0] = -1
-        edges = int(edge_windows(chains, region_order).sum())
+        across = edge_windows(chains, region_order)
+        edges = int((across & (starts < 0)).sum())
+        info.update(unknown_regions=misread_regions(chains[(starts < 0) & ~across]),
+                    contradicted_windows=int((contra & ~across).sum()),
+                    past_windows=int((past_windows(chains, region_order, spec)
+                                      & ~across).sum()))
     info.update(code_windows=info.get("code_windows", 0) - edges,
                 unknown_windows=info.get("unknown_windows", 0) - edges, edge_windows=edges)
-    windows, unknown_count = info.get("code_windows", 0), info.get("unknown_windows", 0)
-    read = windows + info.get("unsure_windows", 0)
-    if read >= 20 and info.get("unsure_windows", 0) > UNSURE * read:
-        refuse(  # no window judged is no evidence that the spec fits
-            f"{100 * info['unsure_windows'] / read:.0f}% of the {read} code windows read "
-            "pass through a fringe region that reads no one code: does the spec fit "
-            "(method, period, projector size, levels, window)?")
-    if windows >= 20 and unknown_count > 0.15 * windows:
-        refuse(
-            f"{100 * unknown_count / windows:.0f}% of the "
-            f"{windows} code windows read are not in the spec's code sequence: does the spec "
-            "fit (period, projector size, levels, window)?")
+    misfit, other, other_levels = levels_fit(code.maps["code_phase"], fs, spec.levels)
+    info.update(code_misfit=misfit, other_levels=other_levels, other_misfit=other)
+    refuse(window_problem(info, spec))
+    if misfit > MISFIT_RATIO * other and misfit > MISFIT_FLOOR:
+        refuse(f"the code phases sit {misfit:.2f} of half a level step off the spec's "
+               f"{spec.levels} levels, {other:.2f} off {other_levels}: are the levels "
+               "(or the projector size) right?")
     return Orders(order, info)
 
 

@@ -210,7 +210,7 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: PhaseCodingSpec, *,
     info = {"strategy": strategy, "noise": fs.noise, "levels": spec.levels}
     if strategy == "pixel":
         return Orders(codes, info)
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise, links=fs.links)
     weight = core_weight(fs.phi)
 
     def evidence_of(labels: np.ndarray, n: int) -> tuple[np.ndarray, int, np.ndarray]:

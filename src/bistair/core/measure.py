@@ -26,7 +26,7 @@ from .checks import judge_sample
 from .measure_jit import fit_residual_energy, front_end, keep_coherent, phase_noise
 from .phase import shifts_of
 from .phase_jit import offset_parts, shift_weights
-from .regions import MIN_REGION, label_fringes
+from .regions import MIN_REGION, Links, label_fringes
 from .sample import Sample, chi2_median, clip_level, kernel_view, set_noise, take_sample
 
 
@@ -44,6 +44,9 @@ class FringeSet:
     sigma: np.ndarray | None = None  # the phase noise per pixel of the full pass, if kept
     stair: tuple[np.ndarray, np.ndarray] | None = None  # the stair pair's phase, modulation
     sample: Sample | None = None  # pass 0's sample of the capture (column layout)
+    # the links of the coherent dim pixels' labelling, for the decode's own labelling of
+    # ``phi`` to take over (``links`` of :func:`~bistair.core.regions.fringe_regions`)
+    links: Links | None = None
 
     @property
     def phase_noise(self) -> np.ndarray:
@@ -55,8 +58,8 @@ class FringeSet:
         return phase_noise(self.mod, self.noise, 4 if self.steps is None else self.steps)
 
     def transposed(self) -> FringeSet:
-        """The same set with image axes swapped (for the rows orientation; the sample, of
-        the column layout, is left out)."""
+        """The same set with image axes swapped (for the rows orientation; the sample and
+        the links, of the column layout, are left out)."""
         def t(a: np.ndarray | None) -> np.ndarray | None:
             return None if a is None else np.ascontiguousarray(a.T)
 
@@ -256,21 +259,24 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
         avg = None
         if not check:
             mod = None
+    links = None
     if lowest < threshold and weak:  # dim pixels to judge by their regions
-        valid = coherent_pixels(phi, valid, strong, sigma)
+        valid, links = coherent_pixels(phi, valid, strong, sigma)
     del strong
     if check:
         check_decodable(valid, lambda: prepared.clipped, min_modulation, mod)
     return FringeSet(phi, avg, mod if maps else None, valid, noise, steps, threshold,
                      sigma if maps else None,
-                     None if pair is None else (theta, stair_mod), sample)
+                     None if pair is None else (theta, stair_mod), sample,
+                     links if maps else None)
 
 
 def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
                     phase_noise: np.ndarray, min_strong: int = 10,
-                    min_size: int = 100) -> np.ndarray:
+                    min_size: int = 100) -> tuple[np.ndarray, Links | None]:
     """The ``strong`` pixels and the ``weak`` ones in fringe regions of the weak mask that
-    hold at least ``min_strong`` strong pixels or ``min_size`` pixels in all.
+    hold at least ``min_strong`` strong pixels or ``min_size`` pixels in all, and the
+    links of that labelling, for the decode's own labelling of ``phi`` to take over.
 
     Noise has random phases: its pixels do not join into fringe regions, so a dim pixel
     whose phase runs on smoothly with a region's is part of a lit surface.
@@ -292,8 +298,11 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
 
     Returns
     -------
-    (H, W) bool array
+    keep : (H, W) bool array
         The pixels to count as valid.
+    links : Links or None
+        The labelling's links (:class:`~bistair.core.regions.Links`), for the decode's
+        own labelling of ``phi`` and ``phase_noise`` to take over (``FringeSet.links``).
 
     Examples
     --------
@@ -302,14 +311,15 @@ def coherent_pixels(phi: np.ndarray, weak: np.ndarray, strong: np.ndarray,
     >>> phi[:, 35:] = rng.uniform(0, 2 * np.pi, (20, 25))  # noise on the right
     >>> weak = np.ones(phi.shape, bool)
     >>> weak[:, 30:35] = False
-    >>> keep = coherent_pixels(phi.astype(np.float32), weak, np.zeros(phi.shape, bool),
-    ...                        np.full(phi.shape, 0.02, np.float32))
-    >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any())
-    (True, False)
+    >>> keep, links = coherent_pixels(phi.astype(np.float32), weak,
+    ...                               np.zeros(phi.shape, bool),
+    ...                               np.full(phi.shape, 0.02, np.float32))
+    >>> bool(keep[:, :30].all()), bool(keep[:, 35:].any()), links.bits.shape
+    (True, False, (20, 60))
     """
     # the regions fringe_regions drops as too small are left out here; the labelling
     # counted each region's pixels and strong pixels: no relabelling, no counting pass.
-    # Its links are shared: the decode's own labelling of phi takes them over
+    # Its links are handed on: the decode's own labelling of phi takes them over
     lab = label_fringes(phi, weak, phase_noise=phase_noise, strong=strong, share=True)
     return keep_coherent(lab.labels, lab.roots, lab.size, lab.strong, strong, min_strong,
-                         min_size, MIN_REGION)
+                         min_size, MIN_REGION), lab.links

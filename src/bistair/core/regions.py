@@ -20,8 +20,6 @@ Examples
 
 from __future__ import annotations
 
-import threading
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -251,6 +249,23 @@ def cut_reference(phi: np.ndarray, valid: np.ndarray) -> float:
     return float(np.clip(3.0 * grad, 0.6, 2.2))
 
 
+@dataclass(eq=False)
+class Links:
+    """The links a labelling made (:func:`~bistair.core.regions_jit.link_bits`), handed to
+    the next labelling of the same phase and phase noise (a decode labels its phase twice:
+    its coherent dim pixels on the weak mask, :func:`bistair.core.measure.coherent_pixels`,
+    then its regions on the valid pixels with its own cuts; ``FringeSet.links`` carries
+    them from one to the other). Taken over once: :func:`label_fringes` empties ``bits``
+    (it changes them in place).
+    """
+
+    phi: np.ndarray  # the phase they link (the same array must be labelled again)
+    phase_noise: np.ndarray  # its phase noise (the same array)
+    bits: np.ndarray | None  # (H, W) uint8 link bits; None once taken
+    cut: float  # the cut threshold they were made with
+    sign: int  # the phase's direction along the rows
+
+
 @dataclass(frozen=True)
 class Labelling:
     """Fringe regions as :func:`label_fringes` leaves them: provisional labels and the
@@ -266,28 +281,29 @@ class Labelling:
     n: int  # regions
     size: np.ndarray  # (n+1,) int64 pixels per region, the reattached ones included
     strong: np.ndarray  # (n+1,) int64 pixels of the ``strong`` mask per region (0 without)
+    links: Links | None = None  # its links, to hand on (``share``)
 
 
 def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                   phase_noise: np.ndarray | None = None,
                   boundaries: tuple[np.ndarray, np.ndarray] | None = None,
                   sign: int | None = None, strong: np.ndarray | None = None,
-                  share: bool = False) -> Labelling:
+                  share: bool = False, links: Links | None = None) -> Labelling:
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
     labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
     pixels labelled and the dropped ones reattached, with per-region counts
     (:func:`~bistair.core.regions_jit.label_kept`).
 
-    With ``share``, the links are kept for the next labelling of the same ``phi`` and
-    ``phase_noise`` (the same arrays) in this thread (a decode labels its phase twice:
-    the coherent dim pixels on the weak mask, then its regions on the valid pixels with
-    its own cuts): that labelling takes them over, makes again only the rows that read
-    a row whose validity changed (:func:`~bistair.core.regions_jit.relink`; where those
-    are at most three quarters of the rows) and adds its cuts
-    (:func:`~bistair.core.regions_jit.cut_links`), where its direction is the first one's
-    and no link's step lies between the two cut thresholds
+    With ``share``, the links are handed on in ``Labelling.links`` (:class:`Links`) for
+    the next labelling of the same ``phi`` and ``phase_noise`` (the same arrays): given
+    them as ``links`` (a decode labels its phase twice: the coherent dim pixels on the
+    weak mask, then its regions on the valid pixels with its own cuts), that labelling
+    takes them over, makes again only the rows that read a row whose validity changed
+    (:func:`~bistair.core.regions_jit.relink`; where those are at most three quarters of
+    the rows) and adds its cuts (:func:`~bistair.core.regions_jit.cut_links`), where its
+    direction is the first one's and no link's step lies between the two cut thresholds
     (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
-    own pass; none kept past the next ``share`` in the thread.
+    own pass; they are taken over once (a later labelling given them makes its own).
 
     Parameters
     ----------
@@ -296,7 +312,10 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     strong : (H, W) bool array, optional
         A mask whose pixels are counted per region (``Labelling.strong``).
     share : bool
-        Keep the links for the next labelling of ``phi`` (without ``boundaries`` only).
+        Hand the links on (``Labelling.links``; without ``boundaries`` only).
+    links : Links, optional
+        The links a labelling of the same ``phi`` and ``phase_noise`` handed on, to take
+        over.
 
     Returns
     -------
@@ -320,7 +339,8 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     cut_v, cut_h = NO_CUTS, NO_CUTS
     if boundaries is not None:
         cut_v, cut_h = (np.ascontiguousarray(b, dtype=bool) for b in boundaries)
-    bits, cut, sign = _shared_links(phi, valid, noise, cut, sign, phase_noise)
+    bits, cut, sign = _shared_links(links, phi, valid, noise, cut, sign, phase_noise)
+    shared = None
     if bits is not None:
         if boundaries is not None:
             bits = cut_links(bits, cut_v, cut_h)
@@ -333,33 +353,31 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                          float(np.float32(cut)), int(sign), 0.3, cut_v, cut_h,
                          boundaries is not None)
         if share and boundaries is None and phase_noise is not None:
-            _SHARED.links = (weakref.ref(phi), weakref.ref(phase_noise), bits, cut, sign)
+            shared = Links(phi, phase_noise, bits, cut, sign)
     del noise
     counted = strong is not None
     mask = np.ascontiguousarray(strong, dtype=bool) if counted else NO_CUTS
     # the pixels dropped beside a cut link (thin lines along the wraps) join the region
     # they still link to: three rounds
     labels, roots, n, size, lit = label_kept(bits, mask, counted, TILE, 3)
-    return Labelling(labels, roots, int(n), size, lit)
+    return Labelling(labels, roots, int(n), size, lit, shared)
 
 
-_SHARED = threading.local()  # per thread: the links a labelling shared (label_fringes)
-
-
-def _shared_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray,
-                  cut: float | None, sign: int | None, phase_noise: np.ndarray | None
+def _shared_links(links: Links | None, phi: np.ndarray, valid: np.ndarray,
+                  noise: np.ndarray, cut: float | None, sign: int | None,
+                  phase_noise: np.ndarray | None
                   ) -> tuple[np.ndarray | None, float | None, int | None]:
-    """The links :func:`label_fringes` shared for this ``phi`` and ``phase_noise``, taken
-    over and made for ``valid`` (``None`` where there are none, or where their direction
-    is not this labelling's or their cut threshold cuts a link otherwise), with the cut
-    and the direction; they are handed out once."""
-    shared = getattr(_SHARED, "links", None)
-    if shared is None or phase_noise is None:
+    """The ``links`` another labelling handed on for this ``phi`` and ``phase_noise``,
+    taken over and made for ``valid`` (``None`` where there are none, or where their
+    direction is not this labelling's or their cut threshold cuts a link otherwise), with
+    the cut and the direction; they are taken over once."""
+    if links is None or links.bits is None or phase_noise is None:
         return None, cut, sign
-    phi_ref, noise_ref, bits, cut0, sign0 = shared
-    if phi_ref() is not phi or noise_ref() is not phase_noise or bits.shape != phi.shape:
+    bits, cut0, sign0 = links.bits, links.cut, links.sign
+    if links.phi is not phi or links.phase_noise is not phase_noise or \
+            bits.shape != phi.shape:
         return None, cut, sign
-    _SHARED.links = None
+    links.bits = None
     changed = valid_changes(bits, valid)
     reread = np.convolve(changed, np.ones(4, np.uint8))[2:2 + changed.size]  # rows y-1..y+2
     if np.count_nonzero(reread) * 4 > 3 * changed.size:  # most rows: its own pass is cheaper
@@ -384,7 +402,8 @@ def _shared_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray,
 def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
                    min_size: int = MIN_REGION, phase_noise: np.ndarray | None = None,
                    boundaries: tuple[np.ndarray, np.ndarray] | None = None,
-                   sign: int | None = None) -> tuple[np.ndarray, int]:
+                   sign: int | None = None, links: Links | None = None
+                   ) -> tuple[np.ndarray, int]:
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
 
     Links are cut at wraps, at steps above ``cut``, where the fringe period jumps
@@ -417,6 +436,9 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     sign : int, optional
         The phase's direction along the rows, when the caller has it already:
         ``fringe_direction(phi, valid)``.
+    links : Links, optional
+        The links a labelling of the same ``phi`` and ``phase_noise`` handed on
+        (``FringeSet.links``), taken over (:func:`label_fringes`).
 
     Returns
     -------
@@ -439,7 +461,7 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     >>> n, labels[0, [0, 9, 10, 29, 30]].tolist()
     (3, [1, 1, 2, 2, 3])
     """
-    lab = label_fringes(phi, valid, cut, phase_noise, boundaries, sign)
+    lab = label_fringes(phi, valid, cut, phase_noise, boundaries, sign, links=links)
     remap, n = kept_regions(lab, min_size)
     relabel(lab.labels, lab.roots, remap)
     return lab.labels, n

@@ -23,7 +23,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse import csgraph
 
-from .parts import Agreement, split_parts
+from .parts import Agreement, split_disagreeing
 from .regions import RegionLinks, fill_orders, fringe_direction, region_links
 from .resolve_jit import (
     label_code_votes,
@@ -199,7 +199,7 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
     leads the runner-up by less than ``min_margin`` stays invalid. With ``agrees`` (which
     pixels' own codes fit a given per-pixel order), parts of regions whose codes contradict
     their region's order are detached and decoded on their own
-    (:func:`~bistair.core.parts.split_parts`).
+    (:func:`~bistair.core.parts.split_disagreeing`).
     With ``phase_noise``, an undecided region whose decided neighbours demand different
     orders across its wraps is cut in two where its fringe period jumps
     (:func:`~bistair.core.split.split_contradicted`): two surfaces side by side whose phase
@@ -273,7 +273,7 @@ def orders_from_regions(phi: np.ndarray, valid: np.ndarray, labels: np.ndarray,
                                             contradicted_regions(links, k_reg, faint=faint))
         k_reg = np.concatenate([k_reg, np.full(n - before, -1, k_reg.dtype)])
     if agrees is not None:
-        labels, n, detached = split_parts(labels, n, k_reg, agrees)
+        labels, n, detached = split_disagreeing(labels, n, k_reg, agrees)
     if detached or cut:
         labels, n, evidence = evidence_of(labels, n)
         links = region_links(phi, labels, direction)

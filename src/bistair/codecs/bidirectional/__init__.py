@@ -47,7 +47,6 @@ import numpy as np
 from ...core.captures import Prepared
 from ...core.checks import refuse, stair_misfit, stair_sample, wrap_steps
 from ...core.measure import FringeSet
-from ...core.parts import ALL
 from ...core.regions import (
     core_weight,
     fringe_direction,
@@ -411,11 +410,11 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
         edges = stair_edges(fs.phi, theta, fs.valid, stair_noise_map(), spec.stairs, 12)
         if not (compiled and GATHER):
             return fringe_regions(fs.phi, fs.valid, phase_noise=phase_noise,
-                                  boundaries=edges, sign=direction)[0]
+                                  boundaries=edges, sign=direction, links=fs.links)[0]
         # the final numbering writes the labels and sums the stair values per (region,
         # row) in one scan: the first evidence reads those sums
         lab = label_fringes(fs.phi, fs.valid, phase_noise=phase_noise, boundaries=edges,
-                            sign=direction)
+                            sign=direction, links=fs.links)
         remap, n = kept_regions(lab)
         gathered.append((lab.labels, relabel_stair_profiles(
             lab.labels, lab.roots, remap, fs.phi, theta, stair_mod, fs.mod, n)))
@@ -451,12 +450,9 @@ def _region_orders(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: 
             evidence[doubtful_regions(runs, n, doubt)] *= THIN_DOUBT
         return labels, n, evidence
 
-    # judged on the whole image (not marked ``windowed``): a sample of every second row and
-    # column missed a part 5 rows tall on the README's sphere-on-plane (tests/test_parts.py)
-    def agrees(k: np.ndarray, at: tuple[slice, slice] = ALL) -> np.ndarray:
-        """A pixel of ``image[at]`` reads its order's local or partition level (its row
-        decides which)."""
-        return stair_agreement(ks[at], theta[at], k, spec.stairs, spec.partitions)
+    def agrees(k: np.ndarray) -> np.ndarray:
+        """A pixel reads its order's local or partition level (its row decides which)."""
+        return stair_agreement(ks, theta, k, spec.stairs, spec.partitions)
 
     # the labels are passed on, not kept here: the decode replaces them as it splits regions
     return orders_from_regions(fs.phi, fs.valid, regions(), evidence_of, agrees, info,

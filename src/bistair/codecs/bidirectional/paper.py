@@ -119,7 +119,7 @@ def paper_orders(ks: np.ndarray, theta: np.ndarray, fs: FringeSet,
     del run_theta, new_group, merged, group, g_first, g_second, has_second, second_theta
     del local_theta, part_theta, k1, k2, c_len, ok
     fringes, n_fringes = fringe_regions(fs.phi, fs.valid, min_size=1,
-                                        phase_noise=fs.phase_noise)
+                                        phase_noise=fs.phase_noise, links=fs.links)
     mode, _ = run_label_modes(fringes, runs, run_k, n_fringes, S * P)
     return paint_labels(fringes, mode)
 
