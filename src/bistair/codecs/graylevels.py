@@ -290,8 +290,8 @@ def estimate_levels(values: np.ndarray, digits: np.ndarray, levels: int) -> np.n
 def separation(values: np.ndarray, centres: np.ndarray) -> tuple[float, int]:
     """How badly a frame's levels separate: the largest count of sample values in the middle
     half between two neighbouring levels over the count within a quarter gap of the
-    fainter of them, and that pair's lower level (index into ``centres``). Levels out of
-    order give ``inf``.
+    fainter of them (each plus one: a level no value is at gives 1 or more), and that
+    pair's lower level (index into ``centres``). Levels out of order give ``inf``.
 
     Examples
     --------
@@ -300,7 +300,7 @@ def separation(values: np.ndarray, centres: np.ndarray) -> tuple[float, int]:
     >>> separation(four, np.array([-1.0, -1 / 3, 1 / 3, 1.0]))[0] < 0.01
     True
     >>> two = np.repeat([-1.0, 1.0], 1000) + rng.normal(0, 0.05, 2000)  # a binary frame
-    >>> separation(two, np.array([-1.0, -1 / 3, 1 / 3, 1.0]))[0] > 1
+    >>> separation(two, np.array([-1.0, -1 / 3, 1 / 3, 1.0]))[0] >= 1
     True
     """
     values = np.asarray(values, dtype=np.float64)
@@ -317,7 +317,7 @@ def separation(values: np.ndarray, centres: np.ndarray) -> tuple[float, int]:
 
     at = between(centres - reach, centres + reach)
     band = between(centres[:-1] + gaps / 4, centres[1:] - gaps / 4)
-    ratio = band / np.maximum(np.minimum(at[:-1], at[1:]), 1)
+    ratio = (band + 1) / (np.minimum(at[:-1], at[1:]) + 1)  # an empty level: 1 at least
     worst = int(np.argmax(ratio))
     return float(ratio[worst]), worst
 
@@ -355,7 +355,7 @@ def frame_levels(samples: list[np.ndarray], used: list[np.ndarray], levels: int
     >>> first = pos[np.repeat([0, 1], 800)] + rng.normal(0, 0.03, 1600)  # digits 2, 3 out of view
     >>> last = pos[np.repeat([0, 1, 2, 3], 400)] + rng.normal(0, 0.03, 1600)
     >>> centres, worst = frame_levels([first, last], [np.arange(4)] * 2, 4)
-    >>> centres.round(2).tolist(), worst[0] < 0.01
+    >>> centres.astype(float).round(2).tolist(), worst[0] < 0.01
     ([[-0.9, -0.45, 0.37, 1.1], [-0.9, -0.45, 0.37, 1.1]], True)
     """
     pooled = np.concatenate(samples) if samples else np.empty(0)

@@ -73,7 +73,7 @@ def sample_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: n
     >>> raw = np.float32([[[0.0, 1 / 3], [0.0, 1 / 3]]])
     >>> ones = np.ones((2, 2), np.float32)
     >>> sample_levels(raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, np.ones((2, 2), bool), ones,
-    ...               np.int64([0, 1]), np.int64([0, 1]), 2, 0.5).round(3).tolist()
+    ...               np.int64([0, 1]), np.int64([0, 1]), 2, 0.5).astype(float).round(3).tolist()
     [[-1.0, -0.333]]
     """
     raw, start = kernel_frames(raw, start, digits)
