@@ -383,12 +383,14 @@ def frame_levels(samples: list[np.ndarray], used: list[np.ndarray], levels: int
 def _sample_values(prepared: Prepared, start: int, digits: int, fs: FringeSet
                    ) -> list[np.ndarray]:
     """``v`` of each code frame (averaged along the fringe as read) on an even grid of at
-    most ``SAMPLE`` valid pixels, the better modulated half of them (where the levels read
-    with the least noise)."""
+    most ``SAMPLE`` valid pixels at least ``EDGE_ZONE`` from the code's edges (no level
+    between two there), the better modulated half of them (where the levels read with the
+    least noise)."""
     h, w = fs.phi.shape
     step = max(1, int(math.ceil(math.sqrt(h * w / SAMPLE))))
-    mod = fs.mod[::step, ::step]
-    valid = fs.valid[::step, ::step] & (mod > 0)
+    mod, phi = fs.mod[::step, ::step], fs.phi[::step, ::step]
+    valid = fs.valid[::step, ::step] & (mod > 0) & (phi >= EDGE_ZONE) & (
+        phi <= TWO_PI - EDGE_ZONE)  # away from the code's edges: no level between two
     if np.any(valid):
         valid &= mod >= np.median(mod[valid])
     ys, xs = np.nonzero(valid)
