@@ -152,7 +152,7 @@ def reflected_index(gray: np.ndarray, levels: int) -> np.ndarray:
 
 def validate_levels(spec: Any) -> None:
     """Refuse a ``code_levels`` and its combinations that are not defined: L from 2 to
-    ``MAX_LEVELS`` (and at most the projector's grey levels); for L > 2 no complementary
+    ``MAX_LEVELS``; for L > 2 no complementary
     pattern, shifted code, inverse patterns or second period (each is a binary code's) and
     phase shifts to read the levels against. A white frame is the texture frame, as
     always.
@@ -175,9 +175,6 @@ def validate_levels(spec: Any) -> None:
                            f"{levels}")
     if levels == 2:
         return
-    if levels > 2 ** spec.bits:
-        raise BistairError(f"code_levels {levels} needs more grey levels than {spec.bits}-bit "
-                           "patterns have")
     what = f"a code of {levels} levels"
     if spec.steps == 0:
         raise BistairError(f"{what} is read against the fringes' average and modulation: it "
