@@ -46,7 +46,7 @@ CASES = {
     "occlusion": ("mugs-on-wall", DEFAULT, True, 30, (8, 8), "surfaces"),
 }
 METHODS = ["bidirectional", "bidirectional (paper decoder)", "lv", "phase-coding", "graycode",
-           "multifreq"]
+           "graycode (4 levels)", "multifreq"]
 TARGETS = {"paper": (0.001, 0.99, 0.99), "hard": (0.005, 0.97, 0.95),
            "121 fringes": (0.005, 0.97, None), "occlusion": (0.005, None, 0.98)}
 
@@ -58,6 +58,14 @@ def case_specs(projector: tuple[int, int], period: int, parts_stairs: tuple[int,
     for label in ("bidirectional", "bidirectional (paper decoder)"):
         spec, options = specs[label]
         specs[label] = (spec.replace(partitions=p, stairs=s), options)
+    return with_levels(specs)
+
+
+def with_levels(specs):
+    """The rows plus the quaternary Gray code (He et al. 2019, as SLMaster projects it) at
+    the Gray code's period and steps."""
+    gray, _ = specs["graycode"]
+    specs["graycode (4 levels)"] = (gray.replace(complementary=0, code_levels=4), {})
     return specs
 
 
@@ -143,7 +151,7 @@ def widths_scene() -> tuple[Scene, list[float]]:
 def sweep(traced, factor: str, values, make_imaging, make_specs=None):
     rows = []
     for value in values:
-        specs = (make_specs or (lambda _: method_specs(PROJECTOR, gamma=2.2)))(value)
+        specs = (make_specs or (lambda _: with_levels(method_specs(PROJECTOR, gamma=2.2))))(value)
         comp = run(traced, specs, imaging=make_imaging(value))
         for row in comp.rows:
             rows.append({"factor": factor, "value": value, "method": row.label,
@@ -196,7 +204,7 @@ def sweeps(out: Path, camera: tuple[int, int]) -> None:
     rows += sweep(traced, "defocus", [0.5, 1.0, 2.0, 3.0], lambda v: imaging_with(camera_blur=v))
     rows += sweep(traced, "gamma (uncompensated)", [1.0, 1.6, 2.2, 2.8],
                   lambda v: imaging_with(gamma=v),
-                  lambda v: method_specs(PROJECTOR, gamma=1.0))
+                  lambda v: with_levels(method_specs(PROJECTOR, gamma=1.0)))
     rows += sweep(traced, "fringes", [30, 17, 11, 8], lambda v: imaging_with(), fringes_specs)
     wscene, widths = widths_scene()
     wtraced = trace(Rig.default(camera_size=camera, projector_size=PROJECTOR), wscene,
