@@ -144,7 +144,7 @@ class GrayCodeSpec(PeriodSpec):
                                  "orders next to its edges (0: none)")
     code_levels: int = field(2, "grey levels of the code: 2, the binary Gray code; L > 2, a "
                              "base-L reflected Gray code read against the fringes (4: the "
-                             "quaternary code)")
+                             "quaternary code)", later=True)
 
     @property
     def levels(self) -> int:

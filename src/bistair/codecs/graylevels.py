@@ -72,7 +72,7 @@ CLEAR_SHARE = 0.5
 EDGE_ZONE = math.pi / 3
 # a digit is read on the pixels of its fringe within REACH rows along it (the column
 # layout's columns), their phase within SAME_FRINGE radians of the pixel's
-REACH = 6
+REACH = 3
 SAME_FRINGE = 0.5
 # a fringe region settles its order where over SETTLED of at least MIN_STRONG of its
 # carried pixels read it
@@ -87,7 +87,7 @@ ROW_CUT = math.pi / 2
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
 MAX_BAND = 0.5
 ABSENT = 0.005
-SAMPLE = 200_000  # pixels the levels are estimated on
+SAMPLE = 100_000  # pixels the levels are estimated on
 
 
 def code_digits(fringes: int, levels: int) -> int:

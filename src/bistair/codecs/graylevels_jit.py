@@ -98,32 +98,51 @@ def _read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np
     carried = np.zeros((h, w), np.bool_)
     beyond = np.zeros(h, np.int64)
     two_pi = np.float32(2.0 * math.pi)
+    ok = np.empty((h, w), np.bool_)  # the pixels whose v counts
+    v = np.empty((digits, h, w), np.float32)
     for y in prange(h):
         for x in range(w):
-            if not valid[y, x]:
+            ok[y, x] = valid[y, x] and mod[y, x] > 0
+            for i in range(digits):
+                v[i, y, x] = (np.float32(raw[start + i, y, x]) * s32 - avg[y, x]) / mod[y, x] \
+                    if ok[y, x] else np.float32(0.0)
+    for y in prange(h):
+        # each digit's v summed along the fringe, row by row (as :func:`_level` sums it)
+        total = np.zeros((digits, w), np.float32)
+        count = np.zeros(w, np.float32)
+        for yy in range(max(0, y - reach), min(h, y + reach + 1)):
+            for x in range(w):  # (without branches: the loop vectorises)
+                same = np.float32(1.0) if ok[yy, x] and abs(phi[yy, x] - phi[y, x]) < t32 \
+                    else np.float32(0.0)
+                count[x] += same
+            for i in range(digits):
+                for x in range(w):
+                    same = np.float32(1.0) if ok[yy, x] and abs(phi[yy, x] - phi[y, x]) < t32 \
+                        else np.float32(0.0)
+                    total[i, x] += v[i, yy, x] * same
+        for x in range(w):
+            if not ok[y, x]:
                 continue
             b = mod[y, x]
-            if not b > 0:
-                continue
             parent = 0
             clear = True
             for i in range(digits):
-                v, count = _level(raw, start + i, y, x, s32, avg, mod, valid, phi, reach,
-                                  t32)
+                value = total[i, x] / max(count[x], np.float32(1.0))
                 n = used[i]
-                j = 0  # the nearest level: the first whose upper threshold v is under
-                while j < n - 1 and v >= np.float32(0.5) * (centres[i, j] + centres[i, j + 1]):
+                j = 0  # the nearest level: the first whose upper threshold value is under
+                while j < n - 1 and value >= np.float32(0.5) * (centres[i, j]
+                                                                + centres[i, j + 1]):
                     j += 1
                 c = centres[i, j]
-                if v >= c:  # the margin to the threshold on v's side (none past the ends)
+                if value >= c:  # the margin to the threshold on its side (none past the ends)
                     half = (centres[i, j + 1] - c) * np.float32(0.5) if j < n - 1 else \
                         np.float32(np.inf)
-                    margin = half - (v - c)
+                    margin = half - (value - c)
                 else:
                     half = (c - centres[i, j - 1]) * np.float32(0.5) if j > 0 else \
                         np.float32(np.inf)
-                    margin = half - (c - v)
-                if margin < share * half or margin * b * math.sqrt(count) < z * noise_d:
+                    margin = half - (c - value)
+                if margin < share * half or margin * b * math.sqrt(count[x]) < z * noise_d:
                     clear = False
                 g = digit_of[i, j]
                 digit = g if parent % 2 == 0 else levels - 1 - g
