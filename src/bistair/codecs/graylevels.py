@@ -81,7 +81,7 @@ MIN_STRONG = 50
 # and the rest from their fringe along the row: the first carried pixel either way within
 # ROW_REACH pixels, reached without a phase step of ROW_CUT radians or more
 ROW_REACH = 64
-ROW_CUT = math.pi / 2
+ROW_CUT = math.pi / 4
 # the checks: between two neighbouring levels of a frame at most MAX_BAND times as many
 # sample pixels as at the fainter of the two (measured on renders: see
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
