@@ -94,6 +94,15 @@ def code_digits(fringes: int, levels: int) -> int:
     """Digits of base ``levels`` that count ``fringes`` orders: ``ceil(log_L(fringes))``,
     at least 1.
 
+    Parameters
+    ----------
+    fringes, levels : int
+        The orders to count and the base L.
+
+    Returns
+    -------
+    int
+
     Examples
     --------
     >>> code_digits(16, 4), code_digits(17, 4), code_digits(36, 3), code_digits(1, 4)
@@ -138,6 +147,18 @@ def reflected_index(gray: np.ndarray, levels: int) -> np.ndarray:
     """The index of base-``levels`` reflected Gray code digits (inverse of
     :func:`reflected_digits`).
 
+    Parameters
+    ----------
+    gray : numpy.ndarray
+        (digits, ...) digits, most significant first.
+    levels : int
+        The base L.
+
+    Returns
+    -------
+    numpy.ndarray
+        int64 indices, ``gray.shape[1:]``.
+
     Examples
     --------
     >>> reflected_index(reflected_digits(np.arange(64), 4, 3), 4).tolist() == list(range(64))
@@ -156,6 +177,16 @@ def validate_levels(spec: Any) -> None:
     pattern, shifted code, inverse patterns or second period (each is a binary code's) and
     phase shifts to read the levels against. A white frame is the texture frame, as
     always.
+
+    Parameters
+    ----------
+    spec : GrayCodeSpec
+        The spec being validated.
+
+    Raises
+    ------
+    BistairError
+        One line naming what is not defined.
 
     Examples
     --------
@@ -197,6 +228,15 @@ def level_patterns(spec: Any) -> np.ndarray:
     """The code frames of a multi-level spec along the coded axis: ``(D, coded_length)``
     float64, digit ``d`` at ``offset + amplitude * (2 d / (L - 1) - 1)``.
 
+    Parameters
+    ----------
+    spec : GrayCodeSpec
+        A spec with ``code_levels`` > 2.
+
+    Returns
+    -------
+    numpy.ndarray
+
     Examples
     --------
     >>> from bistair import make_spec
@@ -211,6 +251,16 @@ def level_patterns(spec: Any) -> np.ndarray:
 
 def frame_digits(spec: Any) -> list[np.ndarray]:
     """The digits each code frame of ``spec`` draws somewhere on the projector, increasing.
+
+    Parameters
+    ----------
+    spec : GrayCodeSpec
+        A spec with ``code_levels`` > 2.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        One array of digits per code frame.
 
     Examples
     --------
@@ -289,6 +339,18 @@ def separation(values: np.ndarray, centres: np.ndarray) -> tuple[float, int]:
     half between two neighbouring levels over the count within a quarter gap of the
     fainter of them (each plus one: a level no value is at gives 1 or more), and that
     pair's lower level (index into ``centres``). Levels out of order give ``inf``.
+
+    Parameters
+    ----------
+    values : numpy.ndarray
+        ``v`` of a frame's sample pixels.
+    centres : numpy.ndarray
+        The frame's level positions, increasing.
+
+    Returns
+    -------
+    ratio : float
+    pair : int
 
     Examples
     --------
@@ -452,6 +514,17 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
 def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None:
     """The one-line reason to refuse a capture whose levels do not separate (the worst
     :func:`separation` over ``MAX_BAND``), or ``None``.
+
+    Parameters
+    ----------
+    worst : (ratio, frame, digit)
+        From :func:`frame_levels` (frame -1: the pooled levels).
+    levels : int
+        L.
+
+    Returns
+    -------
+    str or None
 
     Examples
     --------

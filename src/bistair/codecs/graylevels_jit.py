@@ -64,6 +64,17 @@ def sample_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: n
     """``v = (I - A) / B`` of each code frame at the pixels ``(ys, xs)`` (valid ones),
     averaged along the fringe as :func:`read_levels` reads it.
 
+    Parameters
+    ----------
+    raw, start, digits, scale, avg, mod, valid, phi
+        As :func:`read_levels` takes them.
+    ys, xs : numpy.ndarray
+        The pixels' rows and columns.
+    reach : int
+        Rows either side averaged along the fringe.
+    tol : float
+        The largest phase difference (radians) of a pixel averaged with.
+
     Returns
     -------
     (digits, len(ys)) float32
@@ -223,6 +234,17 @@ def read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.
         ``code`` set and the phase at least ``zone`` from the code's edges.
     beyond : int
         Pixels whose clear digits name a fringe past the last.
+
+    Examples
+    --------
+    >>> raw = np.float32([[[0.0, 2 / 3, 2 / 3]]])  # digit 0, then a digit 2 of one frame
+    >>> ones = np.ones((1, 3), np.float32)
+    >>> code, nearest, carried, beyond = read_levels(
+    ...     raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, np.ones((1, 3), bool),
+    ...     np.float32([[3.0, 3.0, 0.1]]), np.float32([[-1, -1 / 3, 1 / 3, 1]]),
+    ...     np.int32([[0, 1, 2, 3]]), np.int32([4]), 4, 4, 0.01, 3.0, 0.5, 1.0)
+    >>> code.tolist(), carried.tolist()  # the last beside a wrap: not carried
+    ([[0, 2, 2]], [[True, True, False]])
     """
     raw, start = kernel_frames(raw, start, digits)
     code, nearest, carried, beyond = _read_levels(
