@@ -48,7 +48,8 @@ CASES = {
     "occlusion": ("mugs-on-wall", DEFAULT, True, 30, (8, 8), "surfaces"),
 }
 METHODS = ["bidirectional", "bidirectional (paper decoder)", "lv", "phase-coding", "graycode",
-           "graycode (shifted)", "graycode (shifted, cyclic)", "multifreq"]
+           "graycode (shifted)", "graycode (shifted, cyclic)", "graycode (4 levels)",
+           "multifreq"]
 # the shifted Gray codes beside the comparable (complementary) one: Wu et al.'s, over
 # fringes + 1 levels, and SLMaster's cyclic one over the fringes
 SHIFTED = {"graycode (shifted)": dict(gray_offset=0.5),
@@ -64,8 +65,17 @@ def case_specs(projector: tuple[int, int], period: int, parts_stairs: tuple[int,
     for label in ("bidirectional", "bidirectional (paper decoder)"):
         spec, options = specs[label]
         specs[label] = (spec.replace(partitions=p, stairs=s), options)
+    return with_graycodes(specs)
+
+
+def with_graycodes(specs):
+    """The rows plus the shifted Gray codes (Wu et al. 2019; SLMaster's cyclic one) and the
+    quaternary one (He et al. 2019, as SLMaster projects it) at the Gray code's period and
+    steps."""
+    gray, _ = specs["graycode"]
     for label, fields in SHIFTED.items():
-        specs[label] = (specs["graycode"][0].replace(complementary=0, **fields), {})
+        specs[label] = (gray.replace(complementary=0, **fields), {})
+    specs["graycode (4 levels)"] = (gray.replace(complementary=0, code_levels=4), {})
     return specs
 
 
@@ -154,7 +164,8 @@ def widths_scene() -> tuple[Scene, list[float]]:
 def sweep(traced, factor: str, values, make_imaging, make_specs=None):
     rows = []
     for value in values:
-        specs = (make_specs or (lambda _: method_specs(PROJECTOR, gamma=2.2)))(value)
+        make = make_specs or (lambda _: with_graycodes(method_specs(PROJECTOR, gamma=2.2)))
+        specs = make(value)
         comp = run(traced, specs, imaging=make_imaging(value))
         for row in comp.rows:
             rows.append({"factor": factor, "value": value, "method": row.label,
@@ -212,7 +223,7 @@ def sweeps(out: Path, camera: tuple[int, int]) -> None:
     rows += sweep(traced, "defocus", [0.5, 1.0, 2.0, 3.0], lambda v: imaging_with(camera_blur=v))
     rows += sweep(traced, "gamma (uncompensated)", [1.0, 1.6, 2.2, 2.8],
                   lambda v: imaging_with(gamma=v),
-                  lambda v: method_specs(PROJECTOR, gamma=1.0))
+                  lambda v: with_graycodes(method_specs(PROJECTOR, gamma=1.0)))
     rows += sweep(traced, "fringes", [30, 17, 11, 8], lambda v: imaging_with(), fringes_specs)
     wscene, widths = widths_scene()
     wtraced = trace(Rig.default(camera_size=camera, projector_size=PROJECTOR), wscene,

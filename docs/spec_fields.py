@@ -19,7 +19,8 @@ def spec_fields_page() -> str:
     base = {f.name for f in dataclasses.fields(BaseSpec)}
     lines = ["# Every spec field", "",
              "Written from the spec classes (`docs/spec_fields.py`). A spec read "
-             "from a file must name every field that shapes the patterns (marked *shapes*); "
+             "from a file must name every field that shapes the patterns (marked *shapes*; those "
+             "added later may be left out and mean what older files meant); "
              "the others may be left out and take their defaults. Numbers may be written as "
              "fractions or with `pi` (`\"1920/58\"`, `\"-2*pi/3\"`); `frames` lists the "
              "captures in order (the method's frame names, and `white`, `black`, `ignore`).",
@@ -30,6 +31,8 @@ def spec_fields_page() -> str:
         default = f.default if f.default is not dataclasses.MISSING else ""
         needed = f.metadata.get("shapes", True) and f.metadata.get("cli", True) is not False
         shapes = "yes" if needed else ""
+        if needed and f.metadata.get("later"):  # added after spec files were written
+            shapes = f"yes (left out: `{f.default!r}`)"
         meaning = f.metadata.get("help", "").replace("|", "\\|")
         name = "frames" if f.name == "frame_order" else f.name
         return f"| `{name}` | `{default!r}` | {shapes} | {meaning} |"

@@ -46,7 +46,10 @@ def field(default: Any, help: str, shapes: bool = True, **cli: Any) -> Any:  # n
 
     ``shapes``: the field decides where the patterns' fringes and codes fall, so a spec read
     from a file must name it (defaults serve only when making new patterns); fields of
-    intensity only (offset, amplitude, gamma, bit depth) may be left out.
+    intensity only (offset, amplitude, gamma, bit depth) may be left out. ``later=True``
+    (among the settings): a field added after spec files were written, whose default is
+    what those files meant: written only when it is not the default, read as the default
+    where a file does not name it.
     """
     return dataclasses.field(default=default, metadata={"help": help, "shapes": shapes, **cli})
 
@@ -214,6 +217,9 @@ class BaseSpec:
         data: dict[str, Any] = {"method": self.method, "version": SPEC_VERSION}
         data.update(dataclasses.asdict(self))
         del data["frame_order"]
+        for f in dataclasses.fields(self):  # (files written before a later field existed)
+            if f.metadata.get("later") and data[f.name] == f.default:
+                del data[f.name]
         for key, value in data.items():
             if isinstance(value, float) and value.is_integer():
                 data[key] = int(value)  # 30, not 30.0
@@ -364,6 +370,8 @@ def check_fields(cls: type[BaseSpec], data: Mapping[str, Any]) -> BaseSpec:
     data = dict(data)
     if version == 1:
         data = {**_V1_DEFAULTS, **data}
+    data = {**{f.name: f.default for f in dataclasses.fields(cls) if f.metadata.get("later")},
+            **data}
     if "frames" in data:
         data["frame_order"] = data.pop("frames")
         if isinstance(data["frame_order"], list) and "white" in data["frame_order"]:

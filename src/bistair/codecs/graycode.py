@@ -88,6 +88,7 @@ from .base import (
 from .graycode_alone import code_alone, measure_alone
 from .graycode_edges import edge_orders
 from .graycode_jit import code_bits, orders_fit, read_orders
+from .graylevels import code_digits, level_patterns, levels_code, order_levels, validate_levels
 
 # The per-pixel evidence a read order needs (:func:`~.graycode_jit.read_orders`; measured
 # in docs/guide/checks.md): a bit clears the noise of its margin by CLEAR_NOISE sigmas (a
@@ -152,10 +153,13 @@ class GrayCodeSpec(PeriodSpec):
     # past the phase's middle, reads order -1: left out) or refused by the frame count
     gray_wrap: int = field(0, "1: the shifted code wraps cyclically over the fringes (the first "
                            "half period and the last share code 0; SLMaster's "
-                           "SinusShiftGrayCodePattern), with gray_offset 0.5; may be left "
-                           "out of a spec file (0)", shapes=False, choices=(0, 1))
+                           "SinusShiftGrayCodePattern), with gray_offset 0.5",
+                           later=True, choices=(0, 1))
     second_period: float = field(0.0, "period of a second N-step set that checks the code's "
                                  "orders next to its edges (0: none)")
+    code_levels: int = field(2, "grey levels of the code: 2, the binary Gray code; L > 2, a "
+                             "base-L reflected Gray code read against the fringes (4: the "
+                             "quaternary code)", later=True)
 
     @property
     def levels(self) -> int:
@@ -167,7 +171,10 @@ class GrayCodeSpec(PeriodSpec):
 
     @property
     def code_bits(self) -> int:
-        """Gray code bits of the fringe count (the complementary pattern adds one)."""
+        """Gray code bits of the fringe count (the complementary pattern adds one); with
+        ``code_levels`` L > 2 the base-L digits of the fringe count."""
+        if self.code_levels != 2:
+            return code_digits(self.fringes, self.code_levels)
         return max(1, int(np.ceil(np.log2(self.levels if not self.complementary
                                           else self.fringes))))
 
@@ -187,6 +194,7 @@ class GrayCodeSpec(PeriodSpec):
         return super().extra_frames()
 
     def validate(self) -> None:
+        validate_levels(self)
         super().validate()
         if self.steps == 0:
             self._validate_alone()
@@ -295,6 +303,8 @@ def encode_columns(spec: GrayCodeSpec) -> np.ndarray:
     >>> (pats[4:, 0, 15::30] > 0.5).astype(int).tolist()  # the bits of fringes 0..7
     [[0, 0, 0, 0, 1, 1, 1, 1], [0, 0, 1, 1, 1, 1, 0, 0], [0, 1, 1, 0, 0, 1, 1, 0]]
     """
+    if spec.code_levels != 2:
+        return along_columns(np.concatenate([shift_patterns(spec), level_patterns(spec)]), spec)
     shifts = shift_patterns(spec)
     second = shift_patterns(spec, spec.second_period) if spec.second_period else shifts[:0]
     n_bits = spec.code_bits + spec.complementary
@@ -362,6 +372,8 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     """
     if spec.steps == 0:
         return code_alone(prepared, spec, fs, min_modulation)
+    if spec.code_levels != 2:
+        return levels_code(prepared, spec, fs)
     n = spec.steps
     start = n * (2 if spec.second_period else 1)
     n_bits = spec.code_bits + spec.complementary
@@ -490,6 +502,8 @@ def order_columns(fs: FringeSet, code: CodeMap, spec: GrayCodeSpec, *,
     info = {"strategy": strategy, "noise": fs.noise,
             "bits": spec.code_bits + spec.complementary}
     read = code.code
+    if strategy == "pixel" and spec.code_levels != 2:
+        return order_levels(fs, code, spec, info)
     if strategy == "pixel":
         # the orders the pixels' own evidence carries (all read ones where it is not judged)
         carried = code.maps.get("carried")
