@@ -237,7 +237,8 @@ class GrayCodeSpec(PeriodSpec):
         >>> spec.replace(gray_offset=0.5, gray_wrap=1).half_period_reading()
         'gray_offset 0 (gray_wrap 0)'
         """
-        if self.steps == 0 or self.complementary or self.second_period:
+        if self.steps == 0 or self.complementary or self.second_period or \
+                self.code_levels != 2:  # (a multi-level code has no shifted twin)
             return ""
         if self.gray_offset:
             plain = self.replace(gray_offset=0.0, gray_wrap=0, frame_order=())
@@ -555,6 +556,26 @@ def part_carried(labels: np.ndarray, first: int, n: int, read: np.ndarray,
     A part is detached where its codes deny its region's order (two surfaces in one
     region); where that denial rests on codes no pixel's evidence carries, the part is a
     misread, not a surface, and is left undecided rather than decoded on it.
+
+    Parameters
+    ----------
+    labels : (H, W) int array
+        Fringe regions, the detached parts numbered from ``first + 1``.
+    first : int
+        The highest label before any part was detached.
+    n : int
+        The highest label.
+    read : (H, W) int array
+        The order each pixel's code reads, negative where it reads none.
+    carried : (H, W) bool array
+        Where the pixel's own evidence carries its read order.
+    share : float
+        The share of a part's read pixels that must carry their code.
+
+    Returns
+    -------
+    (n - first,) bool array
+        Per part (label ``first + 1`` first), whether it is carried.
 
     Examples
     --------

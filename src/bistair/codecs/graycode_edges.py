@@ -78,6 +78,23 @@ def edge_orders(fs: FringeSet, read: np.ndarray, orders: np.ndarray, fringes: in
         (H, W) int32: ``orders`` with the pixels beside the edges given their region's.
     taken : int
         The pixels whose order changed.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.codecs.graycode import code_columns
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=32, period=30, gray_offset=0.5)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> fs = measure_shifts(cols, spec)
+    >>> read = code_columns(cols, spec, fs).code
+    >>> orders = read.copy()
+    >>> orders[:, 42:48] = -1  # beside the code's edge at x = 45: left out
+    >>> read[:16, 44] = 2  # and misread one up in half the rows
+    >>> orders, taken = edge_orders(fs, read, orders, spec.fringes)
+    >>> taken, orders[0, 40:50].tolist() == orders[20, 40:50].tolist() == [1] * 10
+    (192, True)
     """
     read_any = read >= 0
     near = read_any & (np.abs(fs.phi - np.float32(np.pi)) < np.float32(EDGE_BAND))
