@@ -10,7 +10,7 @@ from conftest import cli_run
 
 from bistair.app.simulate_motion import simulate_motion
 from bistair.app.stream import decode_stream
-from bistair.codecs import make_spec
+from bistair.codecs import decode, encode, make_spec
 from bistair.core.motion import compensate, compensate_modulation, window_phases
 from bistair.core.phase import TWO_PI, wrap
 from bistair.errors import BistairError
@@ -47,19 +47,25 @@ def rms_error(phi, truth):
     return float(np.sqrt(np.mean(wrap(phi[both] - truth[both]) ** 2)))
 
 
-def test_a_single_period_spec_loads_and_decode_alone_refuses_it(tmp_path, monkeypatch, capsys):
+def test_a_single_period_spec_loads_and_decode_alone_refuses_it(moving, tmp_path, monkeypatch,
+                                                                 capsys):
     """``patterns multifreq --periods 30`` loads; ``decode`` refuses it in one line that says
-    why (no fringe order) and what to use, and writes nothing."""
+    why (no fringe order) and what to use, and writes nothing: a set of its 4 frames, and a
+    stream of 12 (before counting them against the set's)."""
     pats = tmp_path / "p"
     code, _, _ = cli_run(monkeypatch, capsys, "patterns", "multifreq", "--periods", "30",
                          "--out", pats)
     assert code == 0
     spec = load_spec(pats / "spec.json")
     assert spec.periods == (30,) and spec.single_period and spec.frame_count == 4
-    code, out, err = cli_run(monkeypatch, capsys, "decode", pats, "--out", tmp_path / "d")
-    assert code == 2 and out == "" and len(err.splitlines()) == 1, err
-    assert "gives no fringe order" in err and "decode --window" in err
-    assert "stereo --depth-range" in err and not (tmp_path / "d").exists()
+    for captures in (pats, moving / "multifreq"):
+        code, out, err = cli_run(monkeypatch, capsys, "decode", captures, "--out",
+                                 tmp_path / "d")
+        assert code == 2 and out == "" and len(err.splitlines()) == 1, err
+        assert "gives no fringe order" in err and "decode --window" in err
+        assert "stereo --depth-range" in err and not (tmp_path / "d").exists()
+    with pytest.raises(BistairError, match="gives no fringe order"):  # the library too
+        decode(encode(spec), spec)
     # one period covering the projector is still a decodable set; several still refuse
     assert not make_spec("multifreq", width=300, height=20, periods=(300,)).single_period
     with pytest.raises(BistairError, match="beat"):

@@ -204,6 +204,9 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
         _decode_stream(list(captures), spec_path, out, window, starts, min_modulation,
                        strategy, force, quiet)
         return
+    from .stream import refuse_single_period
+
+    refuse_single_period(list(captures), spec_path)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
                                  ("force", force or None)) if v is not None}
     with Progress(quiet) as say:

@@ -53,7 +53,7 @@ from typing import Any
 
 import numpy as np
 
-from ..codecs.multifreq import MultiFreqSpec, top_phase
+from ..codecs.multifreq import MultiFreqSpec, single_period_refusal, top_phase
 from ..core.captures import full_scale_of, prepare
 from ..core.measure import measure
 from ..core.motion import PhaseStream
@@ -162,6 +162,15 @@ def check_stream_spec(spec: BaseSpec) -> MultiFreqSpec:
     if list(spec.frames) != list(spec.method_frames()):
         raise BistairError(f"{need}; the spec's frame list differs from its shifts in order")
     return spec
+
+
+def refuse_single_period(captures: Captures, spec: BaseSpec | str | Path | None) -> None:
+    """``decode`` without ``--window``: refuse a single-period spec at once, before the
+    frames are counted (a stream has more frames than its set), saying why and what to
+    use instead (:func:`~bistair.codecs.multifreq.single_period_refusal`)."""
+    found = find_spec(captures, spec)
+    if isinstance(found, MultiFreqSpec) and found.single_period:
+        raise BistairError(single_period_refusal(found))
 
 
 def decode_stream(captures: Captures | np.ndarray, spec: BaseSpec | str | Path | None,
