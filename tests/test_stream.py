@@ -175,3 +175,20 @@ def test_simulate_takes_the_streams_steps_and_period(tmp_path, monkeypatch, caps
                                "--out", tmp_path / "bad")
         assert code == 2 and says in err and len(err.splitlines()) == 1, err
         assert not (tmp_path / "bad").exists()
+
+
+def test_one_period_covering_the_projector_gives_the_absolute_phase(tmp_path):
+    """A stream of one period as wide as the projector: its wrapped phase is absolute, so
+    each window writes phase.npy too (the projector column times 2*pi/T), NaN where the
+    modulation is too low."""
+    spec = make_spec("multifreq", width=200, height=16, periods=(200,), steps=4)
+    assert not spec.single_period
+    x = np.arange(200.0)[None, :].repeat(16, 0)
+    lit = np.where(x < 190, 0.4, 0.0)  # the last columns unlit
+    frames = np.stack([0.5 + lit * np.cos(TWO_PI * (x + 0.5) / 200 + np.pi * i / 2)
+                       for i in range(6)])
+    out = decode_stream(frames, spec, tmp_path / "o", "4+1")
+    phase = np.load(out / "0001" / "phase.npy")
+    assert np.isnan(phase[:, 190:]).all()
+    assert np.abs(phase[:, :190] - TWO_PI * (x[:, :190] + 0.5) / 200).max() < 1e-4
+    assert json.loads((out / "0001" / "info.json").read_text())["absolute_phase"] is True
