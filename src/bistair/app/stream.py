@@ -54,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from ..codecs.multifreq import MultiFreqSpec, single_period_refusal, top_phase
-from ..core.captures import full_scale_of, prepare
+from ..core.captures import prepare
 from ..core.measure import measure
 from ..core.motion import PhaseStream
 from ..errors import BistairError
@@ -225,8 +225,10 @@ def decode_stream(captures: Captures | np.ndarray, spec: BaseSpec | str | Path |
     if stack is None:
         say(f"reading {last} of {count} frames")
         stack = read_captures(files[:last] if len(files) > 1 else files)[:last]
-    scale = full_scale_of(stack[:win.frames])
-    first = prepare(stack[:spec.steps], spec.steps, spec.method)
+    first = prepare(stack[:spec.steps], spec.steps, spec.method)  # shape, dtype, scale
+    if stack.dtype.kind == "f" and not np.isfinite(stack).all():
+        raise BistairError("captures contain NaN or infinite values")
+    scale = first.full_scale
     fs = measure(first, 0, spec.steps, min_modulation, check=False, shift_sign=spec.shift_sign,
                  phase_offset=spec.phase_offset)
     threshold = fs.threshold
