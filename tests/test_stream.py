@@ -192,3 +192,13 @@ def test_one_period_covering_the_projector_gives_the_absolute_phase(tmp_path):
     assert np.isnan(phase[:, 190:]).all()
     assert np.abs(phase[:, :190] - TWO_PI * (x[:, :190] + 0.5) / 200).max() < 1e-4
     assert json.loads((out / "0001" / "info.json").read_text())["absolute_phase"] is True
+
+
+def test_a_stream_with_a_nan_frame_is_refused_and_nothing_is_written(tmp_path):
+    spec = make_spec("multifreq", width=200, height=16, periods=(20,), steps=4)
+    x = np.arange(200.0)[None, :].repeat(16, 0)
+    frames = np.stack([0.5 + 0.4 * np.cos(TWO_PI * x / 20 + np.pi * i / 2) for i in range(6)])
+    frames[5, 3, 3] = np.nan  # after the first set
+    with pytest.raises(BistairError, match="NaN or infinite"):
+        decode_stream(frames, spec, tmp_path / "o", "4")
+    assert not (tmp_path / "o").exists()
