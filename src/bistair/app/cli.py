@@ -179,12 +179,19 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
 @click.option("--no-previews", is_flag=True, help="skip the PNG previews")
+@click.option("--window", default=None, metavar="N|N+K",
+              help="a stream of one single-period N-step set whose shift advances one step "
+              "per frame: decode every window of N frames (N+K: motion compensated to order "
+              "K) into OUT/<start>/ (wrapped.npy, modulation.npy, info.json)")
+@click.option("--starts", default=None, metavar="S,S,...",
+              help="with --window: the window starts to write [default: every one]")
 @_force
 @_threads
 @_quiet
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
-           min_modulation: float | None, no_previews: bool, force: bool, quiet: bool) -> None:
+           min_modulation: float | None, no_previews: bool, window: str | None,
+           starts: str | None, force: bool, quiet: bool) -> None:
     """Decode captured images into absolute phase, projector coordinate and fringe order.
 
     CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
@@ -193,6 +200,13 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     from .jobs import decode_folder
     from .progress import Progress
 
+    if window is not None or starts is not None:
+        _decode_stream(list(captures), spec_path, out, window, starts, min_modulation,
+                       strategy, force, quiet)
+        return
+    from .stream import refuse_single_period
+
+    refuse_single_period(list(captures), spec_path)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
                                  ("force", force or None)) if v is not None}
     with Progress(quiet) as say:
@@ -209,6 +223,26 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     else:
         click.echo(f"decoded {result.method}: {int(result.mask.sum())} of {result.mask.size} "
                    f"pixels valid ({100 * result.mask.mean():.1f}%); wrote {out}")
+
+
+def _decode_stream(captures: list[str], spec_path: Path | None, out: str, window: str | None,
+                   starts: str | None, min_modulation: float | None, strategy: str | None,
+                   force: bool, quiet: bool) -> None:
+    """``decode --window``: a stream decoded window by window (:mod:`bistair.app.stream`)."""
+    from .progress import Progress
+    from .stream import decode_stream
+
+    if window is None:
+        raise CliError("--starts needs --window N or N+K")
+    if strategy is not None or force:
+        raise CliError(f"--{'strategy' if strategy is not None else 'force'} does not apply "
+                       "to a stream (--window): it gives the wrapped phase, no fringe order")
+    with Progress(quiet) as say:
+        written = decode_stream(captures, spec_path, out, window, starts, min_modulation,
+                                progress=say)
+    if not quiet:
+        count = sum(1 for p in Path(written).iterdir() if p.is_dir() and p.name.isdigit())
+        click.echo(f"decoded {count} windows of --window {window.strip()}; wrote {out}")
 
 
 @cli.command()

@@ -85,8 +85,14 @@ from .cli_options import (
               help="with --continuous: the stream's length in frames")
 @click.option("--continuous", is_flag=True,
               help="a stream of --frames N whose shift advances one step per frame (frame i "
-              "shows shift i mod 4 of one 4-step set of period 30; --method multifreq; "
-              "OUT/multifreq/0000.png ..., spec.json of that single period)")
+              "shows shift i mod N of one N-step set of one period: --steps, --period; "
+              "--method multifreq; OUT/multifreq/0000.png ..., spec.json of that single "
+              "period)")
+@click.option("--steps", type=int, default=None,
+              help="with --continuous: the stream's phase-shift steps N [default: 4]")
+@click.option("--period", type=float, default=None,
+              help="with --continuous: the stream's fringe period in projector pixels "
+              "[default: 30]")
 @_quiet
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
@@ -94,8 +100,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              compensated: bool, ambient: float, bits: str, seed: int, count: int | None,
              vary: str | None, workers: int | None, scheduler: str | None, no_white: bool,
              both_axes: bool, cameras: int, baseline: float, motion: str | None,
-             motion_of: str, frames: int | None, continuous: bool, spec_path: Path | None,
-             quiet: bool) -> None:
+             motion_of: str, frames: int | None, continuous: bool, steps: int | None,
+             period: float | None, spec_path: Path | None, quiet: bool) -> None:
     """Render a preset scene on the virtual rig: one capture folder per method + the truth.
 
     With --count N, a data set of N scenes (deterministic for a --seed whatever the number
@@ -118,13 +124,17 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
         spec = load_spec(spec_path)
     imaging = dict(read_noise=noise, camera_blur=blur, gamma=gamma, ambient=ambient,
                    bits=int(bits))
+    if not continuous and (steps is not None or period is not None):
+        raise CliError(f"--{'steps' if steps is not None else 'period'} applies to a stream: "
+                       "give --frames N --continuous too")
     if motion is not None or continuous or frames is not None:
         if spec is not None:
             raise CliError("--spec renders a still scene: --motion and --continuous render "
                            "the comparable sets (leave out --spec)")
+        stream = {k: v for k, v in (("steps", steps), ("period", period)) if v is not None}
         _simulate_motion(scene, chosen, out, camera, compensated, seed, count, vary,
                          no_white or both_axes, cameras, baseline, motion, motion_of, frames,
-                         continuous, quiet, imaging)
+                         continuous, quiet, imaging, stream)
         return
     if cameras == 2:
         if no_white or both_axes:
@@ -189,7 +199,8 @@ def _simulate_motion(scene: str | None, methods: list[str], out: Path,
                      camera: tuple[int, int] | None, compensated: bool, seed: int,
                      count: int | None, vary: str | None, boards: bool, cameras: int,
                      baseline: float, motion: str | None, motion_of: str, frames: int | None,
-                     continuous: bool, quiet: bool, imaging: dict[str, Any]) -> None:
+                     continuous: bool, quiet: bool, imaging: dict[str, Any],
+                     stream: dict[str, Any] | None = None) -> None:
     """``bistair simulate --motion`` / ``--frames N --continuous``."""
     from .progress import Progress
     from .simulate_motion import simulate_motion
@@ -206,7 +217,7 @@ def _simulate_motion(scene: str | None, methods: list[str], out: Path,
         simulate_motion(scene, methods, out, motion, moves=motion_of, frames=frames,
                         continuous=continuous, cameras=cameras, baseline=baseline,
                         camera_size=camera, compensated=compensated, progress=say,
-                        seed=seed, **imaging)
+                        seed=seed, **(stream or {}), **imaging)
     if quiet:
         return
     what = (f"a stream of {frames} frames" if continuous

@@ -13,10 +13,11 @@ Every frame is rendered with the scene at its own pose (:mod:`bistair.sim.motion
                                   given, in mm and degrees per frame, what moves),
                                   "reference_frame" (0) and "frames"
 
-``--frames N --continuous`` renders a stream instead: frame ``i`` shows shift ``i mod 4``
-of one 4-step set of period 30 (``OUT/multifreq/0000.png`` ...) and ``spec.json`` is that
-single-period spec (``patterns multifreq --periods 30 --steps 4``: ``decode`` alone
-refuses it; its conventions describe the stream's first frame).
+``--frames N --continuous`` renders a stream instead: frame ``i`` shows shift ``i mod N``
+of one N-step set of one period (``--steps``, ``--period``; 4 and 30 by default;
+``OUT/multifreq/0000.png`` ...) and ``spec.json`` is that single-period spec (``patterns
+multifreq --periods 30 --steps 4``: ``decode`` alone refuses it, ``decode --window``
+decodes it; its conventions describe the stream's first frame).
 
 Examples
 --------
@@ -62,18 +63,21 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
                     motion: str | None, moves: str = "objects", frames: int | None = None,
                     continuous: bool = False, cameras: int = 1, baseline: float = 200.0,
                     camera_size: tuple[int, int] | None = None, compensated: bool = True,
-                    progress: Callable[[str], None] | None = None, **imaging: Any) -> Path:
+                    progress: Callable[[str], None] | None = None, steps: int = STREAM_STEPS,
+                    period: float = STREAM_PERIOD, **imaging: Any) -> Path:
     """Render ``scene`` with its objects (``moves="objects"``) or the whole scene
     (``"scene"``) moving by ``motion`` (:func:`~bistair.sim.motion.parse_motion`) every
-    frame, each method's set or (``continuous``) a stream of ``frames`` frames; see the
-    module docstring for the layout.
+    frame, each method's set or (``continuous``) a stream of ``frames`` frames of one
+    ``steps``-step set of ``period`` (projector pixels); see the module docstring for the
+    layout.
 
     Raises
     ------
     BistairError
         A malformed motion, a stream without ``frames`` (or ``frames`` without
         ``continuous``), a stream of a method other than multifreq or of fewer frames than
-        one set, an unknown scene or method; nothing is written then.
+        one set, steps or a period a stream's spec refuses, an unknown scene or method;
+        nothing is written then.
     """
     say = progress or (lambda stage: None)
     if moves not in ("objects", "scene"):
@@ -87,10 +91,12 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
     if continuous and methods != ["multifreq"]:
         raise BistairError("--continuous renders a single-period N-step stream: give "
                            "--method multifreq alone")
+    if (steps, period) != (STREAM_STEPS, STREAM_PERIOD) and not continuous:
+        raise BistairError("--steps and --period apply to a stream: give --frames N "
+                           "--continuous too")
     if continuous and (isinstance(frames, bool) or not isinstance(frames, int)
-                       or frames < STREAM_STEPS):
-        raise BistairError(f"--frames must be at least {STREAM_STEPS} (one set), got "
-                           f"{frames!r}")
+                       or frames < steps):
+        raise BistairError(f"--frames must be at least {steps} (one set), got {frames!r}")
     if motion is None and not continuous:
         raise BistairError("give --motion (or --frames N --continuous for a stream)")
     if cameras not in (1, 2):
@@ -102,9 +108,9 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
     rig, geometry = preset(scene, **({} if camera_size is None else
                                      {"camera_size": camera_size}))
     if continuous:
-        spec, patterns = stream_patterns(rig.projector.size, gamma)
+        spec, patterns = stream_patterns(rig.projector.size, gamma, steps, period)
         specs = {"multifreq": spec}
-        sets = {"multifreq": patterns[np.arange(frames) % STREAM_STEPS]}
+        sets = {"multifreq": patterns[np.arange(frames) % steps]}
     else:
         chosen = method_specs(rig.projector.size, gamma=gamma, methods=methods)
         specs = {m: s for m, (s, _) in chosen.items()}
@@ -152,28 +158,33 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
     return Path(out)
 
 
-def stream_patterns(projector: tuple[int, int], gamma: float = 1.0
-                    ) -> tuple[dict[str, Any], np.ndarray]:
+def stream_patterns(projector: tuple[int, int], gamma: float = 1.0, steps: int = STREAM_STEPS,
+                    period: float = STREAM_PERIOD) -> tuple[dict[str, Any], np.ndarray]:
     """The stream's single-period spec (as a ``spec.json`` dictionary: ``multifreq``,
-    ``periods`` [30], 4 steps) and its 4 patterns, encoded as a multifreq set encodes its
-    finest period (pre-compensating ``gamma``).
+    ``periods`` [period], ``steps``) and its patterns (pre-compensating ``gamma``).
 
     Examples
     --------
     >>> spec, patterns = stream_patterns((64, 48))
     >>> spec["periods"], spec["steps"], patterns.shape
     ([30], 4, (4, 48, 64))
+    >>> stream_patterns((64, 48), steps=3, period=12.5)[1].shape
+    (3, 48, 64)
     """
     width, height = projector
-    full = make_spec("multifreq", width=width, height=height, gamma=gamma, steps=STREAM_STEPS,
-                     periods=(max(width, STREAM_PERIOD * 2), STREAM_PERIOD))
-    names = full.method_frames()
-    picked = [names.index(f"T{STREAM_PERIOD}-shift-{n}") for n in range(STREAM_STEPS)]
-    data = full.to_dict()
-    data["periods"] = [STREAM_PERIOD]
-    for key in ("unwrap", "frames"):
-        data.pop(key, None)
-    return data, encode(full)[picked]
+    try:
+        spec = make_spec("multifreq", width=width, height=height, gamma=gamma, steps=steps,
+                         periods=(period,))
+    except (TypeError, ValueError) as exc:
+        raise BistairError(f"a stream of --steps {steps!r} and --period {period!r}: "
+                           f"{exc}") from None
+    if not spec.single_period:
+        raise BistairError(f"--period {period:g} covers the {spec.coded_length}-px projector: "
+                           "a stream's period is narrower (its fringe order comes from "
+                           "elsewhere)")
+    data = spec.to_dict()
+    data.pop("frames", None)
+    return data, encode(spec)
 
 
 def _expose_each(traces: list[Trace], patterns: np.ndarray, imaging: Imaging) -> list:

@@ -96,7 +96,7 @@ class MultiFreqSpec(BaseSpec):
 
     def __post_init__(self) -> None:
         if (self.unwrap == "auto" and self.periods and self.orientation != "both"
-                and all(math.isfinite(t) for t in self.periods)):
+                and all(math.isfinite(t) for t in self.periods) and not self.single_period):
             rule = "hierarchical" if covers(max(self.periods), self.coded_length) \
                 else "heterodyne"
             object.__setattr__(self, "unwrap", rule)
@@ -114,6 +114,8 @@ class MultiFreqSpec(BaseSpec):
                                f"({shown})")
         if len(set(self.periods)) != len(self.periods):
             raise BistairError(f"periods must differ, got {self.periods}")
+        if self.single_period and self.unwrap == "auto":
+            return  # a stream's set or stereo's: nothing to unwrap (see single_period)
         if self.unwrap not in ("hierarchical", "heterodyne"):
             raise BistairError(f"unwrap must be hierarchical or heterodyne, got {self.unwrap!r}")
         if self.unwrap == "hierarchical" and not covers(max(self.periods), self.coded_length):
@@ -128,6 +130,38 @@ class MultiFreqSpec(BaseSpec):
     def period(self) -> float:
         """The shortest period, which ``phase`` and ``order`` refer to."""
         return min(self.periods)
+
+    @property
+    def single_period(self) -> bool:
+        """One period narrower than the coded axis (``unwrap`` stays ``auto``): a set that
+        gives the wrapped phase and no fringe order, for a stream (``decode --window``) or
+        two cameras (``stereo --depth-range``); :func:`measure_columns` refuses it alone.
+
+        Examples
+        --------
+        >>> from bistair.codecs import make_spec
+        >>> spec = make_spec("multifreq", width=300, height=32, periods=(30,))
+        >>> spec.single_period, spec.unwrap, spec.frame_count
+        (True, 'auto', 4)
+        """
+        return (len(self.periods) == 1 and self.orientation != "both"
+                and math.isfinite(self.periods[0])
+                and not covers(self.periods[0], self.coded_length))
+
+
+def single_period_refusal(spec: MultiFreqSpec) -> str:
+    """Why a single-period spec does not decode alone, and what to use instead.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> print(single_period_refusal(make_spec("multifreq", width=300, height=32,
+    ...                                       periods=(30,))))  # doctest: +ELLIPSIS
+    one period (30 px on the 300-px coded axis) gives no fringe order: decode a stream ...
+    """
+    return (f"one period ({format_period(spec.periods[0])} px on the {spec.coded_length}-px "
+            f"coded axis) gives no fringe order: decode a stream of it with 'decode --window "
+            f"N' (the wrapped phase), or two cameras' with 'stereo --depth-range'")
 
 
 def encode_columns(spec: MultiFreqSpec) -> np.ndarray:
@@ -238,6 +272,8 @@ def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
     >>> fs.phi.shape, round(float(fs.phi[0, 21]), 3)  # half of the 42-px period
     ((32, 300), 3.142)
     """
+    if spec.single_period:
+        raise BistairError(single_period_refusal(spec))
     i = spec.periods.index(min(spec.periods))
     return measure(prepared, i * spec.steps, spec.steps, min_modulation,
                    shift_sign=spec.shift_sign, phase_offset=spec.phase_offset)
