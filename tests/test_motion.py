@@ -13,6 +13,7 @@ from bistair.core.motion import (
     window_phases,
 )
 from bistair.core.phase import TWO_PI, wrap
+from bistair.errors import BistairError
 
 
 def stream(x, steps, count, speed=0.0, period=30.0, shift_sign=1, phase_offset=0.0):
@@ -101,3 +102,9 @@ def test_refusals():
         window_phases(np.zeros((3, 2, 2)), 4)
     with pytest.raises(ValueError, match="N >= 3"):
         PhaseStream(2)
+    with pytest.raises(BistairError, match="shift_sign must be"):
+        PhaseStream(4, shift_sign=2)
+    stream = PhaseStream(4)
+    stream.push(np.zeros((4, 6)))
+    with pytest.raises(BistairError, match=r"frame 1 is \(4, 5\), the stream's frames are"):
+        stream.push(np.zeros((4, 5)))

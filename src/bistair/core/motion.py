@@ -45,6 +45,7 @@ from math import comb
 
 import numpy as np
 
+from ..errors import BistairError
 from .phase import TWO_PI, phase_of_sums, wrap
 
 
@@ -174,20 +175,20 @@ def compensate(phases: np.ndarray, order: int) -> np.ndarray:
 
     Parameters
     ----------
-    phases : (W, H, W) array
+    phases : (windows, H, W) array
         Consecutive windows' wrapped phases (:func:`window_phases`), ``W > K``.
     order : int
         ``K`` (0: the phases themselves).
 
     Returns
     -------
-    (W - K, H, W) float32
+    (windows - K, H, W) float32
         The compensated phases in ``[0, 2*pi)``; the result for windows ``s .. s+K``
         describes the time ``s + (N+K-1)/2``.
 
     Raises
     ------
-    ValueError
+    BistairError
         Fewer than ``K + 1`` windows, or an order that is not a whole number of 0 or more.
 
     Examples
@@ -199,7 +200,7 @@ def compensate(phases: np.ndarray, order: int) -> np.ndarray:
     _check_order(order)
     level = np.asarray(phases, np.float32)
     if level.shape[0] <= order:
-        raise ValueError(f"order {order} needs {order + 1} windows, got {level.shape[0]}")
+        raise BistairError(f"order {order} needs {order + 1} windows, got {level.shape[0]}")
     for k in range(order):
         level = pair_mean(level[:-1], level[1:], reduce=k == order - 1)
     return level
@@ -210,14 +211,14 @@ def compensate_modulation(mods: np.ndarray, order: int) -> np.ndarray:
 
     Parameters
     ----------
-    mods : (W, H, W) array
+    mods : (windows, H, W) array
         Consecutive windows' modulations (:func:`window_phases`), ``W > K``.
     order : int
         ``K``.
 
     Returns
     -------
-    (W - K, H, W) float32
+    (windows - K, H, W) float32
         The weighted means.
 
     Examples
@@ -259,7 +260,9 @@ class PhaseStream:
                  phase_offset: float = 0.0) -> None:
         _check_order(order)
         if steps < 3:
-            raise ValueError("a stream of N-step windows needs N >= 3")
+            raise BistairError("a stream of N-step windows needs N >= 3")
+        if shift_sign not in (1, -1):
+            raise BistairError(f"shift_sign must be +1 or -1, got {shift_sign}")
         self.steps, self.order = steps, order
         self.shift_sign, self.phase_offset = shift_sign, phase_offset
         shifts = stream_shifts(steps, steps, shift_sign)
@@ -278,10 +281,14 @@ class PhaseStream:
 
     def push(self, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """Add the next frame (copied: the caller may reuse its buffer); the wrapped phase
-        and modulation (float32) of the newest window, compensated to order ``K``, once
-        ``N + K`` frames are in, else None."""
+        and modulation (float32; the modulation in the frames' own units, e.g. 0-255 for
+        uint8 frames) of the newest window, compensated to order ``K``, once ``N + K``
+        frames are in, else None."""
         frame = np.asarray(frame)
         n, k = self.steps, self.count % self.steps
+        if self._num is not None and frame.shape != self._num.shape:
+            raise BistairError(f"frame {self.count} is {frame.shape}, the stream's frames "
+                               f"are {self._num.shape}")
         if self._num is None:
             self._num = np.zeros(frame.shape, np.float64)
             self._den = np.zeros(frame.shape, np.float64)
@@ -320,13 +327,13 @@ class PhaseStream:
 
 def _check_order(order: int) -> None:
     if isinstance(order, bool) or not isinstance(order, int | np.integer) or order < 0:
-        raise ValueError(f"the compensation order must be a whole number of 0 or more, got "
+        raise BistairError(f"the compensation order must be a whole number of 0 or more, got "
                          f"{order!r}")
 
 
 def _check_stream(stack: np.ndarray, steps: int) -> None:
     if steps < 3:
-        raise ValueError("a stream of N-step windows needs N >= 3")
+        raise BistairError("a stream of N-step windows needs N >= 3")
     if stack.ndim < 1 or stack.shape[0] < steps:
-        raise ValueError(f"a stream of {steps}-step windows needs {steps} frames or more, "
+        raise BistairError(f"a stream of {steps}-step windows needs {steps} frames or more, "
                          f"got {stack.shape[0] if stack.ndim else 0}")
