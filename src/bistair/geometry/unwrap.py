@@ -59,8 +59,10 @@ MIN_TOLERANCE = 0.1
 SUPPORT = 1.0
 #: :func:`check_range` refuses when more than this share of the points lies outside.
 MOST_OUTSIDE = 0.5
-#: ... judged on every this-many-th rectified row.
+#: ... judged on every this-many-th rectified row, and only on at least this many points
+#: (and this share of the valid pixels searched): fewer say nothing.
 CHECK_ROWS = 4
+CHECK_POINTS, CHECK_SHARE = 100, 0.005
 
 
 @dataclass
@@ -213,16 +215,18 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
     (about its centre, from half ``low``) that fall outside ``[low, high]``.
 
     Every :data:`CHECK_ROWS`-th rectified row is searched over the wider range; a pixel
-    with one consistent candidate there is a point.
+    with one consistent candidate there is a point. Fewer than :data:`CHECK_POINTS` points
+    (or :data:`CHECK_SHARE` of the valid pixels searched) are not judged: ``share`` 0 and
+    ``depths`` ``None``.
 
     Returns
     -------
     share : float
-        Of the points, those outside the range (0 without points).
+        Of the points, those outside the range (0 when not judged).
     points : int
         The points found.
     depths : tuple of float or None
-        Their 5th and 95th percentile depth (mm), ``None`` without points.
+        Their 5th and 95th percentile depth (mm), ``None`` when not judged.
     """
     width = high - low
     wide = (max(low - width, 0.5 * low), high + width)
@@ -230,8 +234,9 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
     _, _, n_all, z_all = _search(lrect, rrect, rect, calibration, period, tolerance, low,
                                  high, wide, rows, whole=False)
     z = z_all[np.isfinite(z_all)]
-    if not z.size:
-        return 0.0, 0, None
+    searched = int(np.isfinite(lrect[rows]).sum())
+    if z.size < max(CHECK_POINTS, CHECK_SHARE * searched):
+        return 0.0, int(z.size), None
     outside = float(np.mean((z < low) | (z > high)))
     lo, hi = np.percentile(z, [5, 95])
     return outside, int(z.size), (float(lo), float(hi))
@@ -328,7 +333,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         "range_check": {"outside": round(share, 6), "points": points,
                         "depths": None if depths is None else [round(d, 1) for d in depths]},
         "warnings": []}
-    if points and share > MOST_OUTSIDE:
+    if depths is not None and share > MOST_OUTSIDE:
         lo, hi = depths
         message = (f"{100 * share:.0f}% of the points found near the depth range lie outside "
                    f"it ({min_depth:g} to {max_depth:g} mm; they lie at {lo:.0f} to "
@@ -363,3 +368,92 @@ def absolute_phase(unwrapped: Unwrapped, phase: np.ndarray, calibration: StereoC
     absolute = np.full(phase.shape, np.nan, np.float32)
     absolute[rows, cols] = (phi + 2 * np.pi * k).astype(np.float32)
     return absolute, order
+
+
+def is_single_period(spec: Any) -> bool:
+    """Whether a spec is one N-step set of one period (``patterns multifreq --periods T``):
+    what stereo phase unwrapping reads.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> is_single_period(make_spec("multifreq", width=300, height=32, periods=(300, 30)))
+    False
+    """
+    return getattr(spec, "method", None) == "multifreq" and len(spec.periods) == 1
+
+
+def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = None
+               ) -> tuple[np.ndarray, Any]:
+    """The wrapped phase of a single-period capture (NaN where not valid) and its
+    :class:`~bistair.core.measure.FringeSet` (stage 1 of the multi-frequency codec: the one
+    N-step set, in the spec's phase convention)."""
+    from ..core.captures import prepare
+    from ..core.measure import measure
+
+    prepared = prepare(images, spec.frame_count, spec.method)
+    fs = measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
+                 phase_offset=spec.phase_offset)
+    return np.where(fs.valid, fs.phi, np.float32(np.nan)).astype(np.float32), fs
+
+
+def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
+                  calibration: StereoCalibration, min_depth: float, max_depth: float,
+                  force: bool = False, min_modulation: float | None = None,
+                  tolerance: float | None = None) -> Any:
+    """Two cameras' captures of one single-period N-step set to depth by stereo phase
+    unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
+
+    Parameters
+    ----------
+    left_images, right_images : numpy.ndarray
+        ``(frames, height, width)`` captures of each camera (the spec's frames).
+    spec : MultiFreqSpec
+        One period (:func:`is_single_period`), coding the projector columns.
+    calibration : StereoCalibration
+        The cameras and the projector.
+    min_depth, max_depth : float
+        The depth range (left camera frame, mm).
+    force : bool, optional
+        Keep what the depth range check refuses, as a warning in ``info``.
+    min_modulation, tolerance : float, optional
+        The modulation a valid pixel needs (fraction of full scale; by default from the
+        noise) and the phase tolerance (:func:`unwrap_stereo`).
+
+    Returns
+    -------
+    StereoResult
+        ``left``: the left camera's absolute phase and order where a point is decided;
+        ``right``: the right camera's wrapped phase (no order); ``info``: as
+        :func:`unwrap_stereo`'s, with ``matched`` and ``matched_fraction`` (the decided
+        points).
+
+    Raises
+    ------
+    BistairError
+        A spec that is not one period of columns, or what :func:`unwrap_stereo` refuses.
+    """
+    from ..core.result import make_result
+    from .stereo import StereoResult, _grey
+
+    if not is_single_period(spec) or spec.orientation != "columns":
+        raise BistairError("stereo phase unwrapping needs one N-step set of one period "
+                           "coding the projector columns (bistair patterns multifreq "
+                           "--periods T)")
+    period = float(spec.periods[0])
+    maps = [wrapped_of(images, spec, min_modulation) for images in (left_images, right_images)]
+    (lphase, lfs), (rphase, rfs) = maps
+    noise = tuple(float(np.median(fs.phase_noise[fs.valid])) if fs.valid.any() else 0.0
+                  for fs in (lfs, rfs))
+    found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
+                          tolerance, force=force)
+    _, order = absolute_phase(found, lphase, calibration, period)
+    left = make_result(spec.method, np.where(order >= 0, lphase, 0), order, period, lfs.mod,
+                       lfs.avg, wrapped=lphase)
+    right = make_result(spec.method, np.zeros_like(rphase), np.full(rphase.shape, -1),
+                        period, rfs.mod, rfs.avg, wrapped=rphase)
+    info = dict(found.info)
+    info["matched"] = info["decided"]
+    info["matched_fraction"] = info["decided_fraction"]
+    return StereoResult(found.disparity, found.depth, _grey(left, spec.offset), found.mask,
+                        left, right, found.rectification, info)
