@@ -98,6 +98,8 @@ class ProjectorPose:
         import cv2
 
         pts = np.asarray(points, np.float64).reshape(-1, 1, 3)
+        if not len(pts):
+            return np.zeros((0, 2))
         out, _ = cv2.projectPoints(pts, cv2.Rodrigues(self.R)[0], self.T, self.device.K,
                                    self.device.dist)
         return out.reshape(-1, 2)

@@ -214,8 +214,10 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
     """The share of the points found over a range three times as wide as ``[low, high]``
     (about its centre, from half ``low``) that fall outside ``[low, high]``.
 
-    Every :data:`CHECK_ROWS`-th rectified row is searched over the wider range; a pixel
-    with one consistent candidate there is a point. Fewer than :data:`CHECK_POINTS` points
+    Every :data:`CHECK_ROWS`-th rectified row is searched over the wider range; each pixel
+    with a consistent candidate there gives a point, the candidate whose phase agrees best
+    (the true point agrees within the noise; the repeats of the fringes further along the
+    ray drift off, a little, with the distance). Fewer than :data:`CHECK_POINTS` points
     (or :data:`CHECK_SHARE` of the valid pixels searched) are not judged: ``share`` 0 and
     ``depths`` ``None``.
 

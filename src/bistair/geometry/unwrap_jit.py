@@ -91,6 +91,7 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 n_in[i, x] = -1  # of equal phase may lie beyond it, so none is alone
                 n_all[i, x] = -1
                 continue
+            best = math.inf
             for j in range(max(j0, 0), min(j1, wr - 1)):
                 b0, b1 = float(right[y, j]), float(right[y, j + 1])
                 if b0 != b0 or b1 != b1:
@@ -114,13 +115,13 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 u = _projector_column(px, py, pz, kp, dp, rp, tp)
                 if not (-0.5 <= u <= width - 0.5):
                     continue
-                if abs(_wrapped(TWO_PI * u / period - a)) > tolerance:
+                miss = abs(_wrapped(TWO_PI * u / period - a))
+                if miss > tolerance:
                     continue
                 n_all[i, x] += 1
-                if n_all[i, x] == 1:
+                if n_all[i, x] == 1 or miss < best:
                     z_all[i, x] = pz
-                else:
-                    z_all[i, x] = math.nan
+                    best = miss
                 if zmin <= pz <= zmax:
                     n_in[i, x] += 1
                     if n_in[i, x] == 1:
@@ -193,7 +194,8 @@ def unwrap_rows(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift
         ``(rows, W)`` int16: consistent candidates over all disparities searched (-1 as
         ``n_in``).
     z_all : numpy.ndarray
-        ``(rows, W)`` float32: the depth ``z`` of the one such candidate, else NaN.
+        ``(rows, W)`` float32: the depth ``z`` of the consistent candidate whose phase
+        agrees best, NaN without one.
     """
     left = np.ascontiguousarray(left, np.float32)
     right = np.ascontiguousarray(right, np.float32)

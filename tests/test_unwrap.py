@@ -1,0 +1,155 @@
+"""Stereo phase unwrapping (geometry/unwrap.py) against the renderer's truth: one
+single-period four-step set seen by the virtual rig's two cameras (default optics and
+imaging, the projector halfway between the cameras), the order from the projector's pose and
+the depth range."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from bistair.core.phase import phase_shift_patterns
+from bistair.errors import BistairError
+from bistair.geometry.stereo_calibration import (
+    StereoCalibration,
+    load_stereo_calibration,
+    save_stereo_calibration,
+)
+from bistair.geometry.unwrap import (
+    absolute_phase,
+    cross_checked,
+    ghost_spacing,
+    unwrap_stereo,
+    wrapped_of,
+)
+from bistair.sim import preset, trace
+from bistair.sim.render import Imaging, expose
+from bistair.sim.stereo import StereoRig
+
+SIZE = (320, 240)
+
+
+class _Spec:
+    """What :func:`wrapped_of` reads of a single-period spec (four steps, no offset)."""
+
+    method, frame_count, steps, shift_sign, phase_offset = "multifreq", 4, 4, 1, 0.0
+
+
+def _render(scene: str, period: float, projector_at: float = 0.5):
+    """Both cameras' wrapped phase (NaN where not valid), their phase noise, the rig's
+    calibration and the left camera's truth."""
+    rig, geometry = preset(scene, camera_size=SIZE)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             projector_at=projector_at)
+    im = Imaging()
+    pw, ph = rig.projector.size
+    x = np.broadcast_to(np.arange(pw, dtype=float), (ph, pw))
+    patterns = (phase_shift_patterns(x, period, 4) ** (1 / im.gamma)).astype(np.float32)
+    phases, noise, truths = [], [], []
+    for i, side in enumerate(("left", "right")):
+        cam = dataclasses.replace(im, seed=im.seed + i)
+        traced = trace(srig.rig(side), geometry, cam)
+        phase, fs = wrapped_of(expose(traced, patterns, cam), _Spec)
+        phases.append(phase)
+        noise.append(float(np.median(fs.phase_noise[fs.valid])))
+        truths.append(traced.truth)
+    return phases, tuple(noise), StereoCalibration.from_rig(srig), truths[0]
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return _render("sphere-on-plane", 48.0)
+
+
+def _wrong(found, phase, cal, period, truth):
+    """Decided pixels whose absolute phase is off the truth by more than pi (an order
+    off), and the decided pixels."""
+    Phi, order = absolute_phase(found, phase, cal, period)
+    decided = order >= 0
+    err = Phi - 2 * np.pi * truth.coord_x / period
+    return decided & (~np.isfinite(err) | (np.abs(err) > np.pi)), decided, Phi
+
+
+def test_orders_against_the_truth(sphere):
+    """Default optics (projector halfway): at most 0.1% of the decided pixels an order off,
+    every pixel with two or more consistent candidates undecided (NaN), depth on the truth."""
+    (lp, rp), noise, cal, truth = sphere
+    found = unwrap_stereo(lp, rp, cal, 48.0, 460.0, 710.0, noise)
+    wrong, decided, Phi = _wrong(found, lp, cal, 48.0, truth)
+    assert decided.sum() > 0.05 * np.isfinite(lp).sum()
+    assert wrong.sum() <= 0.001 * decided.sum(), (wrong.sum(), decided.sum())
+    assert np.array_equal(decided, found.mask) and np.isnan(found.depth[~decided]).all()
+    assert np.isnan(Phi[~decided]).all()
+    # the undecided on the rectified grid: no disparity where two or more agree
+    assert np.isnan(found.disparity[found.candidates >= 2]).all()
+    assert found.info["undecided"] > 0
+    on = decided & truth.mask
+    assert np.median(np.abs(found.depth[on] - truth.depth[on])) < 0.5
+
+
+def test_off_centre_projector_decides_more():
+    """A projector nearer the left camera lines up with the right camera's fringes less
+    often: more pixels decided, still at most 0.1% an order off."""
+    (lp, rp), noise, cal, truth = _render("sphere-on-plane", 48.0, projector_at=0.3)
+    found = unwrap_stereo(lp, rp, cal, 48.0, 460.0, 710.0, noise)
+    wrong, decided, _ = _wrong(found, lp, cal, 48.0, truth)
+    assert decided.sum() > 0.35 * np.isfinite(lp).sum()
+    assert wrong.sum() <= 0.001 * decided.sum(), (wrong.sum(), decided.sum())
+
+
+def test_a_wrong_depth_range_is_refused(sphere):
+    (lp, rp), noise, cal, _ = sphere
+    with pytest.raises(BistairError, match=r"of the points found near the depth range lie "
+                       r"outside it \(800 to 900 mm; they lie at 7\d\d to"):
+        unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise)
+    found = unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise, force=True)
+    assert "correct --depth-range" in found.info["warnings"][0]
+
+
+def test_what_it_needs(sphere):
+    (lp, rp), noise, cal, _ = sphere
+    with pytest.raises(BistairError, match="needs the projector in the calibration"):
+        unwrap_stereo(lp, rp, cal.replace(projector=None), 48.0, 460.0, 710.0, noise)
+    with pytest.raises(BistairError, match="finite depth range above 0 mm"):
+        unwrap_stereo(lp, rp, cal, 48.0, 0.0, 710.0, noise)
+    with pytest.raises(BistairError, match="320x240 left images, the left captures are"):
+        unwrap_stereo(lp[:, :100], rp, cal, 48.0, 460.0, 710.0, noise)
+
+
+def test_occlusion_is_not_guessed():
+    """A left pixel whose point the right camera does not see finds only wrong candidates;
+    the right camera's own decision at the match does not confirm them."""
+    left = np.float32([[np.nan, 3.0, 5.0, 9.0]])
+    right = np.float32([[3.0, 3.0, 4.0, np.nan]])
+    assert np.isnan(cross_checked(left, right, 0.0)).all()
+    assert cross_checked(np.float32([[np.nan, 3.0, 5.0, 3.0]]), right, 0.0)[0, 3] == 3.0
+
+
+def test_ghost_spacing():
+    # halfway: every second right-camera fringe; a quarter of the way: every fourth
+    half = ghost_spacing(200.0, 100.0, 600.0, 16.0, 2000.0)
+    assert half == pytest.approx(2 * 600 * (16 * 600 / 2000) / 200)
+    assert ghost_spacing(200.0, 50.0, 600.0, 16.0, 2000.0) == pytest.approx(2 * half)
+
+
+def test_calibration_keeps_the_projector(tmp_path):
+    """The projector entry is saved and read back; a file of two cameras alone reads as
+    before (no projector)."""
+    cal = StereoCalibration.from_rig(StereoRig.default(camera_size=(64, 48),
+                                                       projector_size=(128, 80)))
+    path = save_stereo_calibration(cal, tmp_path / "rig.json")
+    back = load_stereo_calibration(path)
+    np.testing.assert_array_equal(back.projector.R, cal.projector.R)
+    np.testing.assert_array_equal(back.projector.T, cal.projector.T)
+    assert back.projector.device.size == (128, 80)
+    data = json.loads(path.read_text())
+    del data["projector"]
+    (tmp_path / "old.json").write_text(json.dumps(data))
+    assert load_stereo_calibration(tmp_path / "old.json").projector is None
+    data["projector"] = {**cal.projector.to_dict(), "R": np.eye(3).tolist()[:2]}
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    with pytest.raises(BistairError, match="'projector.R' must be 3x3"):
+        load_stereo_calibration(tmp_path / "bad.json")
