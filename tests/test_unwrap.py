@@ -153,3 +153,66 @@ def test_calibration_keeps_the_projector(tmp_path):
     (tmp_path / "bad.json").write_text(json.dumps(data))
     with pytest.raises(BistairError, match="'projector.R' must be 3x3"):
         load_stereo_calibration(tmp_path / "bad.json")
+
+
+def _single_period_spec():
+    """A single-period spec, or ``None`` before such a spec loads (issue 34's stream part
+    makes it load; until then the command cannot read one)."""
+    from bistair.codecs import make_spec
+
+    try:
+        return make_spec("multifreq", width=1920, height=1080, periods=(48,))
+    except BistairError:
+        return None
+
+
+@pytest.mark.skipif(_single_period_spec() is None, reason="a single-period spec does not "
+                    "load yet (issue 34's stream part)")
+def test_stereo_command_unwraps_a_single_period_set(tmp_path):
+    """bistair stereo with a single-period spec, the rig's calibration (with the projector)
+    and --depth-range: the depth on the truth, the undecided NaN; refusals in one line."""
+    from click.testing import CliRunner
+
+    from bistair.app.cli import cli
+    from bistair.codecs import encode
+    from bistair.io.atomic import write_image
+
+    spec = _single_period_spec().replace(gamma=2.2)
+    rig, geometry = preset("sphere-on-plane", camera_size=SIZE)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             projector_at=0.3)
+    im, patterns = Imaging(), encode(spec)
+    for i, side in enumerate(("L", "R")):
+        cam = dataclasses.replace(im, seed=im.seed + i)
+        traced = trace(srig.rig("left" if side == "L" else "right"), geometry, cam)
+        (tmp_path / side).mkdir()
+        for k, img in enumerate(expose(traced, patterns, cam)):
+            write_image(tmp_path / side / f"{k:02d}.png", img)
+        (tmp_path / side / "spec.json").write_text(spec.to_json())
+        truth = traced.truth if side == "L" else truth
+    cal = save_stereo_calibration(StereoCalibration.from_rig(srig), tmp_path / "rig.json")
+    run = CliRunner().invoke
+    args = ["stereo", str(tmp_path / "L"), str(tmp_path / "R"), "--calibration", str(cal)]
+    res = run(cli, [*args, "--depth-range", "460:710", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    assert "undecided, two or more candidates agree" in res.output
+    depth = np.load(tmp_path / "out" / "depth.npy")
+    on = np.isfinite(depth) & truth.mask
+    assert on.sum() > 0.35 * truth.mask.sum()
+    assert np.median(np.abs(depth[on] - truth.depth[on])) < 0.5
+    info = json.loads((tmp_path / "out" / "info.json").read_text())
+    assert info["unwrapping"] == "stereo" and info["decided"] == int(np.isfinite(depth).sum())
+    for extra, want in ((["--depth-range", "800:900"], "lie outside it (800 to 900 mm"),
+                        ([], "needs --depth-range ZMIN:ZMAX"),
+                        (["--depth-range", "460:710", "--calibration-x"], "No such option")):
+        out = tmp_path / "refused"
+        res = run(cli, [*args, *extra, "--out", str(out)])
+        assert res.exit_code == 2 and want in res.output, res.output
+        assert not out.exists()
+    data = json.loads(cal.read_text())
+    del data["projector"]
+    (tmp_path / "pair.json").write_text(json.dumps(data))
+    res = run(cli, ["stereo", str(tmp_path / "L"), str(tmp_path / "R"), "--calibration",
+                    str(tmp_path / "pair.json"), "--depth-range", "460:710", "--out",
+                    str(tmp_path / "refused")])
+    assert res.exit_code == 2 and "needs the projector in the calibration" in res.output

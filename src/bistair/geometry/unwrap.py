@@ -61,7 +61,7 @@ SUPPORT = 1.0
 MOST_OUTSIDE = 0.5
 #: ... judged on every this-many-th rectified row, and only on at least this many points
 #: (and this share of the valid pixels searched): fewer say nothing.
-CHECK_ROWS = 4
+CHECK_ROWS = 8
 CHECK_POINTS, CHECK_SHARE = 100, 0.005
 
 

@@ -11,15 +11,17 @@ Two cameras 100 mm apart (``f`` = 100 px) and a projector 25 mm right of the lef
 (the same optics, a period of 8 px) look at a plane 500 mm away (a disparity of 20 px):
 
 >>> import numpy as np
->>> cols = np.arange(48, dtype=np.float32)[None]
+>>> cols = np.arange(80, dtype=np.float32)[None]
 >>> left = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)  # the projector column is x - 5
 >>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)  # the same points 20 px on
 >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
 >>> n_in, disparity, n_all, z_all = unwrap_rows(
 ...     left, right, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k, np.zeros(5),
 ...     np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
->>> int(n_in[0, 30]), round(float(disparity[0, 30]), 4), round(float(z_all[0, 30]), 3)
+>>> int(n_in[0, 50]), round(float(disparity[0, 50]), 4), round(float(z_all[0, 50]), 3)
 (1, 20.0, 500.0)
+>>> int(n_in[0, 30])  # disparities up to 40 would reach past the right row's start
+-1
 
 Four other places of equal phase (disparities 4, 12, 28 and 36) put the point where the
 projector shows another phase.
@@ -41,6 +43,17 @@ TWO_PI = 2.0 * math.pi
 def _wrapped(angle: float) -> float:
     """``angle`` wrapped into ``[-pi, pi)``."""
     return angle - TWO_PI * math.floor((angle + math.pi) / TWO_PI)
+
+
+@_numba_inline
+def _near(difference: float) -> float:
+    """The difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (NaN
+    stays NaN)."""
+    if difference >= math.pi:
+        return difference - TWO_PI
+    if difference < -math.pi:
+        return difference + TWO_PI
+    return difference
 
 
 @_numba_inline
@@ -92,13 +105,14 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 n_all[i, x] = -1
                 continue
             best = math.inf
-            for j in range(max(j0, 0), min(j1, wr - 1)):
-                b0, b1 = float(right[y, j]), float(right[y, j + 1])
-                if b0 != b0 or b1 != b1:
-                    continue
-                e0, e1 = _wrapped(b0 - a), _wrapped(b1 - a)
+            j = max(j0, 0)
+            e1 = _near(float(right[y, j]) - a)  # NaN where unknown
+            for j in range(j, min(j1, wr - 1)):
+                e0 = e1
+                e1 = _near(float(right[y, j + 1]) - a)
+                # a crossing of a (not a wrap, where the difference jumps by 2 pi)
                 if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
-                    continue
+                    continue  # (also when either is NaN)
                 xs = j + e0 / (e0 - e1)
                 d = xs - x - shift if from_right else x - xs - shift
                 xl = ((xs if from_right else x) - cx) / f
