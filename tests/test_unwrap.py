@@ -181,7 +181,7 @@ def test_stereo_command_unwraps_a_single_period_set(tmp_path):
     rig, geometry = preset("sphere-on-plane", camera_size=SIZE)
     srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
                              projector_at=0.3)
-    im, patterns = Imaging(), encode(spec)
+    im, patterns, truths = Imaging(), encode(spec), []
     for i, side in enumerate(("L", "R")):
         cam = dataclasses.replace(im, seed=im.seed + i)
         traced = trace(srig.rig("left" if side == "L" else "right"), geometry, cam)
@@ -189,7 +189,8 @@ def test_stereo_command_unwraps_a_single_period_set(tmp_path):
         for k, img in enumerate(expose(traced, patterns, cam)):
             write_image(tmp_path / side / f"{k:02d}.png", img)
         (tmp_path / side / "spec.json").write_text(spec.to_json())
-        truth = traced.truth if side == "L" else truth
+        truths.append(traced.truth)
+    truth = truths[0]
     cal = save_stereo_calibration(StereoCalibration.from_rig(srig), tmp_path / "rig.json")
     run = CliRunner().invoke
     args = ["stereo", str(tmp_path / "L"), str(tmp_path / "R"), "--calibration", str(cal)]

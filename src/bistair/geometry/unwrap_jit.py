@@ -105,9 +105,9 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 n_all[i, x] = -1
                 continue
             best = math.inf
-            j = max(j0, 0)
-            e1 = _near(float(right[y, j]) - a)  # NaN where unknown
-            for j in range(j, min(j1, wr - 1)):
+            first = max(j0, 0)
+            e1 = _near(float(right[y, first]) - a)  # NaN where unknown
+            for j in range(first, min(j1, wr - 1)):
                 e0 = e1
                 e1 = _near(float(right[y, j + 1]) - a)
                 # a crossing of a (not a wrap, where the difference jumps by 2 pi)
