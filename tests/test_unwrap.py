@@ -100,6 +100,17 @@ def test_off_centre_projector_decides_more():
     assert wrong.sum() <= 0.001 * decided.sum(), (wrong.sum(), decided.sum())
 
 
+def test_a_search_the_other_view_cuts_decides_nothing():
+    """Fine fringes (16 px, some 5 camera pixels each) and a projector nearer the left
+    camera: where the right view ends within a pixel's search, or the right camera does not
+    see its point, a wrong candidate can be the only one found; none of those is decided."""
+    (lp, rp), noise, cal, truth = _render("sphere-on-plane", 16.0, projector_at=0.3)
+    found = unwrap_stereo(lp, rp, cal, 16.0, 460.0, 710.0, noise)
+    wrong, decided, _ = _wrong(found, lp, cal, 16.0, truth)
+    assert decided.sum() > 50 and wrong.sum() == 0, (wrong.sum(), decided.sum())
+    assert (found.candidates == -1).sum() > 0.1 * np.isfinite(lp).sum()
+
+
 def test_a_wrong_depth_range_is_refused(sphere):
     (lp, rp), noise, cal, _ = sphere
     with pytest.raises(BistairError, match=r"of the points found near the depth range lie "
