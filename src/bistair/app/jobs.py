@@ -35,7 +35,8 @@ from ..errors import BistairError
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
-from ..geometry.stereo_calibration import StereoCalibration
+from ..geometry.projection_matrices import import_matrices
+from ..geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.atomic import check_output, output_file, output_folder, write_image
 from ..io.jsonfile import read_json, write_json
@@ -302,9 +303,6 @@ def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Pat
     calibration ``out`` in the left camera's frame
     (:mod:`~bistair.geometry.projection_matrices`). ``files`` may be ``"L,R,P"``. Nothing
     is written on error."""
-    from ..geometry.projection_matrices import import_matrices
-    from ..geometry.stereo_calibration import save_stereo_calibration
-
     if isinstance(files, str):
         files = [f.strip() for f in files.split(",")]
     sizes = []

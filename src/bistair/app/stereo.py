@@ -365,7 +365,8 @@ def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
 
         OUT/<method>/L/, OUT/<method>/R/   each camera's captures and spec.json
         OUT/truth/L/, OUT/truth/R/         each camera's truth (as bistair simulate)
-        OUT/stereo.json                    the cameras' exact calibration
+        OUT/stereo.json                    the cameras' exact calibration, the projector's
+                                           included
         OUT/calibration.json               the left camera and the projector's
         OUT/scene.json                     the scene, rig and imaging
 

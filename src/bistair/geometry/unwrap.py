@@ -44,8 +44,11 @@ from typing import Any
 import cv2
 import numpy as np
 
+from ..core.captures import prepare
+from ..core.measure import FringeSet, measure
+from ..core.result import make_result
 from ..errors import BistairError
-from .stereo import Rectification, rectify
+from .stereo import Rectification, StereoResult, _grey, rectify
 from .stereo_calibration import StereoCalibration
 from .stereo_jit import depth_counts, grid_points
 from .triangulate import check_depth_range
@@ -386,13 +389,10 @@ def is_single_period(spec: Any) -> bool:
 
 
 def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = None
-               ) -> tuple[np.ndarray, Any]:
+               ) -> tuple[np.ndarray, FringeSet]:
     """The wrapped phase of a single-period capture (NaN where not valid) and its
     :class:`~bistair.core.measure.FringeSet` (stage 1 of the multi-frequency codec: the one
     N-step set, in the spec's phase convention)."""
-    from ..core.captures import prepare
-    from ..core.measure import measure
-
     prepared = prepare(images, spec.frame_count, spec.method)
     fs = measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
                  phase_offset=spec.phase_offset)
@@ -402,7 +402,7 @@ def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = Non
 def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
                   calibration: StereoCalibration, min_depth: float, max_depth: float,
                   force: bool = False, min_modulation: float | None = None,
-                  tolerance: float | None = None) -> Any:
+                  tolerance: float | None = None) -> StereoResult:
     """Two cameras' captures of one single-period N-step set to depth by stereo phase
     unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
 
@@ -435,9 +435,6 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     BistairError
         A spec that is not one period of columns, or what :func:`unwrap_stereo` refuses.
     """
-    from ..core.result import make_result
-    from .stereo import StereoResult, _grey
-
     if not is_single_period(spec) or spec.orientation != "columns":
         raise BistairError("stereo phase unwrapping needs one N-step set of one period "
                            "coding the projector columns (bistair patterns multifreq "
