@@ -118,6 +118,9 @@ def test_a_wrong_depth_range_is_refused(sphere):
         unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise)
     found = unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise, force=True)
     assert "correct --depth-range" in found.info["warnings"][0]
+    unchecked = unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise, check=False)
+    assert unchecked.info["range_check"] is None and not unchecked.info["warnings"]
+    np.testing.assert_array_equal(unchecked.depth, found.depth)
 
 
 def test_what_it_needs(sphere):

@@ -60,6 +60,9 @@ TOLERANCE_SIGMAS = 4.0
 MIN_TOLERANCE = 0.1
 #: A decided disparity must be confirmed within this many pixels by the row above or below.
 SUPPORT = 1.0
+#: Decided pixels this close (rectified pixels along the row) to one the right camera does
+#: not confirm are dropped (:func:`_beside_occlusion`).
+EDGE = 2
 #: :func:`check_range` refuses when more than this share of the points lies outside.
 MOST_OUTSIDE = 0.5
 #: ... judged on every this-many-th rectified row, and only on at least this many points
@@ -211,6 +214,18 @@ def _supported(disparity: np.ndarray, support: float) -> np.ndarray:
     return np.where(ok, d, np.float32(np.nan)).astype(np.float32)
 
 
+def _beside_occlusion(disparity: np.ndarray, occluded: np.ndarray, reach: int) -> np.ndarray:
+    """``disparity``, NaN within ``reach`` pixels along the row of an ``occluded`` pixel
+    (one whose point the right camera does not confirm): beside an occlusion, the left ray
+    grazes the occluding surface's silhouette, and a point of that surface that the right
+    camera sees agrees with the pixel's phase as well as the hidden true point would."""
+    near = occluded.copy()
+    for k in range(1, reach + 1):
+        near[:, k:] |= occluded[:, :-k]
+        near[:, :-k] |= occluded[:, k:]
+    return np.where(near, np.float32(np.nan), disparity).astype(np.float32)
+
+
 def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
                 calibration: StereoCalibration, period: float, tolerance: float,
                 low: float, high: float) -> tuple[float, int, tuple[float, float] | None]:
@@ -251,7 +266,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   calibration: StereoCalibration, period: float, min_depth: float,
                   max_depth: float, noise: tuple[float, float] = (0.0, 0.0),
                   tolerance: float | None = None, rectification: Rectification | None = None,
-                  force: bool = False) -> Unwrapped:
+                  force: bool = False, check: bool = True) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -277,6 +292,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     force : bool, optional
         Keep the result when :func:`check_range` would refuse the range (a warning in
         ``info``).
+    check : bool, optional
+        Run :func:`check_range` (about a fifth of the time); a stream of windows of one
+        scene may check its first window alone (``info["range_check"]`` is then ``None``).
 
     Returns
     -------
@@ -310,15 +328,16 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     rect = rectification or rectify(calibration)
     lrect = rectified_phase(left_phase, rect.maps_left)
     rrect = rectified_phase(right_phase, rect.maps_right)
-    share, points, depths = check_range(lrect, rrect, rect, calibration, period, tolerance,
-                                        min_depth, max_depth)
+    share, points, depths = (check_range(lrect, rrect, rect, calibration, period, tolerance,
+                                         min_depth, max_depth) if check else (0.0, 0, None))
     n_in, disparity, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
                                     min_depth, max_depth, (min_depth, max_depth))
     _, from_right, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
                                   min_depth, max_depth, (min_depth, max_depth),
                                   from_right=True)
     crossed = cross_checked(disparity, from_right, rect.shift, SUPPORT)
-    disparity = _supported(crossed, SUPPORT)
+    disparity = _beside_occlusion(_supported(crossed, SUPPORT), np.isfinite(lrect) & (
+        (n_in == 0) | ((n_in == 1) & np.isnan(crossed))), EDGE)
     decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
     depth, mask, outside, per_row, valid = depth_counts(
         disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
@@ -335,8 +354,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
         "tolerance_rad": round(float(tolerance), 6),
         "noise_rad": [round(float(n), 6) for n in noise],
-        "range_check": {"outside": round(share, 6), "points": points,
-                        "depths": None if depths is None else [round(d, 1) for d in depths]},
+        "range_check": None if not check else {
+            "outside": round(share, 6), "points": points,
+            "depths": None if depths is None else [round(d, 1) for d in depths]},
         "warnings": []}
     if depths is not None and share > MOST_OUTSIDE:
         lo, hi = depths
