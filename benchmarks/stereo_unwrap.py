@@ -5,7 +5,8 @@ Every scene rendered by both cameras of the two-camera rig (default imaging: noi
 gamma 2.2 compensated) with one four-step set of one period, the projector halfway between
 the cameras (the rig's default) or at 0.3 of the baseline. The depth range is the truth's
 depths +-10 mm; the share of the valid left pixels decided, and of those an order off
-(absolute phase more than pi off the truth), the range check's share of points outside
+(absolute phase more than pi off the truth, or no truth there: pixels at an object's
+silhouette), and the same on the truth's mask (bistair's score), the range check's share of points outside
 (over 0.5 refuses), and three wrong ranges (just beyond, just before, far beyond): their
 check share, points, decided share and order errors. Time: process CPU of
 :func:`bistair.geometry.unwrap.unwrap_stereo` (min of three rounds) and its ratio to the
@@ -76,22 +77,25 @@ def case(scene: str, camera: tuple[int, int], projector_at: float, period: float
         Phi, order = absolute_phase(found, lp, cal, period)
         decided = order >= 0
         err = Phi - 2 * np.pi * truth.coord_x / period
-        wrong = int((decided & (~np.isfinite(err) | (np.abs(err) > np.pi))).sum())
-        return found.info, int(decided.sum()), wrong
+        wrong = decided & (~np.isfinite(err) | (np.abs(err) > np.pi))
+        on = decided & truth.mask
+        return found.info, int(decided.sum()), int(wrong.sum()), int(on.sum()), int(
+            (wrong & on).sum())
 
     cpu, _ = _cpu(lambda: unwrap_stereo(lp, rp, cal, period, low, high, noise, force=True))
-    info, decided, wrong = scored(low, high)
+    info, decided, wrong, on, wrong_on = scored(low, high)
     check = info["range_check"]
     width = high - low
     others = []
     for lo, hi in ((high + 20, high + 20 + width), (max(low - 20 - width, 50), low - 20),
                    (high + 100, high + 100 + 2 * width)):
-        winfo, wdec, wwrong = scored(lo, hi)
+        winfo, wdec, wwrong, _, _ = scored(lo, hi)
         wc = winfo["range_check"]
         others.append(f"{lo}:{hi} {wc['outside']:.3f}/{wc['points']} "
                       f"{100 * wdec / valid:.1f}% {wwrong}")
     return (f"{scene:17s} at {projector_at} T {period:g} {low}:{high} decided "
-            f"{100 * decided / valid:5.1f}% wrong {wrong} ({100 * wrong / max(decided, 1):.3f}%)"
+            f"{100 * decided / valid:5.1f}% wrong {wrong} ({100 * wrong / max(decided, 1):.3f}%;"
+            f" on the truth's mask {wrong_on} of {on}, {100 * wrong_on / max(on, 1):.3f}%)"
             f" check {check['outside']:.3f}/{check['points']} cpu {cpu:.3f} s "
             f"(x{cpu / base:.0f}) | wrong ranges: " + "; ".join(others))
 
