@@ -7,8 +7,8 @@ the cameras (the rig's default) or at 0.3 of the baseline. The depth range is th
 depths +-10 mm; the share of the valid left pixels decided, and of those an order off
 (absolute phase more than pi off the truth, or no truth there: pixels at an object's
 silhouette), and the same on the truth's mask (bistair's score), the range check's
-share of points outside (over 0.5 refuses), and three wrong ranges (just beyond, just before, far beyond): their
-check share, points, decided share and order errors. Time: process CPU of
+share of points outside (over 0.5 refuses), and three wrong ranges (just beyond, just
+before, far beyond): their check share, points, decided share and order errors. Time: process CPU of
 :func:`bistair.geometry.unwrap.unwrap_stereo` (min of three rounds) and its ratio to the
 wrapped-phase measurement of both cameras in the same run.
 
