@@ -301,7 +301,7 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
 
 
 @cli.command("import-calibration")
-@click.argument("files", nargs=-1, required=True, type=Input())
+@click.argument("files", nargs=-1, type=Input())
 @click.option("--out", "-o", required=True, type=Output(file=True),
               help="calibration file to write (JSON)")
 @click.option("--projector-size", default=None, metavar="WxH",
@@ -317,13 +317,35 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
               "the size keys")
 @click.option("--stereo", is_flag=True, help="two cameras (left first) for 'bistair stereo', "
               "not a camera and a projector")
+@click.option("--projection-matrices", "matrices", default=None,
+              metavar="LEFT,RIGHT,PROJECTOR",
+              help="three 3x4 projection matrices of one world frame (.npy, .txt or .mat "
+              "files; needs --camera-size and --projector-size): a calibration of two "
+              "cameras and the projector in the left camera's frame, no distortion")
 @reports_errors
 def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
-                       camera_size: str | None, keys: str | None, stereo: bool) -> None:
+                       camera_size: str | None, keys: str | None, stereo: bool,
+                       matrices: str | None) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
     R, T map the camera frame to the projector frame; T in millimetres. With --stereo, two
-    cameras: R, T map the left camera's frame to the right one's."""
+    cameras: R, T map the left camera's frame to the right one's. With
+    --projection-matrices (and no FILES), two cameras and the projector from their 3x4
+    matrices P = K [R | t] (X_device = R X_world + t, mm)."""
+    if matrices is not None:
+        from .jobs import import_projection_matrices
+
+        if files or stereo or keys:
+            raise CliError("--projection-matrices takes no FILES, --stereo or --keys")
+        rig = import_projection_matrices(matrices, out, camera_size, projector_size)
+        click.echo(f"cameras {rig.left.width}x{rig.left.height}, baseline "
+                   f"{rig.baseline:.2f} mm, projector {rig.projector.device.width}x"
+                   f"{rig.projector.device.height} at "
+                   f"{float(np.linalg.norm(rig.projector.R.T @ rig.projector.T)):.2f} mm from "
+                   f"the left camera; wrote {out}")
+        return
+    if not files:
+        raise CliError("give the calibration FILES (or --projection-matrices)")
     if stereo:
         from ..geometry.stereo_calibration import short_baseline
         from .stereo import import_stereo_calibration

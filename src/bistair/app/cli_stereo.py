@@ -24,7 +24,8 @@ from .cli_options import Input, Output, _quiet, _strategy, _threads, board_file,
 @click.option("--out", "-o", required=True, type=Output(), help="output folder")
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="keep points with depth z in [MIN, MAX] mm (left camera frame); also "
-              "narrows the search")
+              "narrows the search; needed, holding the whole scene, for a single-period "
+              "spec (stereo phase unwrapping)")
 @click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
               "matches; the decoder's checks where it offers this), as warnings in info.json")
 @_strategy
@@ -46,7 +47,10 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
 
     LEFT, RIGHT: each camera's captures, a folder, a quoted glob pattern or a .npy stack.
     Writes OUT/left/ and OUT/right/ (each decode), disparity.npy, depth.npy, depth.png,
-    cloud.ply (left camera frame, mm) and info.json. The projector needs no calibration."""
+    cloud.ply (left camera frame, mm) and info.json. The projector needs no calibration,
+    except for a single-period spec (patterns multifreq --periods T): its fringe order comes
+    from the projector's pose in the calibration and --depth-range (stereo phase
+    unwrapping); pixels that stay ambiguous are left out."""
     from .jobs import parse_depth_range
     from .progress import Progress
     from .stereo import stereo_folder, warnings
@@ -63,6 +67,14 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     if quiet:
         return
     info = res.info
+    if info.get("unwrapping") == "stereo":
+        click.echo(f"{info['decided']} points from {info['left_decoded']} decoded left pixels "
+                   f"({100 * info['decided_fraction']:.1f}%; by the projector at "
+                   f"{low:g}-{high:g} mm: {info['undecided']} undecided, two or more "
+                   f"candidates agree; {info['no_candidate']} without one; "
+                   f"{info['not_confirmed'] + info['unsupported']} not confirmed by the "
+                   f"right camera or the rows beside); wrote {out}")
+        return
     rejected = info["inconsistent"] + info["ambiguous"] + info["not_monotonic"] + \
         info["other_axis"] + info["alone"]
     within = f" at {low:g}-{high:g} mm" if depth_range else ""

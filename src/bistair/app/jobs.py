@@ -35,6 +35,8 @@ from ..errors import BistairError
 from ..geometry.calibration import Calibration, load_calibration, save_calibration
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
+from ..geometry.projection_matrices import import_matrices
+from ..geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.atomic import check_output, output_file, output_folder, write_image
 from ..io.jsonfile import read_json, write_json
@@ -289,6 +291,28 @@ def import_calibration(files: Sequence[str | Path], out: str | Path,
         keys = parse_keys(keys)
     cal = read_opencv_calibration(list(files), projector_size, camera_size, keys)
     save_calibration(cal, out)
+    return cal
+
+
+def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Path,
+                               camera_size: tuple[int, int] | str | None,
+                               projector_size: tuple[int, int] | str | None
+                               ) -> StereoCalibration:
+    """Read three 3x4 projection matrices (left camera, right camera, projector: ``.npy``,
+    ``.txt`` or ``.mat``, one world frame) and write the two-camera-and-projector
+    calibration ``out`` in the left camera's frame
+    (:mod:`~bistair.geometry.projection_matrices`). ``files`` may be ``"L,R,P"``. Nothing
+    is written on error."""
+    if isinstance(files, str):
+        files = [f.strip() for f in files.split(",")]
+    sizes = []
+    for size, name in ((camera_size, "--camera-size"), (projector_size, "--projector-size")):
+        if size is None:
+            raise BistairError(f"--projection-matrices needs {name} WxH (a matrix does not "
+                               "hold the image size)")
+        sizes.append(parse_size(size, name) if isinstance(size, str) else size)
+    cal = import_matrices(tuple(files), *sizes)
+    save_stereo_calibration(cal, out)
     return cal
 
 

@@ -45,6 +45,7 @@ from ..geometry.stereo_calibration import (
     save_stereo_calibration,
 )
 from ..geometry.stereo_opencv import read_opencv_stereo
+from ..geometry.unwrap import is_single_period, stereo_unwrap
 from ..io.atomic import check_output, output_folder, write_image
 from ..io.jsonfile import write_json
 from ..io.read import (
@@ -111,14 +112,43 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
         except BistairError as exc:
             raise BistairError(f"{name}: {exc}") from None
     (lstack, used), (rstack, _) = stacks
-    say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
-        f"({used.method}) and matching")
-    result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
-                    max_depth=max_depth, force=force, smooth=smooth, **options)
+    if is_single_period(used):
+        say(f"unwrapping 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
+            f"by the projector at {min_depth:g}-{max_depth:g} mm")
+        result = _unwrapped(lstack, rstack, used, calibration, min_depth, max_depth, force,
+                            options)
+    else:
+        say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
+            f"({used.method}) and matching")
+        result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
+                        max_depth=max_depth, force=force, smooth=smooth, **options)
     say(f"writing {int(result.mask.sum())} points")
     with output_folder(out) as tmp:
         write_stereo(result, tmp, previews)
     return result
+
+
+def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
+               calibration: StereoCalibration, min_depth: float, max_depth: float,
+               force: bool, options: dict[str, Any]) -> StereoResult:
+    """Stereo phase unwrapping of a single-period set (:func:`~bistair.geometry.unwrap.
+    stereo_unwrap`): it needs the depth range and the projector in the calibration."""
+    if not (min_depth > 0 and np.isfinite(max_depth)):
+        raise BistairError(f"one period ({spec.periods[0]:g} px) gives no fringe order: "
+                           "stereo phase unwrapping needs --depth-range ZMIN:ZMAX (mm, left "
+                           "camera frame) holding the whole scene")
+    if calibration.projector is None:
+        raise BistairError("one period gives no fringe order: stereo phase unwrapping needs "
+                           "the projector in the calibration (bistair simulate --cameras 2 "
+                           "writes one; or import-calibration --projection-matrices)")
+    unknown = sorted(set(options) - {"min_modulation"})
+    if unknown:
+        raise BistairError(f"stereo phase unwrapping takes no {', '.join(unknown)} option")
+    if lstack.shape != rstack.shape:
+        raise BistairError("left and right captures differ: " + " and ".join(
+            f"{s[0]} frames of {s[2]}x{s[1]}" for s in (lstack.shape, rstack.shape)))
+    return stereo_unwrap(lstack, rstack, spec, calibration, min_depth, max_depth, force,
+                         options.get("min_modulation"))
 
 
 def _same_place(left: Any, right: Any) -> bool:
@@ -335,7 +365,8 @@ def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
 
         OUT/<method>/L/, OUT/<method>/R/   each camera's captures and spec.json
         OUT/truth/L/, OUT/truth/R/         each camera's truth (as bistair simulate)
-        OUT/stereo.json                    the cameras' exact calibration
+        OUT/stereo.json                    the cameras' exact calibration, the projector's
+                                           included
         OUT/calibration.json               the left camera and the projector's
         OUT/scene.json                     the scene, rig and imaging
 

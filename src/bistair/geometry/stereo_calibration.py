@@ -3,7 +3,9 @@
 The two cameras use OpenCV's pinhole model and distortion ``(k1, k2, p1, p2, k3)``
 (:class:`~bistair.geometry.calibration.Device`); ``R, T`` map the left camera's frame to the
 right one's, ``X_right = R @ X_left + T`` (millimetres; what ``cv2.stereoCalibrate``
-returns with the left camera first). The projector is not part of it.
+returns with the left camera first). The projector is optional: matching equal absolute
+phase needs none, stereo phase unwrapping (:mod:`bistair.geometry.unwrap`) needs it, as a
+``projector`` entry with its pose in the left camera's frame, ``X_projector = R @ X_left + T``.
 
 File (JSON): bistair's calibration format with ``"kind": "stereo"``::
 
@@ -14,7 +16,11 @@ File (JSON): bistair's calibration format with ``"kind": "stereo"``::
      "poses": [{"name": ..., "features": n, "left_rms": px, "right_rms": px}, ...],
      "poses_used": n, "poses_total": m, "board": {...},
      "uncertainty": {"left": {"fx": ..., ...}, "right": {...}, "rotation_deg": [...],
-                     "T": [...], "baseline": mm, "noise": {"left": px, "right": px}}}
+                     "T": [...], "baseline": mm, "noise": {"left": px, "right": px}},
+     "projector": {"width": W, "height": H, "K": 3x3, "dist": [...], "R": 3x3, "T": [3]}}
+
+``"projector"`` is absent (or ``null``) in a calibration of the two cameras alone; files
+without it read as before.
 
 A camera-projector calibration (:mod:`bistair.geometry.calibration`, no ``kind`` or
 ``"kind": "camera-projector"``) keeps its own layout; each reader refuses the other kind with
@@ -63,10 +69,60 @@ _SIDES = (("left", "camera"), ("right", "projector"))  # our names, Uncertainty'
 
 
 @dataclass(frozen=True, eq=False)
+class ProjectorPose:
+    """The projector of a two-camera rig: the device and its pose in the left camera's
+    frame, ``X_projector = R @ X_left + T`` (mm).
+
+    Examples
+    --------
+    >>> proj = Device(1280, 800, [[1600.0, 0, 639.5], [0, 1600, 399.5], [0, 0, 1]])
+    >>> pose = ProjectorPose(proj, np.eye(3), [-100.0, 0.0, 0.0])
+    >>> pose.project(np.array([[0.0, 0.0, 800.0]])).round(3).tolist()
+    [[439.5, 399.5]]
+    """
+
+    device: Device
+    R: np.ndarray
+    T: np.ndarray
+
+    def __post_init__(self) -> None:
+        rot = np.asarray(self.R, float).reshape(3, 3)
+        if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-6) or np.linalg.det(rot) < 0:
+            raise BistairError("the projector's 'R' is not a rotation matrix")
+        object.__setattr__(self, "R", rot)
+        object.__setattr__(self, "T", np.asarray(self.T, float).reshape(3))
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Projector pixels ``(N, 2)`` of points ``(N, 3)`` in the left camera's frame
+        (with the projector's distortion, as ``cv2.projectPoints``)."""
+        import cv2
+
+        pts = np.asarray(points, np.float64).reshape(-1, 1, 3)
+        if not len(pts):
+            return np.zeros((0, 2))
+        out, _ = cv2.projectPoints(pts, cv2.Rodrigues(self.R)[0], self.T, self.device.K,
+                                   self.device.dist)
+        return out.reshape(-1, 2)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**self.device.to_dict(), "R": self.R.tolist(), "T": self.T.tolist()}
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ProjectorPose:
+        """The ``projector`` entry of a stereo calibration file (validated)."""
+        entry = data["projector"]
+        if not isinstance(entry, Mapping):
+            raise BistairError("calibration field 'projector' must be an object or null")
+        return cls(_device(data, "projector"), _array(entry, "R", ((3, 3),), "projector."),
+                   _array(entry, "T", ((3,),), "projector."))
+
+
+@dataclass(frozen=True, eq=False)
 class StereoCalibration:
     """Two calibrated cameras; ``X_right = R @ X_left + T`` (mm). ``uncertainty`` holds one
     standard deviation of every quantity (its ``camera`` is the left camera, its
-    ``projector`` the right one)."""
+    ``projector`` the right one). ``projector``: the projector and its pose in the left
+    camera's frame, when known (stereo phase unwrapping needs it)."""
 
     left: Device
     right: Device
@@ -77,6 +133,7 @@ class StereoCalibration:
     board: dict[str, Any] | None = None
     poses_total: int | None = None
     uncertainty: Uncertainty | None = None
+    projector: ProjectorPose | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "R", np.asarray(self.R, float).reshape(3, 3))
@@ -106,13 +163,15 @@ class StereoCalibration:
     @classmethod
     def from_rig(cls, rig: Any) -> StereoCalibration:
         """The exact calibration of a :class:`bistair.sim.stereo.StereoRig` (left camera at
-        the world origin)."""
-        left, right = rig.left, rig.right
+        the world origin), its projector included."""
+        left, right, proj = rig.left, rig.right, rig.projector
         if not (np.allclose(left.R, np.eye(3)) and np.allclose(left.t, 0)):
             raise BistairError("the rig's left camera must sit at the world origin")
         return cls(Device(left.width, left.height, left.K, left.dist_coeffs),
                    Device(right.width, right.height, right.K, right.dist_coeffs),
-                   right.R, right.t)
+                   right.R, right.t,
+                   projector=ProjectorPose(Device(proj.width, proj.height, proj.K,
+                                                  proj.dist_coeffs), proj.R, proj.t))
 
     def to_dict(self) -> dict[str, Any]:
         sigma = None
@@ -121,11 +180,14 @@ class StereoCalibration:
             for ours, theirs in _SIDES:
                 sigma[ours] = sigma.pop(theirs)
                 sigma["noise"][ours] = sigma["noise"].pop(theirs)
-        return {"format": FORMAT, "version": VERSION, "kind": KIND,
+        data = {"format": FORMAT, "version": VERSION, "kind": KIND,
                 "left": self.left.to_dict(), "right": self.right.to_dict(),
                 "R": self.R.tolist(), "T": self.T.tolist(), "baseline": self.baseline,
                 "rms": self.rms, "poses": list(self.poses), "poses_used": len(self.poses),
                 "poses_total": self.poses_total, "board": self.board, "uncertainty": sigma}
+        if self.projector is not None:
+            data["projector"] = self.projector.to_dict()
+        return data
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> StereoCalibration:
@@ -153,10 +215,11 @@ class StereoCalibration:
         elif sigma is not None:
             raise BistairError("calibration field 'uncertainty' must be an object or null")
         rms = data.get("rms")
+        projector = None if data.get("projector") is None else ProjectorPose.from_dict(data)
         return cls(*devices, rot, _array(data, "T", ((3,),)),
                    float(rms) if isinstance(rms, int | float) and math.isfinite(rms) else None,
                    tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"),
-                   sigma)
+                   sigma, projector)
 
 
 def right_centre(R: np.ndarray, T: np.ndarray) -> np.ndarray:

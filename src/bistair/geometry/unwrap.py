@@ -1,0 +1,478 @@
+"""Stereo phase unwrapping: the fringe order of one N-step set from two cameras, the
+projector and a known depth range.
+
+A single-period set gives each camera the wrapped phase alone. With two calibrated cameras
+and the projector's pose (:class:`~.stereo_calibration.ProjectorPose`), the order follows
+from geometry instead of extra patterns:
+
+1. Both cameras' wrapped phases are resampled onto the rectified grids
+   (:func:`rectified_phase`: their cosine and sine, bilinearly, so never across a wrap;
+   a pixel needs its four neighbours valid).
+2. For each left pixel, the places of equal wrapped phase along the right camera's
+   rectified row within the disparities the depth range allows are its candidates; each is
+   triangulated and kept where it projects into the projector at a column whose phase
+   agrees with the left pixel's within ``tolerance`` (:func:`~.unwrap_jit.unwrap_rows`).
+3. A pixel with exactly one consistent candidate in the depth range is decided: its depth
+   comes from that candidate's disparity, its fringe order from the projector column of
+   its point. Pixels with none or with two or more are left undecided (NaN, order -1),
+   never guessed.
+4. :func:`check_range`: when most points the search finds over a wider range (three
+   times as wide, about the same centre) fall outside the depth range, the range is wrong
+   and refused.
+
+What it cannot decide: a candidate repeats wherever the right camera's and the projector's
+fringes line up again along the left pixel's ray. With the projector halfway between the
+cameras, every second fringe of the right camera lines up with one of the projector's, so a
+depth range wider than about two right-camera fringes along the ray
+(:func:`ghost_spacing`) leaves pixels with two consistent candidates: undecided. A projector
+nearer one camera, a longer period or a narrower range decide more pixels. A pixel whose
+point the right camera does not see (occlusion) has no true candidate and is decided only if
+a wrong one happens to agree, which the support of the rows above and below rejects.
+
+Examples
+--------
+>>> round(ghost_spacing(200.0, 100.0, 600.0, 16.0, 2000.0), 1)  # mm along the ray
+28.8
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import cv2
+import numpy as np
+
+from ..core.captures import prepare
+from ..core.measure import FringeSet, measure
+from ..core.result import make_result
+from ..errors import BistairError
+from .stereo import Rectification, StereoResult, _grey, rectify
+from .stereo_calibration import StereoCalibration
+from .stereo_jit import depth_counts, grid_points
+from .triangulate import check_depth_range
+from .unwrap_jit import unwrap_rows
+
+#: The tolerance on the projector's phase is this many times the phase noise of the two
+#: cameras together (at least :data:`MIN_TOLERANCE` radians).
+TOLERANCE_SIGMAS = 4.0
+MIN_TOLERANCE = 0.1
+#: A decided disparity must be confirmed within this many pixels by the row above or below.
+SUPPORT = 1.0
+#: Decided pixels this close (rectified pixels along the row) to one the right camera does
+#: not confirm are dropped (:func:`_beside_occlusion`).
+EDGE = 2
+#: :func:`check_range` refuses when more than this share of the points lies outside.
+MOST_OUTSIDE = 0.5
+#: ... judged on every this-many-th rectified row, and only on at least this many points
+#: (and this share of the valid pixels searched): fewer say nothing.
+CHECK_ROWS = 8
+CHECK_POINTS, CHECK_SHARE = 100, 0.005
+
+
+@dataclass
+class Unwrapped:
+    """What :func:`unwrap_stereo` finds.
+
+    ``disparity``: float32 on the rectified left grid, NaN where undecided; ``depth``
+    (float32 ``z``, mm) and ``mask`` on the left camera's own grid; ``candidates``: int16
+    on the rectified left grid, the consistent candidates in the depth range of each pixel
+    (0: none, 1: decided, 2 or more: left undecided); ``info``: counts and settings.
+    """
+
+    disparity: np.ndarray
+    depth: np.ndarray
+    mask: np.ndarray
+    candidates: np.ndarray
+    rectification: Rectification
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def ghost_spacing(baseline: float, projector_offset: float, depth: float, period: float,
+                  projector_focal: float) -> float:
+    """How far along a left pixel's ray (mm) two candidates that the projector both
+    confirms lie apart, for a surface facing the rig at ``depth``.
+
+    A candidate steps one right-camera fringe for ``depth * s / baseline`` mm along the ray
+    (``s = period * depth / projector_focal``: the fringe's width on the surface), the
+    projector's phase by ``projector_offset / baseline`` of a fringe per step; they line up
+    again after ``q`` steps, the denominator of that ratio (2 for a projector halfway).
+
+    Parameters
+    ----------
+    baseline : float
+        The cameras' distance (mm).
+    projector_offset : float
+        The projector's distance from the left camera along the baseline (mm).
+    depth, period, projector_focal : float
+        The surface's depth (mm), the fringe period and the projector's focal length (px).
+
+    Returns
+    -------
+    float
+        The spacing (mm); a depth range narrower than this decides every pixel it sees.
+    """
+    step = depth * (period * depth / projector_focal) / baseline
+    ratio = abs(projector_offset) / baseline
+    for q in range(1, 9):
+        if abs(q * ratio - round(q * ratio)) < 0.05:
+            return q * step
+    return 9 * step
+
+
+def rectified_phase(phase: np.ndarray, maps: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """A wrapped phase map resampled onto a rectified grid (float32, ``[0, 2*pi)``, NaN
+    where one of the four pixels around the sample is unknown).
+
+    Parameters
+    ----------
+    phase : numpy.ndarray
+        ``(H, W)`` wrapped phase (radians), NaN where unknown.
+    maps : tuple of numpy.ndarray
+        The grid's remap tables (rectified pixel -> camera pixel).
+
+    Returns
+    -------
+    numpy.ndarray
+
+    Examples
+    --------
+    >>> phase = np.float32([[6.2, 0.1, np.nan]])
+    >>> mx, my = np.float32([[0.5, 1.5]]), np.float32([[0.0, 0.0]])
+    >>> out = rectified_phase(phase, (mx, my))
+    >>> round(float(out[0, 0]), 4), bool(np.isnan(out[0, 1]))
+    (0.0084, True)
+    """
+    valid = np.isfinite(phase)
+    ph = np.where(valid, phase, 0).astype(np.float32)
+    planes = [np.where(valid, np.cos(ph), 0).astype(np.float32),
+              np.where(valid, np.sin(ph), 0).astype(np.float32), valid.astype(np.float32)]
+    c, s, w = (cv2.remap(p, maps[0], maps[1], cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_CONSTANT, borderValue=0) for p in planes)
+    out = np.arctan2(s, c).astype(np.float32)
+    out[out < 0] += np.float32(2 * np.pi)
+    out[out >= np.float32(2 * np.pi)] = 0
+    out[w < 0.999] = np.nan
+    return out
+
+
+def _search(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
+            calibration: StereoCalibration, period: float, tolerance: float, low: float,
+            high: float, window: tuple[float, float], rows: np.ndarray | None = None,
+            from_right: bool = False, whole: bool = True
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`~.unwrap_jit.unwrap_rows` over the disparities of depths ``window`` (for
+    the right grid's pixels with ``from_right``)."""
+    proj = calibration.projector
+    lo, hi = rect.disparities(*window)
+    own, other = (rrect, lrect) if from_right else (lrect, rrect)
+    return unwrap_rows(own, other, lo, min(hi, 4.0 * rect.size_right[0]), rect.shift,
+                       rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1.T, proj.device.K,
+                       proj.device.dist, proj.R, proj.T, period, tolerance, low, high,
+                       proj.device.width, rows, from_right, whole)
+
+
+def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
+                  agree: float = 1.0) -> np.ndarray:
+    """The left grid's disparities that the right grid's decision at the matched place
+    confirms (within ``agree`` px at the nearest right pixel), else NaN.
+
+    A left pixel whose point the right camera does not see has no true candidate; a wrong
+    one the projector happens to confirm lands on a right pixel that decided its own,
+    other point.
+
+    Examples
+    --------
+    >>> left = np.float32([[np.nan, 3.0, 3.0, 9.0]])
+    >>> right = np.float32([[3.0, 3.0, 2.0, np.nan]])
+    >>> cross_checked(left, right, 0.0).tolist()
+    [[nan, nan, nan, nan]]
+    >>> cross_checked(np.float32([[np.nan, np.nan, np.nan, 3.0]]), right, 0.0).tolist()
+    [[nan, nan, nan, 3.0]]
+    """
+    h, w = left.shape
+    rows, cols = np.nonzero(np.isfinite(left))
+    d = left[rows, cols]
+    xr = np.rint(cols - shift - d).astype(np.int64)
+    inside = (xr >= 0) & (xr < right.shape[1])
+    ok = np.zeros(d.shape, bool)
+    ok[inside] = np.abs(right[rows[inside], xr[inside]] - d[inside]) <= agree
+    out = np.full((h, w), np.nan, np.float32)
+    out[rows[ok], cols[ok]] = d[ok]
+    return out
+
+
+def _supported(disparity: np.ndarray, support: float) -> np.ndarray:
+    """``disparity`` where the row above or below has a disparity within ``support`` px
+    at the same column (one of them must confirm it), else NaN."""
+    d = disparity
+    ok = np.zeros(d.shape, bool)
+    with np.errstate(invalid="ignore"):
+        ok[1:] |= np.abs(d[1:] - d[:-1]) <= support
+        ok[:-1] |= np.abs(d[:-1] - d[1:]) <= support
+    return np.where(ok, d, np.float32(np.nan)).astype(np.float32)
+
+
+def _beside_occlusion(disparity: np.ndarray, occluded: np.ndarray, reach: int) -> np.ndarray:
+    """``disparity``, NaN within ``reach`` pixels along the row of an ``occluded`` pixel
+    (one whose point the right camera does not confirm): beside an occlusion, the left ray
+    grazes the occluding surface's silhouette, and a point of that surface that the right
+    camera sees agrees with the pixel's phase as well as the hidden true point would."""
+    near = occluded.copy()
+    for k in range(1, reach + 1):
+        near[:, k:] |= occluded[:, :-k]
+        near[:, :-k] |= occluded[:, k:]
+    return np.where(near, np.float32(np.nan), disparity).astype(np.float32)
+
+
+def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
+                calibration: StereoCalibration, period: float, tolerance: float,
+                low: float, high: float) -> tuple[float, int, tuple[float, float] | None]:
+    """The share of the points found over a range three times as wide as ``[low, high]``
+    (about its centre, from half ``low``) that fall outside ``[low, high]``.
+
+    Every :data:`CHECK_ROWS`-th rectified row is searched over the wider range; each pixel
+    with a consistent candidate there gives a point, the candidate whose phase agrees best
+    (the true point agrees within the noise; the repeats of the fringes further along the
+    ray drift off, a little, with the distance). Fewer than :data:`CHECK_POINTS` points
+    (or :data:`CHECK_SHARE` of the valid pixels searched) are not judged: ``share`` 0 and
+    ``depths`` ``None``.
+
+    Returns
+    -------
+    share : float
+        Of the points, those outside the range (0 when not judged).
+    points : int
+        The points found.
+    depths : tuple of float or None
+        Their 5th and 95th percentile depth (mm), ``None`` when not judged.
+    """
+    width = high - low
+    wide = (max(low - width, 0.5 * low), high + width)
+    rows = np.arange(0, lrect.shape[0], CHECK_ROWS, dtype=np.int64)
+    _, _, n_all, z_all = _search(lrect, rrect, rect, calibration, period, tolerance, low,
+                                 high, wide, rows, whole=False)
+    z = z_all[np.isfinite(z_all)]
+    searched = int(np.isfinite(lrect[rows]).sum())
+    if z.size < max(CHECK_POINTS, CHECK_SHARE * searched):
+        return 0.0, int(z.size), None
+    outside = float(np.mean((z < low) | (z > high)))
+    lo, hi = np.percentile(z, [5, 95])
+    return outside, int(z.size), (float(lo), float(hi))
+
+
+def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
+                  calibration: StereoCalibration, period: float, min_depth: float,
+                  max_depth: float, noise: tuple[float, float] = (0.0, 0.0),
+                  tolerance: float | None = None, rectification: Rectification | None = None,
+                  force: bool = False, check: bool = True) -> Unwrapped:
+    """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
+    range (module docstring).
+
+    Parameters
+    ----------
+    left_phase, right_phase : numpy.ndarray
+        ``(H, W)`` wrapped phase ``2*pi*x_p/period`` mod ``2*pi`` of each camera (radians,
+        NaN where unknown), on its own image grid.
+    calibration : StereoCalibration
+        The two cameras and the projector (its ``projector`` entry is needed).
+    period : float
+        The fringe period (projector pixels along its columns).
+    min_depth, max_depth : float
+        The depth range (left camera frame, mm): a finite ``0 < min_depth < max_depth``.
+    noise : tuple of float, optional
+        Each camera's phase noise (radians, a typical pixel's standard deviation).
+    tolerance : float, optional
+        The largest disagreement (radians) of the projector's phase; by default
+        :data:`TOLERANCE_SIGMAS` times the two noises together, at least
+        :data:`MIN_TOLERANCE`.
+    rectification : Rectification, optional
+        :func:`~.stereo.rectify` of ``calibration``, if already made.
+    force : bool, optional
+        Keep the result when :func:`check_range` would refuse the range (a warning in
+        ``info``).
+    check : bool, optional
+        Run :func:`check_range` (about a fifth of the time); a stream of windows of one
+        scene may check its first window alone (``info["range_check"]`` is then ``None``).
+
+    Returns
+    -------
+    Unwrapped
+
+    Raises
+    ------
+    BistairError
+        No projector in the calibration, a depth range that is not finite and positive, a
+        tolerance that is not positive, maps of other sizes than the calibration's, or
+        (without ``force``) a depth range that most points fall outside.
+    """
+    if calibration.projector is None:
+        raise BistairError("stereo phase unwrapping needs the projector in the calibration "
+                           "(its \"projector\" entry: bistair simulate --cameras 2 writes it, "
+                           "import-calibration --projection-matrices makes one)")
+    check_depth_range(min_depth, max_depth)
+    if not (min_depth > 0 and math.isfinite(max_depth)):
+        raise BistairError(f"stereo phase unwrapping needs a finite depth range above 0 mm "
+                           f"(--depth-range ZMIN:ZMAX), got {min_depth:g}:{max_depth:g}")
+    for name, phase, dev in (("left", left_phase, calibration.left),
+                             ("right", right_phase, calibration.right)):
+        if phase.shape != (dev.height, dev.width):
+            raise BistairError(f"the calibration is for {dev.width}x{dev.height} {name} "
+                               f"images, the {name} captures are {phase.shape[1]}x"
+                               f"{phase.shape[0]}")
+    if tolerance is None:
+        tolerance = max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*noise))
+    if not tolerance > 0:
+        raise BistairError(f"the phase tolerance must be positive, got {tolerance}")
+    rect = rectification or rectify(calibration)
+    lrect = rectified_phase(left_phase, rect.maps_left)
+    rrect = rectified_phase(right_phase, rect.maps_right)
+    share, points, depths = (check_range(lrect, rrect, rect, calibration, period, tolerance,
+                                         min_depth, max_depth) if check else (0.0, 0, None))
+    n_in, disparity, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
+                                    min_depth, max_depth, (min_depth, max_depth))
+    _, from_right, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
+                                  min_depth, max_depth, (min_depth, max_depth),
+                                  from_right=True)
+    crossed = cross_checked(disparity, from_right, rect.shift, SUPPORT)
+    disparity = _beside_occlusion(_supported(crossed, SUPPORT), np.isfinite(lrect) & (
+        (n_in == 0) | ((n_in == 1) & np.isnan(crossed))), EDGE)
+    decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
+    depth, mask, outside, per_row, valid = depth_counts(
+        disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
+        min_depth, max_depth)
+    rectified_valid = int(np.isfinite(lrect).sum())
+    info: dict[str, Any] = {
+        "unwrapping": "stereo", "period": period, "depth_range": [min_depth, max_depth],
+        "left_decoded": int(valid), "decided": int(per_row.sum()),
+        "decided_fraction": round(float(per_row.sum() / max(valid, 1)), 6),
+        "rectified_valid": rectified_valid,
+        "no_candidate": int(np.sum(np.isfinite(lrect) & (n_in == 0))),
+        "undecided": int(np.sum(n_in >= 2)),
+        "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed))),
+        "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
+        "tolerance_rad": round(float(tolerance), 6),
+        "noise_rad": [round(float(n), 6) for n in noise],
+        "range_check": None if not check else {
+            "outside": round(share, 6), "points": points,
+            "depths": None if depths is None else [round(d, 1) for d in depths]},
+        "warnings": []}
+    if depths is not None and share > MOST_OUTSIDE:
+        lo, hi = depths
+        message = (f"{100 * share:.0f}% of the points found near the depth range lie outside "
+                   f"it ({min_depth:g} to {max_depth:g} mm; they lie at {lo:.0f} to "
+                   f"{hi:.0f} mm): correct --depth-range")
+        if not force:
+            raise BistairError(message)
+        info["warnings"].append(message)
+    return Unwrapped(disparity, depth, mask, n_in, rect, info)
+
+
+def absolute_phase(unwrapped: Unwrapped, phase: np.ndarray, calibration: StereoCalibration,
+                   period: float) -> tuple[np.ndarray, np.ndarray]:
+    """The left camera's absolute phase and fringe order where :func:`unwrap_stereo`
+    decided a point: the order that puts the wrapped phase nearest the projector column of
+    the point.
+
+    Returns
+    -------
+    Phi : numpy.ndarray
+        ``(H, W)`` float32 absolute phase (radians), NaN where undecided.
+    order : numpy.ndarray
+        ``(H, W)`` int32 fringe order, -1 where undecided.
+    """
+    rect = unwrapped.rectification
+    rows, cols = np.nonzero(unwrapped.mask)
+    points = grid_points(unwrapped.depth, *rect.rays)[rows, cols]
+    u = calibration.projector.project(points)[:, 0]
+    phi = phase[rows, cols].astype(np.float64)
+    k = np.rint((2 * np.pi * u / period - phi) / (2 * np.pi))
+    order = np.full(phase.shape, -1, np.int32)
+    order[rows, cols] = k.astype(np.int32)
+    absolute = np.full(phase.shape, np.nan, np.float32)
+    absolute[rows, cols] = (phi + 2 * np.pi * k).astype(np.float32)
+    return absolute, order
+
+
+def is_single_period(spec: Any) -> bool:
+    """Whether a spec is one N-step set of one period (``patterns multifreq --periods T``):
+    what stereo phase unwrapping reads.
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> is_single_period(make_spec("multifreq", width=300, height=32, periods=(300, 30)))
+    False
+    """
+    return getattr(spec, "method", None) == "multifreq" and len(spec.periods) == 1
+
+
+def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = None
+               ) -> tuple[np.ndarray, FringeSet]:
+    """The wrapped phase of a single-period capture (NaN where not valid) and its
+    :class:`~bistair.core.measure.FringeSet` (stage 1 of the multi-frequency codec: the one
+    N-step set, in the spec's phase convention)."""
+    prepared = prepare(images, spec.frame_count, spec.method)
+    fs = measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
+                 phase_offset=spec.phase_offset)
+    return np.where(fs.valid, fs.phi, np.float32(np.nan)).astype(np.float32), fs
+
+
+def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
+                  calibration: StereoCalibration, min_depth: float, max_depth: float,
+                  force: bool = False, min_modulation: float | None = None,
+                  tolerance: float | None = None) -> StereoResult:
+    """Two cameras' captures of one single-period N-step set to depth by stereo phase
+    unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
+
+    Parameters
+    ----------
+    left_images, right_images : numpy.ndarray
+        ``(frames, height, width)`` captures of each camera (the spec's frames).
+    spec : MultiFreqSpec
+        One period (:func:`is_single_period`), coding the projector columns.
+    calibration : StereoCalibration
+        The cameras and the projector.
+    min_depth, max_depth : float
+        The depth range (left camera frame, mm).
+    force : bool, optional
+        Keep what the depth range check refuses, as a warning in ``info``.
+    min_modulation, tolerance : float, optional
+        The modulation a valid pixel needs (fraction of full scale; by default from the
+        noise) and the phase tolerance (:func:`unwrap_stereo`).
+
+    Returns
+    -------
+    StereoResult
+        ``left``: the left camera's absolute phase and order where a point is decided;
+        ``right``: the right camera's wrapped phase (no order); ``info``: as
+        :func:`unwrap_stereo`'s, with ``matched`` and ``matched_fraction`` (the decided
+        points).
+
+    Raises
+    ------
+    BistairError
+        A spec that is not one period of columns, or what :func:`unwrap_stereo` refuses.
+    """
+    if not is_single_period(spec) or spec.orientation != "columns":
+        raise BistairError("stereo phase unwrapping needs one N-step set of one period "
+                           "coding the projector columns (bistair patterns multifreq "
+                           "--periods T)")
+    period = float(spec.periods[0])
+    maps = [wrapped_of(images, spec, min_modulation) for images in (left_images, right_images)]
+    (lphase, lfs), (rphase, rfs) = maps
+    noise = tuple(float(np.median(fs.phase_noise[fs.valid])) if fs.valid.any() else 0.0
+                  for fs in (lfs, rfs))
+    found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
+                          tolerance, force=force)
+    _, order = absolute_phase(found, lphase, calibration, period)
+    left = make_result(spec.method, np.where(order >= 0, lphase, 0), order, period, lfs.mod,
+                       lfs.avg, wrapped=lphase)
+    right = make_result(spec.method, np.zeros_like(rphase), np.full(rphase.shape, -1),
+                        period, rfs.mod, rfs.avg, wrapped=rphase)
+    info = dict(found.info)
+    info["matched"] = info["decided"]
+    info["matched_fraction"] = info["decided_fraction"]
+    return StereoResult(found.disparity, found.depth, _grey(left, spec.offset), found.mask,
+                        left, right, found.rectification, info)

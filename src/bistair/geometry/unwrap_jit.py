@@ -1,0 +1,226 @@
+"""Compiled pass of stereo phase unwrapping (:mod:`bistair.geometry.unwrap`): for each
+pixel of the rectified left grid, the places of equal wrapped phase along the same row of
+the rectified right grid, each triangulated and checked against the projector.
+
+It runs over rectified rows on every core and has no NumPy twin (the row search has no
+one-pass NumPy form); ``tests/test_unwrap.py`` checks it against the renderer's truth.
+
+Examples
+--------
+Two cameras 100 mm apart (``f`` = 100 px) and a projector 25 mm right of the left camera
+(the same optics, a period of 8 px) look at a plane 500 mm away (a disparity of 20 px):
+
+>>> import numpy as np
+>>> cols = np.arange(80, dtype=np.float32)[None]
+>>> left = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)  # the projector column is x - 5
+>>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)  # the same points 20 px on
+>>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+>>> n_in, disparity, n_all, z_all = unwrap_rows(
+...     left, right, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k, np.zeros(5),
+...     np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
+>>> int(n_in[0, 50]), round(float(disparity[0, 50]), 4), round(float(z_all[0, 50]), 3)
+(1, 20.0, 500.0)
+>>> int(n_in[0, 30])  # disparities up to 40 would reach past the right row's start
+-1
+
+Four other places of equal phase (disparities 4, 12, 28 and 36) put the point where the
+projector shows another phase.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..core.jit import _numba_inline, kernel
+
+prange = range  # numba's prange once the first kernel of this module compiles
+TWO_PI = 2.0 * math.pi
+
+
+@_numba_inline
+def _wrapped(angle: float) -> float:
+    """``angle`` wrapped into ``[-pi, pi)``."""
+    return angle - TWO_PI * math.floor((angle + math.pi) / TWO_PI)
+
+
+@_numba_inline
+def _near(difference: float) -> float:
+    """The difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (NaN
+    stays NaN)."""
+    if difference >= math.pi:
+        return difference - TWO_PI
+    if difference < -math.pi:
+        return difference + TWO_PI
+    return difference
+
+
+@_numba_inline
+def _projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
+                      rp: np.ndarray, tp: np.ndarray) -> float:
+    """The projector column (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of the
+    point ``(px, py, pz)`` of the left camera's frame; NaN behind the projector."""
+    x = rp[0, 0] * px + rp[0, 1] * py + rp[0, 2] * pz + tp[0]
+    y = rp[1, 0] * px + rp[1, 1] * py + rp[1, 2] * pz + tp[1]
+    z = rp[2, 0] * px + rp[2, 1] * py + rp[2, 2] * pz + tp[2]
+    if not z > 0.0:
+        return math.nan
+    x /= z
+    y /= z
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (dp[0] + r2 * (dp[1] + r2 * dp[4]))
+    xd = x * radial + 2.0 * dp[2] * x * y + dp[3] * (r2 + 2.0 * x * x)
+    yd = y * radial + dp[2] * (r2 + 2.0 * y * y) + 2.0 * dp[3] * x * y
+    return kp[0, 0] * xd + kp[0, 1] * yd + kp[0, 2]
+
+
+@kernel(parallel=True)
+def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float,
+            f: float, cx: float, cy: float, tx: float, back: np.ndarray, kp: np.ndarray,
+            dp: np.ndarray, rp: np.ndarray, tp: np.ndarray, period: float, tolerance: float,
+            zmin: float, zmax: float, width: int, rows: np.ndarray, from_right: bool,
+            whole: bool
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    h, wl = left.shape
+    wr = right.shape[1]
+    n = rows.size
+    n_in = np.zeros((n, wl), np.int16)
+    n_all = np.zeros((n, wl), np.int16)
+    disparity = np.full((n, wl), np.nan, np.float32)
+    z_all = np.full((n, wl), np.nan, np.float32)
+    for i in prange(n):
+        y = rows[i]
+        yr = (y - cy) / f
+        for x in range(wl):
+            a = float(left[y, x])
+            if a != a:
+                continue
+            if from_right:  # x is a right pixel, the searched row the left one's
+                j0, j1 = int(math.floor(x + shift + lo)), int(math.ceil(x + shift + hi))
+            else:
+                j0, j1 = int(math.floor(x - shift - hi)), int(math.ceil(x - shift - lo))
+            if whole and (j0 < 0 or j1 > wr - 1):  # the other view ends within the search: a place
+                n_in[i, x] = -1  # of equal phase may lie beyond it, so none is alone
+                n_all[i, x] = -1
+                continue
+            best = math.inf
+            first = max(j0, 0)
+            e1 = _near(float(right[y, first]) - a)  # NaN where unknown
+            for j in range(first, min(j1, wr - 1)):
+                e0 = e1
+                e1 = _near(float(right[y, j + 1]) - a)
+                # a crossing of a (not a wrap, where the difference jumps by 2 pi)
+                if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
+                    continue  # (also when either is NaN)
+                xs = j + e0 / (e0 - e1)
+                d = xs - x - shift if from_right else x - xs - shift
+                xl = ((xs if from_right else x) - cx) / f
+                if not (lo <= d <= hi):
+                    continue
+                zr = -f * tx / d
+                if not zr > 0.0:
+                    continue
+                # the point in the left camera's frame (back = R1.T)
+                qx, qy = xl * zr, yr * zr
+                px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
+                py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
+                pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
+                u = _projector_column(px, py, pz, kp, dp, rp, tp)
+                if not (-0.5 <= u <= width - 0.5):
+                    continue
+                miss = abs(_wrapped(TWO_PI * u / period - a))
+                if miss > tolerance:
+                    continue
+                n_all[i, x] += 1
+                if n_all[i, x] == 1 or miss < best:
+                    z_all[i, x] = pz
+                    best = miss
+                if zmin <= pz <= zmax:
+                    n_in[i, x] += 1
+                    if n_in[i, x] == 1:
+                        disparity[i, x] = d
+                    else:
+                        disparity[i, x] = math.nan
+    return n_in, disparity, n_all, z_all
+
+
+def unwrap_rows(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: float,
+                f: float, cx: float, cy: float, tx: float, back: np.ndarray, kp: np.ndarray,
+                dp: np.ndarray, rp: np.ndarray, tp: np.ndarray, period: float,
+                tolerance: float, zmin: float, zmax: float, width: int,
+                rows: np.ndarray | None = None, from_right: bool = False,
+                whole: bool = True
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates of each rectified left pixel that the projector confirms.
+
+    For a left pixel of wrapped phase ``a``, every place on the same row of the right grid
+    where the right phase passes through ``a`` (between two valid neighbours, not across a
+    wrap) at a disparity ``d = x_l - x_r - shift`` in ``[lo, hi]`` is triangulated
+    (``Z = -f * tx / d``, turned back into the left camera's frame by ``back``) and
+    projected into the projector; it is consistent when the projector's phase there,
+    ``2 * pi * u / period``, is within ``tolerance`` of ``a`` and the column lies on the
+    projector.
+
+    Parameters
+    ----------
+    left, right : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase in ``[0, 2*pi)`` on the rectified grids (the same
+        rows), NaN where unknown.
+    lo, hi : float
+        The disparities searched (rectified pixels).
+    shift, f, cx, cy, tx : float
+        The rectification: ``cx_left - cx_right``, the focal length, the left grid's
+        principal point and the right camera's x in the rectified frame (mm, negative).
+    back : numpy.ndarray
+        ``(3, 3)`` the rectified frame to the left camera's (``R1.T``).
+    kp, dp, rp, tp : numpy.ndarray
+        The projector's intrinsics, distortion (5), rotation and translation from the left
+        camera's frame.
+    period : float
+        The fringe period (projector pixels).
+    tolerance : float
+        The largest phase disagreement (radians) of a consistent candidate.
+    zmin, zmax : float
+        The depth range (left camera frame, mm) a candidate counts in.
+    width : int
+        The projector's width (pixels).
+    rows : numpy.ndarray, optional
+        The rectified rows to search (int64); all by default.
+    from_right : bool, optional
+        Search for the pixels of the right grid instead: ``left`` is then the right
+        camera's rectified phase and ``right`` the left camera's (the same disparity, the
+        same point; the outputs are on the right grid).
+    whole : bool, optional
+        Count a pixel only when its search lies wholly within the other view (-1 in both
+        counts otherwise); ``False`` searches what lies within.
+
+    Returns
+    -------
+    n_in : numpy.ndarray
+        ``(rows, W)`` int16: consistent candidates in the depth range; -1 where the other
+        view ends within the disparities searched (a candidate may lie beyond its border,
+        so none is taken as the only one).
+    disparity : numpy.ndarray
+        ``(rows, W)`` float32: the disparity of the one such candidate, NaN where there is
+        none or several.
+    n_all : numpy.ndarray
+        ``(rows, W)`` int16: consistent candidates over all disparities searched (-1 as
+        ``n_in``).
+    z_all : numpy.ndarray
+        ``(rows, W)`` float32: the depth ``z`` of the consistent candidate whose phase
+        agrees best, NaN without one.
+    """
+    left = np.ascontiguousarray(left, np.float32)
+    right = np.ascontiguousarray(right, np.float32)
+    rows = (np.arange(left.shape[0], dtype=np.int64) if rows is None
+            else np.ascontiguousarray(rows, np.int64))
+
+    def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
+
+    return _unwrap(left, right, float(lo), float(hi), float(shift), float(f), float(cx),
+                   float(cy), float(tx), arr(back, (3, 3)), arr(kp, (3, 3)), arr(dp, (5,)),
+                   arr(rp, (3, 3)), arr(tp, (3,)), float(period), float(tolerance),
+                   float(zmin), float(zmax), int(width), rows, bool(from_right),
+                   bool(whole))

@@ -1,0 +1,233 @@
+"""Stereo phase unwrapping (geometry/unwrap.py) against the renderer's truth: one
+single-period four-step set seen by the virtual rig's two cameras (default optics and
+imaging, the projector halfway between the cameras), the order from the projector's pose and
+the depth range."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from bistair.core.phase import phase_shift_patterns
+from bistair.errors import BistairError
+from bistair.geometry.stereo_calibration import (
+    StereoCalibration,
+    load_stereo_calibration,
+    save_stereo_calibration,
+)
+from bistair.geometry.unwrap import (
+    absolute_phase,
+    cross_checked,
+    ghost_spacing,
+    unwrap_stereo,
+    wrapped_of,
+)
+from bistair.sim import preset, trace
+from bistair.sim.render import Imaging, expose
+from bistair.sim.stereo import StereoRig
+
+SIZE = (320, 240)
+
+
+class _Spec:
+    """What :func:`wrapped_of` reads of a single-period spec (four steps, no offset)."""
+
+    method, frame_count, steps, shift_sign, phase_offset = "multifreq", 4, 4, 1, 0.0
+
+
+def _render(scene: str, period: float, projector_at: float = 0.5):
+    """Both cameras' wrapped phase (NaN where not valid), their phase noise, the rig's
+    calibration and the left camera's truth."""
+    rig, geometry = preset(scene, camera_size=SIZE)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             projector_at=projector_at)
+    im = Imaging()
+    pw, ph = rig.projector.size
+    x = np.broadcast_to(np.arange(pw, dtype=float), (ph, pw))
+    patterns = (phase_shift_patterns(x, period, 4) ** (1 / im.gamma)).astype(np.float32)
+    phases, noise, truths = [], [], []
+    for i, side in enumerate(("left", "right")):
+        cam = dataclasses.replace(im, seed=im.seed + i)
+        traced = trace(srig.rig(side), geometry, cam)
+        phase, fs = wrapped_of(expose(traced, patterns, cam), _Spec)
+        phases.append(phase)
+        noise.append(float(np.median(fs.phase_noise[fs.valid])))
+        truths.append(traced.truth)
+    return phases, tuple(noise), StereoCalibration.from_rig(srig), truths[0]
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return _render("sphere-on-plane", 48.0)
+
+
+def _wrong(found, phase, cal, period, truth):
+    """Decided pixels whose absolute phase is off the truth by more than pi (an order
+    off), and the decided pixels."""
+    Phi, order = absolute_phase(found, phase, cal, period)
+    decided = order >= 0
+    err = Phi - 2 * np.pi * truth.coord_x / period
+    return decided & (~np.isfinite(err) | (np.abs(err) > np.pi)), decided, Phi
+
+
+def test_orders_against_the_truth(sphere):
+    """Default optics (projector halfway): at most 0.1% of the decided pixels an order off,
+    every pixel with two or more consistent candidates undecided (NaN), depth on the truth."""
+    (lp, rp), noise, cal, truth = sphere
+    found = unwrap_stereo(lp, rp, cal, 48.0, 460.0, 710.0, noise)
+    wrong, decided, Phi = _wrong(found, lp, cal, 48.0, truth)
+    assert decided.sum() > 0.05 * np.isfinite(lp).sum()
+    assert wrong.sum() <= 0.001 * decided.sum(), (wrong.sum(), decided.sum())
+    assert np.array_equal(decided, found.mask) and np.isnan(found.depth[~decided]).all()
+    assert np.isnan(Phi[~decided]).all()
+    # the undecided on the rectified grid: no disparity where two or more agree
+    assert np.isnan(found.disparity[found.candidates >= 2]).all()
+    assert found.info["undecided"] > 0
+    on = decided & truth.mask
+    assert np.median(np.abs(found.depth[on] - truth.depth[on])) < 0.5
+
+
+def test_off_centre_projector_decides_more():
+    """A projector nearer the left camera lines up with the right camera's fringes less
+    often: more pixels decided, still at most 0.1% an order off."""
+    (lp, rp), noise, cal, truth = _render("sphere-on-plane", 48.0, projector_at=0.3)
+    found = unwrap_stereo(lp, rp, cal, 48.0, 460.0, 710.0, noise)
+    wrong, decided, _ = _wrong(found, lp, cal, 48.0, truth)
+    assert decided.sum() > 0.35 * np.isfinite(lp).sum()
+    assert wrong.sum() <= 0.001 * decided.sum(), (wrong.sum(), decided.sum())
+
+
+def test_a_search_the_other_view_cuts_decides_nothing():
+    """Fine fringes (16 px, some 5 camera pixels each) and a projector nearer the left
+    camera: where the right view ends within a pixel's search, or the right camera does not
+    see its point, a wrong candidate can be the only one found; none of those is decided."""
+    (lp, rp), noise, cal, truth = _render("sphere-on-plane", 16.0, projector_at=0.3)
+    found = unwrap_stereo(lp, rp, cal, 16.0, 460.0, 710.0, noise)
+    wrong, decided, _ = _wrong(found, lp, cal, 16.0, truth)
+    assert decided.sum() > 50 and wrong.sum() == 0, (wrong.sum(), decided.sum())
+    assert (found.candidates == -1).sum() > 0.1 * np.isfinite(lp).sum()
+
+
+def test_a_wrong_depth_range_is_refused(sphere):
+    (lp, rp), noise, cal, _ = sphere
+    with pytest.raises(BistairError, match=r"of the points found near the depth range lie "
+                       r"outside it \(800 to 900 mm; they lie at 7\d\d to"):
+        unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise)
+    found = unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise, force=True)
+    assert "correct --depth-range" in found.info["warnings"][0]
+    unchecked = unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise, check=False)
+    assert unchecked.info["range_check"] is None and not unchecked.info["warnings"]
+    np.testing.assert_array_equal(unchecked.depth, found.depth)
+
+
+def test_what_it_needs(sphere):
+    (lp, rp), noise, cal, _ = sphere
+    with pytest.raises(BistairError, match="needs the projector in the calibration"):
+        unwrap_stereo(lp, rp, cal.replace(projector=None), 48.0, 460.0, 710.0, noise)
+    with pytest.raises(BistairError, match="finite depth range above 0 mm"):
+        unwrap_stereo(lp, rp, cal, 48.0, 0.0, 710.0, noise)
+    with pytest.raises(BistairError, match="320x240 left images, the left captures are"):
+        unwrap_stereo(lp[:, :100], rp, cal, 48.0, 460.0, 710.0, noise)
+
+
+def test_occlusion_is_not_guessed():
+    """A left pixel whose point the right camera does not see finds only wrong candidates;
+    the right camera's own decision at the match does not confirm them."""
+    left = np.float32([[np.nan, 3.0, 5.0, 9.0]])
+    right = np.float32([[3.0, 3.0, 4.0, np.nan]])
+    assert np.isnan(cross_checked(left, right, 0.0)).all()
+    assert cross_checked(np.float32([[np.nan, 3.0, 5.0, 3.0]]), right, 0.0)[0, 3] == 3.0
+
+
+def test_ghost_spacing():
+    # halfway: every second right-camera fringe; a quarter of the way: every fourth
+    half = ghost_spacing(200.0, 100.0, 600.0, 16.0, 2000.0)
+    assert half == pytest.approx(2 * 600 * (16 * 600 / 2000) / 200)
+    assert ghost_spacing(200.0, 50.0, 600.0, 16.0, 2000.0) == pytest.approx(2 * half)
+
+
+def test_calibration_keeps_the_projector(tmp_path):
+    """The projector entry is saved and read back; a file of two cameras alone reads as
+    before (no projector)."""
+    cal = StereoCalibration.from_rig(StereoRig.default(camera_size=(64, 48),
+                                                       projector_size=(128, 80)))
+    path = save_stereo_calibration(cal, tmp_path / "rig.json")
+    back = load_stereo_calibration(path)
+    np.testing.assert_array_equal(back.projector.R, cal.projector.R)
+    np.testing.assert_array_equal(back.projector.T, cal.projector.T)
+    assert back.projector.device.size == (128, 80)
+    data = json.loads(path.read_text())
+    del data["projector"]
+    (tmp_path / "old.json").write_text(json.dumps(data))
+    assert load_stereo_calibration(tmp_path / "old.json").projector is None
+    data["projector"] = {**cal.projector.to_dict(), "R": np.eye(3).tolist()[:2]}
+    (tmp_path / "bad.json").write_text(json.dumps(data))
+    with pytest.raises(BistairError, match="'projector.R' must be 3x3"):
+        load_stereo_calibration(tmp_path / "bad.json")
+
+
+def _single_period_spec():
+    """A single-period spec, or ``None`` before such a spec loads (issue 34's stream part
+    makes it load; until then the command cannot read one)."""
+    from bistair.codecs import make_spec
+
+    try:
+        return make_spec("multifreq", width=1920, height=1080, periods=(48,))
+    except BistairError:
+        return None
+
+
+@pytest.mark.skipif(_single_period_spec() is None, reason="a single-period spec does not "
+                    "load yet (issue 34's stream part)")
+def test_stereo_command_unwraps_a_single_period_set(tmp_path):
+    """bistair stereo with a single-period spec, the rig's calibration (with the projector)
+    and --depth-range: the depth on the truth, the undecided NaN; refusals in one line."""
+    from click.testing import CliRunner
+
+    from bistair.app.cli import cli
+    from bistair.codecs import encode
+    from bistair.io.atomic import write_image
+
+    spec = _single_period_spec().replace(gamma=2.2)
+    rig, geometry = preset("sphere-on-plane", camera_size=SIZE)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             projector_at=0.3)
+    im, patterns, truths = Imaging(), encode(spec), []
+    for i, side in enumerate(("L", "R")):
+        cam = dataclasses.replace(im, seed=im.seed + i)
+        traced = trace(srig.rig("left" if side == "L" else "right"), geometry, cam)
+        (tmp_path / side).mkdir()
+        for k, img in enumerate(expose(traced, patterns, cam)):
+            write_image(tmp_path / side / f"{k:02d}.png", img)
+        (tmp_path / side / "spec.json").write_text(spec.to_json())
+        truths.append(traced.truth)
+    truth = truths[0]
+    cal = save_stereo_calibration(StereoCalibration.from_rig(srig), tmp_path / "rig.json")
+    run = CliRunner().invoke
+    args = ["stereo", str(tmp_path / "L"), str(tmp_path / "R"), "--calibration", str(cal)]
+    res = run(cli, [*args, "--depth-range", "460:710", "--out", str(tmp_path / "out")])
+    assert res.exit_code == 0, res.output
+    assert "undecided, two or more candidates agree" in res.output
+    depth = np.load(tmp_path / "out" / "depth.npy")
+    on = np.isfinite(depth) & truth.mask
+    assert on.sum() > 0.35 * truth.mask.sum()
+    assert np.median(np.abs(depth[on] - truth.depth[on])) < 0.5
+    info = json.loads((tmp_path / "out" / "info.json").read_text())
+    assert info["unwrapping"] == "stereo" and info["decided"] == int(np.isfinite(depth).sum())
+    for extra, want in ((["--depth-range", "800:900"], "lie outside it (800 to 900 mm"),
+                        ([], "needs --depth-range ZMIN:ZMAX"),
+                        (["--depth-range", "460:710", "--calibration-x"], "No such option")):
+        out = tmp_path / "refused"
+        res = run(cli, [*args, *extra, "--out", str(out)])
+        assert res.exit_code == 2 and want in res.output, res.output
+        assert not out.exists()
+    data = json.loads(cal.read_text())
+    del data["projector"]
+    (tmp_path / "pair.json").write_text(json.dumps(data))
+    res = run(cli, ["stereo", str(tmp_path / "L"), str(tmp_path / "R"), "--calibration",
+                    str(tmp_path / "pair.json"), "--depth-range", "460:710", "--out",
+                    str(tmp_path / "refused")])
+    assert res.exit_code == 2 and "needs the projector in the calibration" in res.output
