@@ -152,6 +152,16 @@ class MultiFreqSpec(BaseSpec):
 def single_period_refusal(spec: MultiFreqSpec) -> str:
     """Why a single-period spec does not decode alone, and what to use instead.
 
+    Parameters
+    ----------
+    spec : MultiFreqSpec
+        A spec of one period narrower than its coded axis.
+
+    Returns
+    -------
+    str
+        The one-line reason, naming the period, the axis and the commands that decode it.
+
     Examples
     --------
     >>> from bistair.codecs import make_spec
