@@ -44,10 +44,13 @@ from ..core.checks import (
     axis_problem,
     convention_problem,
     edge_alignment,
+    edge_jump_problem,
+    edge_steps,
     forcing,
     jump_problem,
     outside_problem,
     refuse,
+    rotated_frames,
     sample_checks,
     sparse_problem,
     swapped_frames,
@@ -325,11 +328,12 @@ class Codec:
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         axis: list[str | None] = [None]
+        seen: dict[str, Any] = {}  # figures the sample's checks judged, for info.json
 
         def on_sample(sample: Sample) -> None:
             """The checks of pass 0's sample, before pass 1 (a Gray code alone, with no
             phase, has no sample: nothing to judge)."""
-            refuse(shift_order_problem(sample, spec))
+            refuse(shift_order_problem(sample, spec, seen=seen))
             axis[0] = axis_problem(sample, spec.orientation)
             if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
                 refuse(axis[0])
@@ -350,8 +354,10 @@ class Codec:
         # the code's maps let go with it once the orders are made (the words narrowed for the
         # result: int8 for up to 127 fringes), the phase noise and the sample too
         words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
+        edge_phase = code.edge_phase
         del code
         fs = replace(fs, sigma=None, sample=None)
+        orders.info.update(seen)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
@@ -360,6 +366,12 @@ class Codec:
             del judged
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
             judge(jump_problem(bad, links, big=big, big_limit=0.02))
+            if edge_phase and getattr(spec, "steps", 0):  # edges mid-fringe: judged there too
+                judged = orders.order if orders.read is None else orders.read
+                _, jumps, across = edge_steps(fs.phi, judged, fs.valid, edge_phase)
+                del judged
+                orders.info.update(edge_links=across, edge_jumps=jumps)
+                judge(edge_jump_problem(jumps, across))
             if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
                 where = ("the code reads pixels beside its edges one order off" if
                          orders.read is None else "the code reads pixels beside its edges "
@@ -427,7 +439,8 @@ def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
     return max((1 << fringes.bit_length()) - 1, cycle or 0)
 
 
-def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) -> str | None:
+def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
+                        seen: dict[str, Any] | None = None) -> str | None:
     """A one-line reason to refuse when two frames of an N-step set look swapped
     (:func:`~bistair.core.checks.swapped_frames`), judged on pass 0's sample: its strong
     pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
@@ -446,6 +459,9 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) ->
         direction of the shifts.
     samples : int, default 20000
         At most how many strong pixels to use.
+    seen : dict, optional
+        Given ``rotated_fit``, the figure the check of a sequence rotated by one frame
+        judged (:func:`~bistair.core.checks.rotated_frames`), where it judged one.
 
     Returns
     -------
@@ -475,6 +491,18 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) ->
         return None
     step = max(1, -(-r.size // samples))
     r, c = r[::step], c[::step]
+    first = next(iter(sets.values()), [])
+    if len(first) >= 4 and first == list(range(len(first))) and len(names) > len(first):
+        way, ratio = rotated_frames(sample.values[:, r, c].astype(np.float64), len(first),
+                                    spec.shift_sign)
+        if seen is not None:
+            seen["rotated_fit"] = round(ratio, 3)
+        if way:  # the whole sequence one frame over: no exchange of two frames explains it
+            return ("the frames look one frame " + ("late: the last one fits as shift-0 "
+                    "(did the capture start a frame late, or a frame go missing at the "
+                    "start?)" if way > 0 else "early: the phase shifts fit from the second "
+                    "frame on (is there an extra frame at the start?)")
+                    + "; check the frame order")
     for members in sets.values():
         if len(members) < 4:
             continue

@@ -495,6 +495,86 @@ def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
     return wrap_step_counts(phi, order, valid, every, reach)
 
 
+def edge_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
+               edge_phase: float) -> tuple[int, int, int]:
+    """How the fringe orders of a code whose edges sit mid-fringe (at wrapped phase
+    ``edge_phase``, not 0: a shifted Gray code's at pi) hold across those edges, where the
+    phase runs on smoothly and the order must not change: :func:`wrap_steps` on the phase
+    turned by ``edge_phase`` and the order plus one past it.
+
+    The wrap check alone cannot see such a code read wrong: its misreads sit at the code's
+    edges, mid-fringe, and the orders on either side of each phase jump come from the same
+    code word. Judge the orders as read (before pixels beside the edges are mended).
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in [0, 2*pi).
+    order : (H, W) int array
+        Fringe orders as read, -1 where invalid.
+    valid : (H, W) bool array
+        Pixels to judge.
+    edge_phase : float
+        The wrapped phase (radians) at the code's edges.
+
+    Returns
+    -------
+    (violations, big violations, places) : tuple of int
+        As :func:`wrap_steps` counts them, at the code's edges: ``big``, orders that change
+        by two or more across an edge (a code read wrong in whole blocks).
+
+    Examples
+    --------
+    >>> x = np.arange(300.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (8, 1)).astype(np.float32)
+    >>> order = np.tile((x // 30).astype(np.int32), (8, 1))
+    >>> ok = np.ones(phi.shape, bool)
+    >>> edge_steps(phi, order, ok, np.pi)
+    (0, 0, 40)
+    >>> blocks = np.where(x % 60 < 45, order, order + 2).astype(np.int32)  # misread blocks
+    >>> edge_steps(phi, np.tile(blocks, (8, 1)), ok, np.pi)
+    (20, 20, 40)
+    """
+    edge = np.float32(edge_phase)
+    turned = (np.asarray(phi, np.float32) - edge) % np.float32(TWO_PI)
+    past = np.where(order >= 0, order + (phi >= edge), -1).astype(np.int32)
+    return wrap_step_counts(turned, past, valid, 2, 3)
+
+
+def edge_jump_problem(big: int, links: int, limit: float = 0.02) -> str | None:
+    """A one-line reason to refuse when a shifted code's orders change by two or more across
+    more than ``limit`` of its own edges where the phase runs on smoothly
+    (:func:`edge_steps`): code frames swapped or a code that does not fit the spec.
+
+    Parameters
+    ----------
+    big : int
+        Code edges across which the orders change by two or more.
+    links : int
+        Code edges judged; with fewer than 200, nothing is said.
+    limit : float
+        Share above which to refuse (right decodes of the rendered scenes: 0.0-0.3%).
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> edge_jump_problem(857, 942)[:52]
+    "the fringe orders jump by whole blocks across 91.0% "
+    >>> edge_jump_problem(1, 942) is None, edge_jump_problem(100, 150) is None
+    (True, True)
+    """
+    if links < 200 or big <= limit * links:
+        return None
+    return (f"the fringe orders jump by whole blocks across {100 * big / links:.1f}% of the "
+            "code's own edges, where the phase runs on smoothly, so the code is misread in "
+            "whole blocks: are code frames swapped (check the frame order), does the spec fit "
+            "the captures (gray_offset, gray_wrap, period), or is there too much noise or "
+            "blur for this code?")
+
+
 def jump_problem(violations: int, links: int, limit: float = 0.1,
                  big: int = 0, big_limit: float = 1.0) -> str | None:
     """A one-line reason to refuse when the fringe orders do not step by one across more
@@ -795,3 +875,59 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
     # of the exchanges that fit about as well, the closest pair is the likely mistake
     close = [pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6]
     return min(close, key=lambda pair: (pair[1] - pair[0], pair))
+
+
+ROTATED = 0.7  # a rotated reading's residual over the set's, under which to refuse
+
+
+def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
+                   limit: float = ROTATED) -> tuple[int, float]:
+    """Whether a capture's frames look rotated by one against the spec: ``samples`` (F,
+    pixels) are every method frame of some pixels, the first ``steps`` of them the N-step
+    set. The set fits a sinusoid worse (residual over 0.2 of the modulation) than it does
+    read from one frame later (frames ``F-1, 0, ..., N-2``: the capture started a frame
+    late, shift-0 grabbed last) or one frame earlier (frames ``1, ..., N``: a frame extra
+    at the start), by the factor ``limit``.
+
+    Parameters
+    ----------
+    samples : (F, pixels) array
+        Every method frame's intensities at some pixels, in the captured order (F > N).
+    steps : int
+        N, the frames of the shift set at the start (4 or more).
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+    limit : float
+        The better rotated reading's residual over the set's under which they look rotated
+        (right captures: 1.2 and over, rendered and real; rotated ones: 0.6 and under;
+        ``benchmarks/check_margins.py``).
+
+    Returns
+    -------
+    way : int
+        +1: the frames look one late (the last frame is shift-0), -1: one early (the first
+        frame is not shift-0), 0: neither.
+    ratio : float
+        The better rotated reading's residual over the set's (``inf`` when not judged).
+
+    Examples
+    --------
+    >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
+    >>> shifts = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
+    >>> code = (np.arange(50)[None] // 7 % 2).repeat(3, 0) * 0.8 + 0.1
+    >>> frames = np.concatenate([shifts, code])
+    >>> rotated_frames(frames, 4)[0], rotated_frames(np.roll(frames, -1, axis=0), 4)[0]
+    (0, 1)
+    >>> rotated_frames(np.roll(frames, 1, axis=0), 4)[0]
+    -1
+    """
+    frames = samples.shape[0]
+    if steps < 4 or frames <= steps:
+        return 0, float("inf")
+    base = fit_residual(samples[:steps], shift_sign)
+    late = fit_residual(samples[[frames - 1, *range(steps - 1)]], shift_sign)
+    early = fit_residual(samples[1:steps + 1], shift_sign)
+    ratio = min(late, early) / max(base, 1e-9)
+    if base <= 0.2 or ratio >= limit:
+        return 0, ratio
+    return (1 if late <= early else -1), ratio
