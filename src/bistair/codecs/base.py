@@ -40,12 +40,15 @@ import numpy as np
 
 from ..core.captures import Prepared, check_min_modulation, prepare
 from ..core.checks import (
+    SWAP_LEAST,
+    SWAPPED,
     EdgeCheck,
     axis_problem,
     convention_problem,
     edge_alignment,
     edge_jump_problem,
     edge_steps,
+    exchange_fits,
     forcing,
     jump_problem,
     outside_problem,
@@ -53,7 +56,6 @@ from ..core.checks import (
     rotated_frames,
     sample_checks,
     sparse_problem,
-    swapped_frames,
     wrap_steps,
 )
 from ..core.measure import FringeSet, measure
@@ -446,8 +448,14 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
     pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
 
     Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
-    or more steps is checked; with fewer than 500 strong pixels in the sample nothing is
-    said.
+    or more steps is checked (:func:`~bistair.core.checks.exchange_fits`: an exchange that
+    fits under ``SWAPPED`` of the set's residual); the first, where it starts the method
+    frames, also against the whole sequence one frame over
+    (:func:`~bistair.core.checks.rotated_frames`: a capture started a frame late or early),
+    named when that fits better than any exchange. With four steps an exchange and the
+    exchange of the other two frames fit alike (one of them also reverses the shifts): both
+    are named.
+    With fewer than 500 strong pixels in the sample nothing is said.
 
     Parameters
     ----------
@@ -460,13 +468,14 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
     samples : int, default 20000
         At most how many strong pixels to use.
     seen : dict, optional
-        Given ``rotated_fit``, the figure the check of a sequence rotated by one frame
-        judged (:func:`~bistair.core.checks.rotated_frames`), where it judged one.
+        Given the first set's figures, where it starts the method frames: ``rotated_fit``
+        (the better reading one frame over, its residual over the set's) and
+        ``exchange_fit`` (the best exchange's, likewise).
 
     Returns
     -------
     str or None
-        The reason naming the two frames, or ``None`` when no pair looks swapped.
+        The reason naming the frames, or ``None`` when the frames look in order.
 
     Examples
     --------
@@ -479,7 +488,10 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
     >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
     >>> swapped = prepare(images, spec.frame_count, spec.method)
     >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
-    'frames shift-0 and shift-1 look swapped'
+    'frames shift-0 and shift-1 look swapped (or shift-2 and shift-3'
+    >>> late = prepare(encode(spec)[[1, 2, 3, 4, 5, 6, 0]], spec.frame_count, spec.method)
+    >>> shift_order_problem(measure_shifts(late, spec).sample, spec)[:40]
+    'the frames look one frame late: the last'
     """
     names = spec.method_frames()
     sets: dict[str, list[int]] = {}
@@ -491,27 +503,29 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
         return None
     step = max(1, -(-r.size // samples))
     r, c = r[::step], c[::step]
-    first = next(iter(sets.values()), [])
-    if len(first) >= 4 and first == list(range(len(first))) and len(names) > len(first):
-        way, ratio = rotated_frames(sample.values[:, r, c].astype(np.float64), len(first),
-                                    spec.shift_sign)
-        if seen is not None:
-            seen["rotated_fit"] = round(ratio, 3)
-        if way:  # the whole sequence one frame over: no exchange of two frames explains it
+    values = sample.values[:, r, c].astype(np.float64)
+    for index, members in enumerate(m for m in sets.values() if len(m) >= 4):
+        base, ratio, pairs = exchange_fits(values[members], spec.shift_sign)
+        way, turned = 0, float("inf")
+        if index == 0 and members == list(range(len(members))) and len(names) > len(members):
+            # the first set at the start: also the whole sequence one frame over
+            way, turned = rotated_frames(values, len(members), spec.shift_sign)
+            if seen is not None:
+                seen.update(rotated_fit=round(turned, 3), exchange_fit=round(ratio, 3))
+        if way and turned < ratio:  # no exchange of two frames explains it as well
             return ("the frames look one frame " + ("late: the last one fits as shift-0 "
                     "(did the capture start a frame late, or a frame go missing at the "
                     "start?)" if way > 0 else "early: the phase shifts fit from the second "
                     "frame on (is there an extra frame at the start?)")
                     + "; check the frame order")
-    for members in sets.values():
-        if len(members) < 4:
-            continue
-        values = sample.values[members][:, r, c].astype(np.float64)
-        pair = swapped_frames(values, spec.shift_sign)
-        if pair is not None:
-            a, b = (names[members[i]] for i in pair)
-            return (f"frames {a} and {b} look swapped: the phase shifts fit a sinusoid three "
-                    "times better exchanged (check the frame order)")
+        if base > SWAP_LEAST and ratio < SWAPPED:
+            a, b = (names[members[i]] for i in pairs[0])
+            other = [p for p in pairs[1:] if not set(p) & set(pairs[0])]
+            also = ("" if len(members) != 4 or not other else " (or {} and {}: with four "
+                    "steps the two fit alike)".format(*(names[members[i]] for i in other[0])))
+            return (f"frames {a} and {b} look swapped{also}: the phase shifts fit a sinusoid "
+                    f"{1 / max(ratio, 1e-3):.1f} times better exchanged (check the frame "
+                    "order)")
     return None
 
 

@@ -532,7 +532,7 @@ def edge_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
     >>> edge_steps(phi, order, ok, np.pi)
     (0, 0, 40)
     >>> blocks = np.where(x % 60 < 45, order, order + 2).astype(np.int32)  # misread blocks
-    >>> edge_steps(phi, np.tile(blocks, (8, 1)), ok, np.pi)
+    >>> edge_steps(phi, blocks, ok, np.pi)
     (20, 20, 40)
     """
     edge = np.float32(edge_phase)
@@ -562,7 +562,7 @@ def edge_jump_problem(big: int, links: int, limit: float = 0.02) -> str | None:
     Examples
     --------
     >>> edge_jump_problem(857, 942)[:52]
-    "the fringe orders jump by whole blocks across 91.0% "
+    'the fringe orders jump by whole blocks across 91.0% '
     >>> edge_jump_problem(1, 942) is None, edge_jump_problem(100, 150) is None
     (True, True)
     """
@@ -832,12 +832,12 @@ def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:
     return float(np.median(rms / np.maximum(mod, 1e-6)))
 
 
-def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] | None:
-    """The two frames of an N-step set (``samples``: (N, pixels), N >= 4) that look swapped:
-    the set fits a sinusoid badly (residual over 0.3 of the modulation) and, with those two
-    exchanged, at least three times better (of equally good exchanges, the nearest pair).
-    ``None`` when the set fits or no exchange helps (an uncompensated gamma leaves a
-    residual that no exchange removes).
+def exchange_fits(samples: np.ndarray, shift_sign: int = 1
+                  ) -> tuple[float, float, list[tuple[int, int]]]:
+    """How much better an N-step set (``samples``: (N, pixels), N >= 4) fits a sinusoid
+    with two of its frames exchanged: the set's residual (:func:`fit_residual`), the best
+    exchange's over it, and the exchanges that fit about as well as the best (within 10%),
+    nearest pairs first.
 
     Parameters
     ----------
@@ -845,6 +845,60 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
         The N-step intensities of some pixels, in the captured frame order.
     shift_sign : int
         The direction the shifts run, +1 or -1.
+
+    Returns
+    -------
+    base : float
+        The set's residual over its modulation.
+    ratio : float
+        The best exchange's residual over ``base`` (``inf`` for N <= 3).
+    pairs : list of (int, int)
+        The 0-based frame pairs ``(i, j)``, ``i < j``, whose exchange fits about as well as
+        the best, nearest first (with four steps an exchange and the exchange of the other
+        two frames fit alike: one of them reverses the shifts).
+
+    Examples
+    --------
+    >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
+    >>> frames = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
+    >>> base, ratio, pairs = exchange_fits(frames[[0, 1, 3, 2]])
+    >>> round(base, 2), ratio < 1e-6, pairs
+    (1.48, True, [(0, 1), (2, 3)])
+    """
+    steps = samples.shape[0]
+    base = fit_residual(samples, shift_sign)
+    if steps <= 3:
+        return base, float("inf"), []
+    tried = {}
+    for i in range(steps):
+        for j in range(i + 1, steps):
+            order = np.arange(steps)
+            order[[i, j]] = order[[j, i]]
+            tried[(i, j)] = fit_residual(samples[order], shift_sign)
+    best = min(tried.values())
+    close = sorted((pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6),
+                   key=lambda pair: (pair[1] - pair[0], pair))
+    return base, best / max(base, 1e-9), close
+
+
+def swapped_frames(samples: np.ndarray, shift_sign: int = 1, limit: float = 1 / 3,
+                   least: float = 0.3) -> tuple[int, int] | None:
+    """The two frames of an N-step set (``samples``: (N, pixels), N >= 4) that look swapped:
+    the set fits a sinusoid badly (residual over ``least`` of the modulation) and, with
+    those two exchanged, better by the factor ``limit`` (three times by default; of equally
+    good exchanges, the nearest pair). ``None`` when the set fits or no exchange helps (an
+    uncompensated gamma leaves a residual that no exchange removes).
+
+    Parameters
+    ----------
+    samples : (N, pixels) array
+        The N-step intensities of some pixels, in the captured frame order.
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+    limit : float
+        The best exchange's residual over the set's under which the frames look swapped.
+    least : float
+        The set's residual over which it is judged.
 
     Returns
     -------
@@ -858,26 +912,22 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
     >>> swapped_frames(frames) is None, swapped_frames(frames[[0, 2, 1, 3, 4]])
     (True, (1, 2))
     """
-    steps = samples.shape[0]
-    base = fit_residual(samples, shift_sign)
-    if steps <= 3 or base <= 0.3:
+    if samples.shape[0] <= 3:
         return None
-    tried = {}
-    for i in range(steps):
-        for j in range(i + 1, steps):
-            order = np.arange(steps)
-            order[[i, j]] = order[[j, i]]
-            tried[(i, j)] = fit_residual(samples[order], shift_sign)
-    best = min(tried.values())
-    if best >= base / 3:
+    base, ratio, pairs = exchange_fits(samples, shift_sign)
+    if base <= least or ratio >= limit:
         return None
     # an exchange can also turn the set into the reversed sequence, which fits as well:
     # of the exchanges that fit about as well, the closest pair is the likely mistake
-    close = [pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6]
-    return min(close, key=lambda pair: (pair[1] - pair[0], pair))
+    return pairs[0]
 
 
 ROTATED = 0.7  # a rotated reading's residual over the set's, under which to refuse
+# two shift frames look swapped: the set's residual over SWAP_LEAST of its modulation and an
+# exchange's under SWAPPED of it (right captures: 1.0 and over, rendered and real;
+# benchmarks/check_margins.py, tests/test_frame_order.py)
+SWAP_LEAST = 0.2
+SWAPPED = 0.7
 
 
 def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
