@@ -97,3 +97,18 @@ def test_two_shift_frames_swapped_are_refused(traced, gamma):
                                            r"alike\): the phase shifts fit a sinusoid \d+\.\d "
                                            "times better exchanged"):
         bistair.decode(swapped, spec)
+
+
+def test_the_messages_name_the_likely_field(traced):
+    """Item 4: a rows spec on column captures (their coordinates fit the projector's
+    1920-px axis, not its 1080 rows) names the orientation; a shifted spec one frame over
+    SLMaster's 9 captures names ``gray_wrap 1``."""
+    images = _images(PLAIN, traced)
+    with pytest.raises(BistairError, match=r"fall outside the 1080-px projector: is "
+                                           r"orientation columns \(they fit along the "
+                                           r"projector's other axis\), or the period"):
+        bistair.decode(images, PLAIN.replace(orientation="rows"))
+    with pytest.raises(BistairError, match=r"^the graycode spec needs 10 frames, the captures "
+                                           r"have 9: gray_wrap 1 gives 9 \(the cyclic shifted "
+                                           r"code\)$"):
+        bistair.decode(_images(CYCLIC, traced), SHIFTED)

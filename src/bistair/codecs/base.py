@@ -269,6 +269,8 @@ class Codec:
             raise BistairError(f"a {spec.method} spec cannot be decoded by the {self.name} codec")
         if spec.orientation == "both":
             raise BistairError("a spec of both axes decodes with decode(), axis by axis")
+        if np.ndim(images) == 3 and len(images) != spec.frame_count:
+            raise frame_count_error(spec, len(images))
         frames = spec.frames
         roles = {role: frames.index(role) if role in frames else None
                  for role in ("white", "black")}
@@ -357,6 +359,7 @@ class Codec:
         # result: int8 for up to 127 fringes), the phase noise and the sample too
         words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
         edge_phase = code.edge_phase
+        read_top = int(code.edges.max()) if beyond else -1  # codes past the projector's end
         del code
         fs = replace(fs, sigma=None, sample=None)
         orders.info.update(seen)
@@ -393,6 +396,8 @@ class Codec:
         # nothing else (the result's other arrays, the captures) shares their memory; the
         # phase and the mask are the only new arrays
         order = orders.order
+        # the top coordinate read, for a hint of the other orientation
+        top = (max(read_top, int(order.max()) if order.size else -1) + 1) * spec.period
         kept = [a for a in (fs.mod, fs.avg, fs.valid, words, images, prepared.raw,
                             prepared.white) if isinstance(a, np.ndarray)]
         reuse = not np.may_share_memory(fs.phi, order) and not any(
@@ -404,14 +409,45 @@ class Codec:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
         decoded = int(np.count_nonzero(result.mask))
+        other = {"columns": "rows", "rows": "columns"}.get(spec.orientation, "")
+        fits = other and spec.coded_length < top <= spec.other_length
         judge(outside_problem(decoded, result.info.get("outside_projector", 0),
-                              spec.coded_length))
+                              spec.coded_length, other if fits else ""))
         result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":  # (only this function holds the result: turned array
             result = transpose_own(result)  # by array, not copied whole)
         result.texture = prepared.white
         return result
+
+
+def frame_count_error(spec: BaseSpec, count: int) -> BistairError:
+    """The error for ``count`` captures where ``spec`` needs another number of frames, with
+    the spec's hint of a near spec that needs ``count`` (``frame_count_hint``) if it has
+    one.
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec the captures were given with.
+    count : int
+        The frames captured.
+
+    Returns
+    -------
+    BistairError
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=1920, height=1080, period=60, gray_offset=0.5)
+    >>> print(frame_count_error(spec, 9))  # doctest: +NORMALIZE_WHITESPACE
+    the graycode spec needs 10 frames, the captures have 9: gray_wrap 1 gives 9
+    (the cyclic shifted code)
+    """
+    hint = getattr(spec, "frame_count_hint", lambda count: "")(count)
+    return BistairError(f"the {spec.method} spec needs {spec.frame_count} frames, the captures "
+                        f"have {count}" + (f": {hint}" if hint else ""))
 
 
 def most_code(spec: BaseSpec, cycle: int | None = None) -> int:

@@ -411,7 +411,7 @@ def axis_problem(sample: Sample, orientation: str, factor: float = 1.0) -> str |
             "camera's images must be turned back)")
 
 
-def outside_problem(decoded: int, outside: int, length: int) -> str | None:
+def outside_problem(decoded: int, outside: int, length: int, other: str = "") -> str | None:
     """A one-line reason to refuse when many decoded pixels land outside the projector.
 
     Many means at least 100 pixels and more than 10% of all decoded ones (inside and out).
@@ -424,6 +424,9 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
         Pixels whose coordinates fall outside ``[0, length)``.
     length : int
         Projector pixels along the coded axis.
+    other : str
+        The other orientation, where the decoded orders fit within its projector size
+        (``"columns"`` or ``"rows"``): named first.
 
     Returns
     -------
@@ -436,13 +439,17 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
     'the coordinates of 85% of the decoded pi'
     >>> outside_problem(90000, 40, 1080) is None
     True
+    >>> outside_problem(900, 5000, 1080, "columns").split(": ")[1][:26]
+    'is orientation columns (th'
     """
     total = decoded + outside
     if outside < 100 or outside <= 0.1 * total:
         return None
+    turned = (f"is orientation {other} (they fit along the projector's other axis), or "
+              if other else "is ")
     return (f"the coordinates of {100 * outside / total:.0f}% of the decoded pixels fall "
-            f"outside the {length}-px projector: is the period (or the projector size) right? "
-            "(or shift_sign: shifts that run the other way mirror the coordinates)")
+            f"outside the {length}-px projector: {turned}the period (or the projector size) "
+            "right? (or shift_sign: shifts that run the other way mirror the coordinates)")
 
 
 def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
@@ -536,9 +543,10 @@ def edge_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
     (20, 20, 40)
     """
     edge = np.float32(edge_phase)
-    turned = (np.asarray(phi, np.float32) - edge) % np.float32(TWO_PI)
+    phi, order = np.asarray(phi, np.float32)[::2], np.asarray(order)[::2]  # rows judged
+    turned = (phi - edge) % np.float32(TWO_PI)
     past = np.where(order >= 0, order + (phi >= edge), -1).astype(np.int32)
-    return wrap_step_counts(turned, past, valid, 2, 3)
+    return wrap_step_counts(turned, past, np.ascontiguousarray(valid[::2]), 1, 3)
 
 
 def edge_jump_problem(big: int, links: int, limit: float = 0.02) -> str | None:
@@ -922,7 +930,7 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1, limit: float = 1 / 
     return pairs[0]
 
 
-ROTATED = 0.7  # a rotated reading's residual over the set's, under which to refuse
+ROTATED = 0.9  # a rotated reading's residual over the set's, under which to refuse
 # two shift frames look swapped: the set's residual over SWAP_LEAST of its modulation and an
 # exchange's under SWAPPED of it (right captures: 1.0 and over, rendered and real;
 # benchmarks/check_margins.py, tests/test_frame_order.py)
@@ -934,10 +942,10 @@ def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
                    limit: float = ROTATED) -> tuple[int, float]:
     """Whether a capture's frames look rotated by one against the spec: ``samples`` (F,
     pixels) are every method frame of some pixels, the first ``steps`` of them the N-step
-    set. The set fits a sinusoid worse (residual over 0.2 of the modulation) than it does
-    read from one frame later (frames ``F-1, 0, ..., N-2``: the capture started a frame
-    late, shift-0 grabbed last) or one frame earlier (frames ``1, ..., N``: a frame extra
-    at the start), by the factor ``limit``.
+    set. The set fits a sinusoid worse (residual over 0.2 of the modulation) than it does,
+    by the factor ``limit``, read from one frame later (frames ``F-1, 0, ..., N-2``: the
+    capture started a frame late, shift-0 grabbed last) or one frame earlier (frames
+    ``1, ..., N``: a frame extra at the start).
 
     Parameters
     ----------
@@ -949,8 +957,11 @@ def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
         The direction the shifts run, +1 or -1.
     limit : float
         The better rotated reading's residual over the set's under which they look rotated
-        (right captures: 1.2 and over, rendered and real; rotated ones: 0.6 and under;
-        ``benchmarks/check_margins.py``).
+        (right captures: CFPE 1.85 and over; renders of every codec on the robustness
+        cases, 320 x 256 and 640 x 512, default and hard optics, 1.28 and over, multifreq
+        under hard optics; the sequences one frame over 0.08-0.84, those over 0.69 only
+        under hard optics at 640 x 512, where the 0.7 first tried missed phase coding's
+        at 0.80: ``benchmarks/check_margins.py``, ``tests/test_frame_order.py``).
 
     Returns
     -------
