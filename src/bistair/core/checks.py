@@ -542,11 +542,7 @@ def edge_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
     >>> edge_steps(phi, blocks, ok, np.pi)
     (20, 20, 40)
     """
-    edge = np.float32(edge_phase)
-    phi, order = np.asarray(phi, np.float32)[::2], np.asarray(order)[::2]  # rows judged
-    turned = (phi - edge) % np.float32(TWO_PI)
-    past = np.where(order >= 0, order + (phi >= edge), -1).astype(np.int32)
-    return wrap_step_counts(turned, past, np.ascontiguousarray(valid[::2]), 1, 3)
+    return wrap_step_counts(phi, order, valid, 2, 3, float(edge_phase) % TWO_PI)
 
 
 def edge_jump_problem(big: int, links: int, limit: float = 0.02) -> str | None:
