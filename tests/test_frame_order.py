@@ -112,3 +112,27 @@ def test_the_messages_name_the_likely_field(traced):
                                            r"have 9: gray_wrap 1 gives 9 \(the cyclic shifted "
                                            r"code\)$"):
         bistair.decode(_images(CYCLIC, traced), SHIFTED)
+
+
+def test_edge_steps_is_the_wrap_check_on_the_turned_phase():
+    """The compiled pass judges what the NumPy it replaced judged: the wrap check on the
+    phase turned by the edge phase, with the order plus one where the phase is past it
+    (noisy phase ramps, orders misread in blocks and beside the edges, invalid pixels)."""
+    from bistair.core.checks import edge_steps, wrap_steps
+    rng = np.random.default_rng(3)
+    x = np.arange(400.0) + 0.5
+    for period, noise in ((20, 0.02), (12, 0.05), (40, 0.1)):
+        phase = 2 * np.pi * x / period + rng.normal(0, noise, (30, x.size))
+        phi = (phase % (2 * np.pi)).astype(np.float32)
+        order = np.floor(phase / (2 * np.pi)).astype(np.int32)
+        order[:, int(5.5 * period):int(9.5 * period)] += 2  # a block misread, mid-fringe
+        order[rng.random(order.shape) < 0.02] += 1  # pixels misread
+        order[rng.random(order.shape) < 0.01] = -1
+        valid = rng.random(order.shape) > 0.01
+        for edge in (np.pi, 2.0):
+            turned = ((phi - np.float32(edge)) % np.float32(2 * np.pi)).astype(np.float32)
+            past = np.where(order >= 0, order + (phi >= np.float32(edge)), -1)
+            want = wrap_steps(turned, past.astype(np.int32), valid)
+            assert edge_steps(phi, order, valid, edge) == want
+            assert want[2] > 100 and (want[1] > 0 or edge != np.pi)
+        assert edge_steps(phi, order, valid, 0.0) == wrap_steps(phi, order, valid)
