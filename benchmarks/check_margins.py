@@ -49,10 +49,15 @@ def main() -> None:
                          _fmt(info.get("stair_misfit")), _fmt(info.get("period_agreement")),
                          _fmt(info.get("cell_steps_against", 0) / info["cell_steps"]
                               if info.get("cell_steps") else None),
+                         _fmt(info.get("rotated_fit")), _fmt(info.get("exchange_fit")),
+                         f"{100 * info['edge_jumps'] / info['edge_links']:.2f}% of "
+                         f"{info['edge_links']}" if info.get("edge_links") else "-",
                          "; ".join(f[:60] for f in forced) or "-",
                          f"{time.perf_counter() - start:.1f}s"))
     head = ("part", "valid", "of modulated", "wrong steps", "block jumps", "stair misfit",
-            "periods agree", "cells backwards", "would refuse", "time")
+            "periods agree", "cells backwards", "rotated fit", "exchange fit",
+            "edge jumps", "would refuse",
+            "time")
     widths = [max(len(str(r[i])) for r in [head, *rows]) for i in range(len(head))]
     for row in [head, *rows]:
         print("  ".join(str(v).ljust(w) for v, w in zip(row, widths, strict=True)))

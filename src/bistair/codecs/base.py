@@ -40,17 +40,22 @@ import numpy as np
 
 from ..core.captures import Prepared, check_min_modulation, prepare
 from ..core.checks import (
+    SWAP_LEAST,
+    SWAPPED,
     EdgeCheck,
     axis_problem,
     convention_problem,
     edge_alignment,
+    edge_jump_problem,
+    edge_steps,
+    exchange_fits,
     forcing,
     jump_problem,
     outside_problem,
     refuse,
+    rotated_frames,
     sample_checks,
     sparse_problem,
-    swapped_frames,
     wrap_steps,
 )
 from ..core.measure import FringeSet, measure
@@ -264,6 +269,8 @@ class Codec:
             raise BistairError(f"a {spec.method} spec cannot be decoded by the {self.name} codec")
         if spec.orientation == "both":
             raise BistairError("a spec of both axes decodes with decode(), axis by axis")
+        if np.ndim(images) == 3 and len(images) != spec.frame_count:
+            raise frame_count_error(spec, len(images))
         frames = spec.frames
         roles = {role: frames.index(role) if role in frames else None
                  for role in ("white", "black")}
@@ -325,11 +332,12 @@ class Codec:
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
         axis: list[str | None] = [None]
+        seen: dict[str, Any] = {}  # figures the sample's checks judged, for info.json
 
         def on_sample(sample: Sample) -> None:
             """The checks of pass 0's sample, before pass 1 (a Gray code alone, with no
             phase, has no sample: nothing to judge)."""
-            refuse(shift_order_problem(sample, spec))
+            refuse(shift_order_problem(sample, spec, seen=seen))
             axis[0] = axis_problem(sample, spec.orientation)
             if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
                 refuse(axis[0])
@@ -350,8 +358,11 @@ class Codec:
         # the code's maps let go with it once the orders are made (the words narrowed for the
         # result: int8 for up to 127 fringes), the phase noise and the sample too
         words, beyond = narrow_code(code.code, most_code(spec, code.cycle)), code.beyond
+        edge_phase = code.edge_phase
+        read_top = int(code.edges.max()) if beyond else -1  # codes past the projector's end
         del code
         fs = replace(fs, sigma=None, sample=None)
+        orders.info.update(seen)
         if warnings:
             orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
         if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
@@ -360,6 +371,12 @@ class Codec:
             del judged
             orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
             judge(jump_problem(bad, links, big=big, big_limit=0.02))
+            if edge_phase and getattr(spec, "steps", 0):  # edges mid-fringe: judged there too
+                judged = orders.order if orders.read is None else orders.read
+                _, jumps, across = edge_steps(fs.phi, judged, fs.valid, edge_phase)
+                del judged
+                orders.info.update(edge_links=across, edge_jumps=jumps)
+                judge(edge_jump_problem(jumps, across))
             if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
                 where = ("the code reads pixels beside its edges one order off" if
                          orders.read is None else "the code reads pixels beside its edges "
@@ -379,6 +396,8 @@ class Codec:
         # nothing else (the result's other arrays, the captures) shares their memory; the
         # phase and the mask are the only new arrays
         order = orders.order
+        # the top coordinate read, for a hint of the other orientation
+        top = (max(read_top, int(order.max()) if order.size else -1) + 1) * spec.period
         kept = [a for a in (fs.mod, fs.avg, fs.valid, words, images, prepared.raw,
                             prepared.white) if isinstance(a, np.ndarray)]
         reuse = not np.may_share_memory(fs.phi, order) and not any(
@@ -390,14 +409,45 @@ class Codec:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
         decoded = int(np.count_nonzero(result.mask))
+        other = {"columns": "rows", "rows": "columns"}.get(spec.orientation, "")
+        fits = other and spec.coded_length < top <= spec.other_length
         judge(outside_problem(decoded, result.info.get("outside_projector", 0),
-                              spec.coded_length))
+                              spec.coded_length, other if fits else ""))
         result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":  # (only this function holds the result: turned array
             result = transpose_own(result)  # by array, not copied whole)
         result.texture = prepared.white
         return result
+
+
+def frame_count_error(spec: BaseSpec, count: int) -> BistairError:
+    """The error for ``count`` captures where ``spec`` needs another number of frames, with
+    the spec's hint of a near spec that needs ``count`` (``frame_count_hint``) if it has
+    one.
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec the captures were given with.
+    count : int
+        The frames captured.
+
+    Returns
+    -------
+    BistairError
+
+    Examples
+    --------
+    >>> from bistair.codecs import make_spec
+    >>> spec = make_spec("graycode", width=1920, height=1080, period=60, gray_offset=0.5)
+    >>> print(frame_count_error(spec, 9))  # doctest: +NORMALIZE_WHITESPACE
+    the graycode spec needs 10 frames, the captures have 9: gray_wrap 1 gives 9
+    (the cyclic shifted code)
+    """
+    hint = getattr(spec, "frame_count_hint", lambda count: "")(count)
+    return BistairError(f"the {spec.method} spec needs {spec.frame_count} frames, the captures "
+                        f"have {count}" + (f": {hint}" if hint else ""))
 
 
 def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
@@ -427,14 +477,21 @@ def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
     return max((1 << fringes.bit_length()) - 1, cycle or 0)
 
 
-def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) -> str | None:
+def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
+                        seen: dict[str, Any] | None = None) -> str | None:
     """A one-line reason to refuse when two frames of an N-step set look swapped
     (:func:`~bistair.core.checks.swapped_frames`), judged on pass 0's sample: its strong
     pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
 
     Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
-    or more steps is checked; with fewer than 500 strong pixels in the sample nothing is
-    said.
+    or more steps is checked (:func:`~bistair.core.checks.exchange_fits`: an exchange that
+    fits under ``SWAPPED`` of the set's residual); the first, where it starts the method
+    frames, also against the whole sequence one frame over
+    (:func:`~bistair.core.checks.rotated_frames`: a capture started a frame late or early),
+    named when that fits better than any exchange. With four steps an exchange and the
+    exchange of the other two frames fit alike (one of them also reverses the shifts): both
+    are named.
+    With fewer than 500 strong pixels in the sample nothing is said.
 
     Parameters
     ----------
@@ -446,11 +503,15 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) ->
         direction of the shifts.
     samples : int, default 20000
         At most how many strong pixels to use.
+    seen : dict, optional
+        Given the first set's figures, where it starts the method frames: ``rotated_fit``
+        (the better reading one frame over, its residual over the set's) and
+        ``exchange_fit`` (the best exchange's, likewise).
 
     Returns
     -------
     str or None
-        The reason naming the two frames, or ``None`` when no pair looks swapped.
+        The reason naming the frames, or ``None`` when the frames look in order.
 
     Examples
     --------
@@ -463,7 +524,10 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) ->
     >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
     >>> swapped = prepare(images, spec.frame_count, spec.method)
     >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
-    'frames shift-0 and shift-1 look swapped'
+    'frames shift-0 and shift-1 look swapped (or shift-2 and shift-3'
+    >>> late = prepare(encode(spec)[[1, 2, 3, 4, 5, 6, 0]], spec.frame_count, spec.method)
+    >>> shift_order_problem(measure_shifts(late, spec).sample, spec)[:40]
+    'the frames look one frame late: the last'
     """
     names = spec.method_frames()
     sets: dict[str, list[int]] = {}
@@ -475,15 +539,29 @@ def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000) ->
         return None
     step = max(1, -(-r.size // samples))
     r, c = r[::step], c[::step]
-    for members in sets.values():
-        if len(members) < 4:
-            continue
-        values = sample.values[members][:, r, c].astype(np.float64)
-        pair = swapped_frames(values, spec.shift_sign)
-        if pair is not None:
-            a, b = (names[members[i]] for i in pair)
-            return (f"frames {a} and {b} look swapped: the phase shifts fit a sinusoid three "
-                    "times better exchanged (check the frame order)")
+    values = sample.values[:, r, c].astype(np.float64)
+    for index, members in enumerate(m for m in sets.values() if len(m) >= 4):
+        base, ratio, pairs = exchange_fits(values[members], spec.shift_sign)
+        way, turned = 0, float("inf")
+        if index == 0 and members == list(range(len(members))) and len(names) > len(members):
+            # the first set at the start: also the whole sequence one frame over
+            way, turned = rotated_frames(values, len(members), spec.shift_sign)
+            if seen is not None:
+                seen.update(rotated_fit=round(turned, 3), exchange_fit=round(ratio, 3))
+        if way and turned < ratio:  # no exchange of two frames explains it as well
+            return ("the frames look one frame " + ("late: the last one fits as shift-0 "
+                    "(did the capture start a frame late, or a frame go missing at the "
+                    "start?)" if way > 0 else "early: the phase shifts fit from the second "
+                    "frame on (is there an extra frame at the start?)")
+                    + "; check the frame order")
+        if base > SWAP_LEAST and ratio < SWAPPED:
+            a, b = (names[members[i]] for i in pairs[0])
+            other = [p for p in pairs[1:] if not set(p) & set(pairs[0])]
+            also = ("" if len(members) != 4 or not other else " (or {} and {}: with four "
+                    "steps the two fit alike)".format(*(names[members[i]] for i in other[0])))
+            return (f"frames {a} and {b} look swapped{also}: the phase shifts fit a sinusoid "
+                    f"{1 / max(ratio, 1e-3):.1f} times better exchanged (check the frame "
+                    "order)")
     return None
 
 

@@ -219,6 +219,25 @@ class GrayCodeSpec(PeriodSpec):
                     "close to a whole number: a period off would not show in the second phase")
 
 
+    def frame_count_hint(self, count: int) -> str:
+        """The field that would make this spec's frames ``count`` where a near spec does:
+        a shifted code one frame over the captures is likely SLMaster's cyclic one
+        (``gray_wrap 1``, a code bit fewer); ``""`` else.
+
+        Examples
+        --------
+        >>> spec = GrayCodeSpec(width=1920, height=1080, period=60, gray_offset=0.5)
+        >>> spec.frame_count, spec.frame_count_hint(9)
+        (10, 'gray_wrap 1 gives 9 (the cyclic shifted code)')
+        >>> spec.frame_count_hint(8)
+        ''
+        """
+        if not self.gray_offset or self.gray_wrap or self.frame_order:
+            return ""
+        cyclic = self.replace(gray_wrap=1)
+        return (f"gray_wrap 1 gives {count} (the cyclic shifted code)"
+                if cyclic.frame_count == count else "")
+
     def half_period_reading(self) -> str:
         """The spec fields that read the same frames with the code's edges half a period
         over (shifted for a plain code, plain for a shifted one), which explains captures

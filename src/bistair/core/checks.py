@@ -411,7 +411,7 @@ def axis_problem(sample: Sample, orientation: str, factor: float = 1.0) -> str |
             "camera's images must be turned back)")
 
 
-def outside_problem(decoded: int, outside: int, length: int) -> str | None:
+def outside_problem(decoded: int, outside: int, length: int, other: str = "") -> str | None:
     """A one-line reason to refuse when many decoded pixels land outside the projector.
 
     Many means at least 100 pixels and more than 10% of all decoded ones (inside and out).
@@ -424,6 +424,9 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
         Pixels whose coordinates fall outside ``[0, length)``.
     length : int
         Projector pixels along the coded axis.
+    other : str
+        The other orientation, where the decoded orders fit within its projector size
+        (``"columns"`` or ``"rows"``): named first.
 
     Returns
     -------
@@ -436,13 +439,17 @@ def outside_problem(decoded: int, outside: int, length: int) -> str | None:
     'the coordinates of 85% of the decoded pi'
     >>> outside_problem(90000, 40, 1080) is None
     True
+    >>> outside_problem(900, 5000, 1080, "columns").split(": ")[1][:26]
+    'is orientation columns (th'
     """
     total = decoded + outside
     if outside < 100 or outside <= 0.1 * total:
         return None
+    turned = (f"is orientation {other} (they fit along the projector's other axis), or "
+              if other else "is ")
     return (f"the coordinates of {100 * outside / total:.0f}% of the decoded pixels fall "
-            f"outside the {length}-px projector: is the period (or the projector size) right? "
-            "(or shift_sign: shifts that run the other way mirror the coordinates)")
+            f"outside the {length}-px projector: {turned}the period (or the projector size) "
+            "right? (or shift_sign: shifts that run the other way mirror the coordinates)")
 
 
 def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
@@ -493,6 +500,83 @@ def wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
     (0, 0, 36)
     """
     return wrap_step_counts(phi, order, valid, every, reach)
+
+
+def edge_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray,
+               edge_phase: float) -> tuple[int, int, int]:
+    """How the fringe orders of a code whose edges sit mid-fringe (at wrapped phase
+    ``edge_phase``, not 0: a shifted Gray code's at pi) hold across those edges, where the
+    phase runs on smoothly and the order must not change: :func:`wrap_steps` on the phase
+    turned by ``edge_phase`` and the order plus one past it.
+
+    The wrap check alone cannot see such a code read wrong: its misreads sit at the code's
+    edges, mid-fringe, and the orders on either side of each phase jump come from the same
+    code word. Judge the orders as read (before pixels beside the edges are mended).
+
+    Parameters
+    ----------
+    phi : (H, W) float array
+        Wrapped phase in [0, 2*pi).
+    order : (H, W) int array
+        Fringe orders as read, -1 where invalid.
+    valid : (H, W) bool array
+        Pixels to judge.
+    edge_phase : float
+        The wrapped phase (radians) at the code's edges.
+
+    Returns
+    -------
+    (violations, big violations, places) : tuple of int
+        As :func:`wrap_steps` counts them, at the code's edges: ``big``, orders that change
+        by two or more across an edge (a code read wrong in whole blocks).
+
+    Examples
+    --------
+    >>> x = np.arange(300.0) + 0.5
+    >>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (8, 1)).astype(np.float32)
+    >>> order = np.tile((x // 30).astype(np.int32), (8, 1))
+    >>> ok = np.ones(phi.shape, bool)
+    >>> edge_steps(phi, order, ok, np.pi)
+    (0, 0, 40)
+    >>> blocks = np.where(x % 60 < 45, order, order + 2).astype(np.int32)  # misread blocks
+    >>> edge_steps(phi, blocks, ok, np.pi)
+    (20, 20, 40)
+    """
+    return wrap_step_counts(phi, order, valid, 2, 3, float(edge_phase) % TWO_PI)
+
+
+def edge_jump_problem(big: int, links: int, limit: float = 0.02) -> str | None:
+    """A one-line reason to refuse when a shifted code's orders change by two or more across
+    more than ``limit`` of its own edges where the phase runs on smoothly
+    (:func:`edge_steps`): code frames swapped or a code that does not fit the spec.
+
+    Parameters
+    ----------
+    big : int
+        Code edges across which the orders change by two or more.
+    links : int
+        Code edges judged; with fewer than 200, nothing is said.
+    limit : float
+        Share above which to refuse (right decodes of the rendered scenes: 0.0-0.3%).
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> edge_jump_problem(857, 942)[:52]
+    'the fringe orders jump by whole blocks across 91.0% '
+    >>> edge_jump_problem(1, 942) is None, edge_jump_problem(100, 150) is None
+    (True, True)
+    """
+    if links < 200 or big <= limit * links:
+        return None
+    return (f"the fringe orders jump by whole blocks across {100 * big / links:.1f}% of the "
+            "code's own edges, where the phase runs on smoothly, so the code is misread in "
+            "whole blocks: are code frames swapped (check the frame order), does the spec fit "
+            "the captures (gray_offset, gray_wrap, period), or is there too much noise or "
+            "blur for this code?")
 
 
 def jump_problem(violations: int, links: int, limit: float = 0.1,
@@ -752,12 +836,12 @@ def fit_residual(samples: np.ndarray, shift_sign: int = 1) -> float:
     return float(np.median(rms / np.maximum(mod, 1e-6)))
 
 
-def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] | None:
-    """The two frames of an N-step set (``samples``: (N, pixels), N >= 4) that look swapped:
-    the set fits a sinusoid badly (residual over 0.3 of the modulation) and, with those two
-    exchanged, at least three times better (of equally good exchanges, the nearest pair).
-    ``None`` when the set fits or no exchange helps (an uncompensated gamma leaves a
-    residual that no exchange removes).
+def exchange_fits(samples: np.ndarray, shift_sign: int = 1
+                  ) -> tuple[float, float, list[tuple[int, int]]]:
+    """How much better an N-step set (``samples``: (N, pixels), N >= 4) fits a sinusoid
+    with two of its frames exchanged: the set's residual (:func:`fit_residual`), the best
+    exchange's over it, and the exchanges that fit about as well as the best (within 10%),
+    nearest pairs first.
 
     Parameters
     ----------
@@ -765,6 +849,60 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
         The N-step intensities of some pixels, in the captured frame order.
     shift_sign : int
         The direction the shifts run, +1 or -1.
+
+    Returns
+    -------
+    base : float
+        The set's residual over its modulation.
+    ratio : float
+        The best exchange's residual over ``base`` (``inf`` for N <= 3).
+    pairs : list of (int, int)
+        The 0-based frame pairs ``(i, j)``, ``i < j``, whose exchange fits about as well as
+        the best, nearest first (with four steps an exchange and the exchange of the other
+        two frames fit alike: one of them reverses the shifts).
+
+    Examples
+    --------
+    >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
+    >>> frames = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
+    >>> base, ratio, pairs = exchange_fits(frames[[0, 1, 3, 2]])
+    >>> round(base, 2), ratio < 1e-6, pairs
+    (1.48, True, [(0, 1), (2, 3)])
+    """
+    steps = samples.shape[0]
+    base = fit_residual(samples, shift_sign)
+    if steps <= 3:
+        return base, float("inf"), []
+    tried = {}
+    for i in range(steps):
+        for j in range(i + 1, steps):
+            order = np.arange(steps)
+            order[[i, j]] = order[[j, i]]
+            tried[(i, j)] = fit_residual(samples[order], shift_sign)
+    best = min(tried.values())
+    close = sorted((pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6),
+                   key=lambda pair: (pair[1] - pair[0], pair))
+    return base, best / max(base, 1e-9), close
+
+
+def swapped_frames(samples: np.ndarray, shift_sign: int = 1, limit: float = 1 / 3,
+                   least: float = 0.3) -> tuple[int, int] | None:
+    """The two frames of an N-step set (``samples``: (N, pixels), N >= 4) that look swapped:
+    the set fits a sinusoid badly (residual over ``least`` of the modulation) and, with
+    those two exchanged, better by the factor ``limit`` (three times by default; of equally
+    good exchanges, the nearest pair). ``None`` when the set fits or no exchange helps (an
+    uncompensated gamma leaves a residual that no exchange removes).
+
+    Parameters
+    ----------
+    samples : (N, pixels) array
+        The N-step intensities of some pixels, in the captured frame order.
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+    limit : float
+        The best exchange's residual over the set's under which the frames look swapped.
+    least : float
+        The set's residual over which it is judged.
 
     Returns
     -------
@@ -778,20 +916,75 @@ def swapped_frames(samples: np.ndarray, shift_sign: int = 1) -> tuple[int, int] 
     >>> swapped_frames(frames) is None, swapped_frames(frames[[0, 2, 1, 3, 4]])
     (True, (1, 2))
     """
-    steps = samples.shape[0]
-    base = fit_residual(samples, shift_sign)
-    if steps <= 3 or base <= 0.3:
+    if samples.shape[0] <= 3:
         return None
-    tried = {}
-    for i in range(steps):
-        for j in range(i + 1, steps):
-            order = np.arange(steps)
-            order[[i, j]] = order[[j, i]]
-            tried[(i, j)] = fit_residual(samples[order], shift_sign)
-    best = min(tried.values())
-    if best >= base / 3:
+    base, ratio, pairs = exchange_fits(samples, shift_sign)
+    if base <= least or ratio >= limit:
         return None
     # an exchange can also turn the set into the reversed sequence, which fits as well:
     # of the exchanges that fit about as well, the closest pair is the likely mistake
-    close = [pair for pair, r in tried.items() if r <= 1.1 * best + 1e-6]
-    return min(close, key=lambda pair: (pair[1] - pair[0], pair))
+    return pairs[0]
+
+
+ROTATED = 0.9  # a rotated reading's residual over the set's, under which to refuse
+# two shift frames look swapped: the set's residual over SWAP_LEAST of its modulation and an
+# exchange's under SWAPPED of it (right captures: 1.0 and over, rendered and real;
+# benchmarks/check_margins.py, tests/test_frame_order.py)
+SWAP_LEAST = 0.2
+SWAPPED = 0.7
+
+
+def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
+                   limit: float = ROTATED) -> tuple[int, float]:
+    """Whether a capture's frames look rotated by one against the spec: ``samples`` (F,
+    pixels) are every method frame of some pixels, the first ``steps`` of them the N-step
+    set. The set fits a sinusoid worse (residual over 0.2 of the modulation) than it does,
+    by the factor ``limit``, read from one frame later (frames ``F-1, 0, ..., N-2``: the
+    capture started a frame late, shift-0 grabbed last) or one frame earlier (frames
+    ``1, ..., N``: a frame extra at the start).
+
+    Parameters
+    ----------
+    samples : (F, pixels) array
+        Every method frame's intensities at some pixels, in the captured order (F > N).
+    steps : int
+        N, the frames of the shift set at the start (4 or more).
+    shift_sign : int
+        The direction the shifts run, +1 or -1.
+    limit : float
+        The better rotated reading's residual over the set's under which they look rotated
+        (right captures: CFPE 1.85 and over; renders of every codec on the robustness
+        cases, 320 x 256 and 640 x 512, default and hard optics, 1.28 and over, multifreq
+        under hard optics; the sequences one frame over 0.08-0.84, those over 0.69 only
+        under hard optics at 640 x 512, where the 0.7 first tried missed phase coding's
+        at 0.80: ``benchmarks/check_margins.py``, ``tests/test_frame_order.py``).
+
+    Returns
+    -------
+    way : int
+        +1: the frames look one late (the last frame is shift-0), -1: one early (the first
+        frame is not shift-0), 0: neither.
+    ratio : float
+        The better rotated reading's residual over the set's (``inf`` when not judged).
+
+    Examples
+    --------
+    >>> d = 2 * np.pi * np.arange(4)[:, None] / 4
+    >>> shifts = 0.5 + 0.3 * np.cos(np.linspace(0, 6, 50)[None] + d)
+    >>> code = (np.arange(50)[None] // 7 % 2).repeat(3, 0) * 0.8 + 0.1
+    >>> frames = np.concatenate([shifts, code])
+    >>> rotated_frames(frames, 4)[0], rotated_frames(np.roll(frames, -1, axis=0), 4)[0]
+    (0, 1)
+    >>> rotated_frames(np.roll(frames, 1, axis=0), 4)[0]
+    -1
+    """
+    frames = samples.shape[0]
+    if steps < 4 or frames <= steps:
+        return 0, float("inf")
+    base = fit_residual(samples[:steps], shift_sign)
+    late = fit_residual(samples[[frames - 1, *range(steps - 1)]], shift_sign)
+    early = fit_residual(samples[1:steps + 1], shift_sign)
+    ratio = min(late, early) / max(base, 1e-9)
+    if base <= 0.2 or ratio >= limit:
+        return 0, ratio
+    return (1 if late <= early else -1), ratio

@@ -173,21 +173,28 @@ def level_misfits(theta: np.ndarray, levels: np.ndarray, half: np.ndarray) -> np
 
 @kernel()
 def _wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: int,
-                reach: int) -> tuple[int, int, int]:
+                reach: int, edge: float) -> tuple[int, int, int]:
     h, w = phi.shape
     rows = (h + every - 1) // every
     span = 2 * reach + 1
     pi32 = np.float32(math.pi)
     near = np.float32(0.6)
+    e = np.float32(edge)
     counts = np.zeros((rows, 3), np.int64)
     for r in range(rows):
         y = r * every
+        # the phase turned by the edge phase and the order plus one past it (edge 0: as is)
+        t = np.empty(w, np.float32)
+        k = np.empty(w, np.int64)
+        for x in range(w):
+            p = np.float32(phi[y, x])
+            t[x] = p - e if p >= e else p - e + TWO_PI32
+            k[x] = -1 if order[y, x] < 0 else np.int64(order[y, x]) + (1 if p >= e else 0)
         bad_sum = np.zeros(w, np.int32)  # prefix counts over the w - 1 pairs
         wrap_sum = np.zeros(w, np.int32)
         for x in range(w - 1):
-            d = np.float32(phi[y, x + 1]) - np.float32(phi[y, x])
-            ok = (valid[y, x] and order[y, x] >= 0 and valid[y, x + 1]
-                  and order[y, x + 1] >= 0)
+            d = t[x + 1] - t[x]
+            ok = valid[y, x] and k[x] >= 0 and valid[y, x + 1] and k[x + 1] >= 0
             clean = ok and abs(d - TWO_PI32 * np.rint(d / TWO_PI32)) < near
             bad_sum[x + 1] = bad_sum[x] + (0 if clean else 1)
             wrap_sum[x + 1] = wrap_sum[x] + (1 if clean and abs(d) > pi32 else 0)
@@ -196,14 +203,14 @@ def _wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: in
         judged = 0
         for j in range(w - span):
             c = j + reach
-            d = np.float32(phi[y, c + 1]) - np.float32(phi[y, c])
+            d = t[c + 1] - t[c]
             if not abs(d) > pi32:
                 continue
             if bad_sum[j + span] - bad_sum[j] != 0 or wrap_sum[j + span] - wrap_sum[j] != 1:
                 continue
             judged += 1
             want = -1 if d > 0 else 1
-            off = abs(np.int64(order[y, j + span]) - np.int64(order[y, j]) - want)
+            off = abs(k[j + span] - k[j] - want)
             if off != 0:
                 bad += 1
             if off >= 2:
@@ -215,7 +222,7 @@ def _wrap_steps(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: in
 
 
 def wrap_step_counts(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, every: int,
-                     reach: int) -> tuple[int, int, int]:
+                     reach: int, edge: float = 0.0) -> tuple[int, int, int]:
     """:func:`~bistair.core.checks.wrap_steps` in one pass over the rows it judges:
     ``(violations, big violations, places)``.
 
@@ -231,6 +238,10 @@ def wrap_step_counts(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, ever
         Judge every ``every``-th row.
     reach : int
         Pixels on either side of a wrap that must run on smoothly.
+    edge : float, default 0.0
+        Judge the wraps of the phase turned by ``edge`` (radians, in [0, 2*pi)) and the
+        orders plus one where the phase is ``edge`` or more: the steps at a code's edges
+        mid-fringe (:func:`~bistair.core.checks.edge_steps`); 0: the phase's own wraps.
 
     Returns
     -------
@@ -250,5 +261,5 @@ def wrap_step_counts(phi: np.ndarray, order: np.ndarray, valid: np.ndarray, ever
     if phi.shape[1] < 2 * reach + 2:
         return 0, 0, 0
     bad, big, places = _wrap_steps(phi, order, np.asarray(valid, bool), int(every),
-                                   int(reach))
+                                   int(reach), float(edge))
     return int(bad), int(big), int(places)

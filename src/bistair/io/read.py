@@ -26,6 +26,7 @@ import numpy as np
 import tifffile
 
 from ..codecs import spec_from_dict
+from ..codecs.base import frame_count_error
 from ..errors import BistairError
 from ..spec import BaseSpec
 from .inputs import note
@@ -486,8 +487,7 @@ def read_with_spec(captures: Captures, spec: BaseSpec | str | Path | None = None
     stack = read_captures(files) if npy else None
     count = stack.shape[0] if npy else len(files)
     if count != spec.frame_count:
-        raise BistairError(f"the {spec.method} spec needs {spec.frame_count} frames, the "
-                           f"captures have {count}")
+        raise frame_count_error(spec, count)
     if npy:
         stack = np.delete(stack, skip, axis=0) if skip else stack
     else:
