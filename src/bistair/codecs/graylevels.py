@@ -61,6 +61,7 @@ from ..core.regions import fringe_regions
 from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
+from .graylevels_cells import cell_digits, cell_periods, fit_blur, read_cells
 from .graylevels_jit import read_levels, row_fill, sample_levels
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
@@ -497,18 +498,35 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     """
     levels, digits, start = spec.code_levels, spec.code_bits, spec.steps
     used = frame_digits(spec)
-    centres, worst = frame_levels(_sample_values(prepared, start, digits, fs), used, levels)
+    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    cid, mean, count, sigma, _, usable = read_cells(
+        prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi, labels,
+        noise_d, EDGE_ZONE)
+    # the fringes' blur, fitted, taken out of every v (a pixel in no cell as it is)
+    period = cell_periods(fs.phi, cid, count.size)
+    blur = fit_blur(mean, count, usable, period,
+                    lambda values: frame_levels(values, used, levels)[0])
+    gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
+    mean, sigma = mean * gain, sigma * gain
+    samples = [np.repeat(m[usable], count[usable]) for m in mean]
+    centres, worst = frame_levels(samples, used, levels)
     refuse(separation_problem(worst, levels))
     digit_of = np.zeros((digits, levels), np.int32)
     for i, ds in enumerate(used):
         digit_of[i, :ds.size] = ds
-    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    cell_order, cell_clear = cell_digits(mean, sigma, centres, digit_of,
+                                         np.array([d.size for d in used]), levels,
+                                         CLEAR_NOISE, CLEAR_SHARE)
+    cell_order = np.where(usable & cell_clear & (cell_order < spec.fringes), cell_order, -1)
     code, nearest, carried, beyond = read_levels(
-        prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
+        prepared.raw, start, digits, prepared.scale, fs.avg,
+        (fs.mod / gain[cid]).astype(np.float32), fs.valid, fs.phi,
         centres, digit_of, np.array([d.size for d in used], np.int32), levels, spec.fringes,
         noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE)
-    return CodeMap(code, {"nearest": nearest, "carried": carried}, edge_phase=0.0,
-                   beyond=beyond)
+    cells = np.where(fs.valid, cell_order[cid], -1).astype(np.int32)
+    return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": cells,
+                          "labels": labels}, edge_phase=0.0, beyond=beyond)
 
 
 def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None:
@@ -578,9 +596,13 @@ def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     >>> bool((orders.order[:, :-1] == np.arange(480)[:-1] // 30).all())
     True
     """
-    nearest, carried = code.maps["nearest"], code.maps["carried"]
-    k = np.where(carried, code.code, -1)
-    labels, n = fringe_regions(fs.phi, fs.valid & (nearest >= 0), phase_noise=fs.phase_noise)
+    nearest, carried, cells = code.maps["nearest"], code.maps["carried"], code.maps["cells"]
+    # a cell read whole carries its pixels, but not one whose own clear digits say otherwise
+    k = np.where(cells >= 0, cells, np.where(carried, code.code, -1))
+    k[carried & (cells >= 0) & (code.code != cells)] = -1
+    carried = k >= 0
+    labels = code.maps["labels"]
+    n = int(labels.max(initial=0))
     shares = code_evidence(labels, n, k, spec.fringes)
     strong = np.bincount(labels[k >= 0], minlength=n + 1)
     settled = np.where((shares.max(axis=1) > SETTLED) & (strong >= MIN_STRONG),
@@ -598,5 +620,6 @@ def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     order = row_fill(order, nearest, clear, carried, phi, fs.valid, EDGE_ZONE, ROW_REACH,
                      ROW_CUT)
     info["region_carried"] = int(np.count_nonzero(order >= 0)) - int(np.count_nonzero(k >= 0))
-    info["left_out"] = int(np.count_nonzero(nearest >= 0)) - int(np.count_nonzero(order >= 0))
+    info["left_out"] = int(np.count_nonzero((nearest >= 0) | (cells >= 0))) - int(
+        np.count_nonzero(order >= 0))
     return Orders(order, info)
