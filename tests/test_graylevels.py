@@ -152,8 +152,7 @@ def test_levels_are_estimated_through_an_uncompensated_gamma_and_heavy_blur():
     assert wrong <= 0.001 and covered >= 0.95, (wrong, covered)
     cols = prepare(captures, spec.frame_count, spec.method)
     fs = measure_shifts(cols, spec)
-    samples = graylevels._sample_values(cols, spec.steps, spec.code_bits, fs)
-    centres, _ = graylevels.frame_levels(samples, graylevels.frame_digits(spec), 4)
+    centres = graylevels.code_cells(cols, spec, fs).centres
     assert (np.abs(centres[:, 1:3] - np.float32([-1 / 3, 1 / 3])) > 0.1).all(), centres
     nominal = np.float32([[-1, -1 / 3, 1 / 3, 1]] * spec.code_bits)
     read = graylevels.read_levels(

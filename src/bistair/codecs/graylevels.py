@@ -49,7 +49,7 @@ Examples
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -62,7 +62,7 @@ from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
 from .graylevels_cells import cell_digits, cell_periods, fit_blur, read_cells
-from .graylevels_jit import read_levels, row_fill, sample_levels
+from .graylevels_jit import read_levels, row_fill
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
 # a clear digit: outside the middle CLEAR_SHARE of the gap between two levels, by
@@ -88,7 +88,6 @@ ROW_CUT = math.pi / 4
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
 MAX_BAND = 0.5
 ABSENT = 0.005
-SAMPLE = 100_000  # pixels the levels are estimated on
 
 
 def code_digits(fringes: int, levels: int) -> int:
@@ -440,23 +439,64 @@ def frame_levels(samples: list[np.ndarray], used: list[np.ndarray], levels: int
     return centres, worst
 
 
-def _sample_values(prepared: Prepared, start: int, digits: int, fs: FringeSet
-                   ) -> list[np.ndarray]:
-    """``v`` of each code frame (averaged along the fringe as read) on an even grid of at
-    most ``SAMPLE`` valid pixels at least ``EDGE_ZONE`` from the code's edges (no level
-    between two there), the better modulated half of them (where the levels read with the
-    least noise)."""
-    h, w = fs.phi.shape
-    step = max(1, int(math.ceil(math.sqrt(h * w / SAMPLE))))
-    mod, phi = fs.mod[::step, ::step], fs.phi[::step, ::step]
-    valid = fs.valid[::step, ::step] & (mod > 0) & (phi >= EDGE_ZONE) & (
-        phi <= TWO_PI - EDGE_ZONE)  # away from the code's edges: no level between two
-    if np.any(valid):
-        valid &= mod >= np.median(mod[valid])
-    ys, xs = np.nonzero(valid)
-    values = sample_levels(prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod,
-                           fs.valid, fs.phi, ys * step, xs * step, REACH, SAME_FRINGE)
-    return list(values)
+class Cells(NamedTuple):
+    """A capture's code cells (:mod:`~bistair.codecs.graylevels_cells`) and its levels."""
+
+    labels: np.ndarray  # (H, W) fringe regions
+    cid: np.ndarray  # (H, W) each pixel's cell
+    mean: np.ndarray  # (D, n) each cell's v, the blur taken out
+    sigma: np.ndarray  # (D, n) the sigma of each mean
+    count: np.ndarray  # (n,) pixels each mean is over
+    usable: np.ndarray  # (n,) the cells read
+    gain: np.ndarray  # (n,) what the blur taken out multiplies each cell's v by
+    blur: float  # the blur constant c (:func:`~bistair.codecs.graylevels_cells.fit_blur`)
+    centres: np.ndarray  # (D, L) the levels (:func:`frame_levels`)
+    worst: tuple[float, int, int]  # the worst separation
+
+
+def code_cells(prepared: Prepared, spec: Any, fs: FringeSet) -> Cells:
+    """The code cells of a multi-level capture read, the fringes' blur fitted and taken
+    out of their ``v`` and the levels estimated on them (each cell weighted by its pixels).
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout.
+    spec : GrayCodeSpec
+        A spec with ``code_levels`` > 2.
+    fs : FringeSet
+        Stage 1.
+
+    Returns
+    -------
+    Cells
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=480, height=64, period=30, code_levels=4)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> cells = code_cells(cols, spec, measure_shifts(cols, spec))
+    >>> cells.centres.astype(float).round(2).tolist(), cells.worst[0] < 0.01
+    ([[-1.0, -0.33, 0.33, 1.0], [-1.0, -0.33, 0.33, 1.0]], True)
+    """
+    levels, digits = spec.code_levels, spec.code_bits
+    used = frame_digits(spec)
+    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    cid, mean, count, sigma, _, usable = read_cells(
+        prepared.raw, spec.steps, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
+        labels, noise_d, EDGE_ZONE)
+    period = cell_periods(fs.phi, cid, count.size)
+    blur = fit_blur(mean, count, usable, period,
+                    lambda values: frame_levels(values, used, levels)[0])
+    gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
+    mean, sigma = mean * gain, sigma * gain
+    centres, worst = frame_levels([np.repeat(m[usable], count[usable]) for m in mean], used,
+                                  levels)
+    return Cells(labels, cid, mean, sigma, count, usable, gain, blur, centres, worst)
 
 
 def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
@@ -499,34 +539,25 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     levels, digits, start = spec.code_levels, spec.code_bits, spec.steps
     used = frame_digits(spec)
     noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
-    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-    cid, mean, count, sigma, _, usable = read_cells(
-        prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi, labels,
-        noise_d, EDGE_ZONE)
-    # the fringes' blur, fitted, taken out of every v (a pixel in no cell as it is)
-    period = cell_periods(fs.phi, cid, count.size)
-    blur = fit_blur(mean, count, usable, period,
-                    lambda values: frame_levels(values, used, levels)[0])
-    gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
-    mean, sigma = mean * gain, sigma * gain
-    samples = [np.repeat(m[usable], count[usable]) for m in mean]
-    centres, worst = frame_levels(samples, used, levels)
+    cells = code_cells(prepared, spec, fs)
+    centres, worst = cells.centres, cells.worst
     refuse(separation_problem(worst, levels))
     digit_of = np.zeros((digits, levels), np.int32)
     for i, ds in enumerate(used):
         digit_of[i, :ds.size] = ds
-    cell_order, cell_clear = cell_digits(mean, sigma, centres, digit_of,
+    cell_order, cell_clear = cell_digits(cells.mean, cells.sigma, centres, digit_of,
                                          np.array([d.size for d in used]), levels,
                                          CLEAR_NOISE, CLEAR_SHARE)
-    cell_order = np.where(usable & cell_clear & (cell_order < spec.fringes), cell_order, -1)
+    cell_order = np.where(cells.usable & cell_clear & (cell_order < spec.fringes), cell_order,
+                          -1)
     code, nearest, carried, beyond = read_levels(
         prepared.raw, start, digits, prepared.scale, fs.avg,
-        (fs.mod / gain[cid]).astype(np.float32), fs.valid, fs.phi,
+        (fs.mod / cells.gain[cells.cid]).astype(np.float32), fs.valid, fs.phi,
         centres, digit_of, np.array([d.size for d in used], np.int32), levels, spec.fringes,
         noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE)
-    cells = np.where(fs.valid, cell_order[cid], -1).astype(np.int32)
-    return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": cells,
-                          "labels": labels}, edge_phase=0.0, beyond=beyond)
+    read = np.where(fs.valid, cell_order[cells.cid], -1).astype(np.int32)
+    return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": read,
+                          "labels": cells.labels}, edge_phase=0.0, beyond=beyond)
 
 
 def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None:

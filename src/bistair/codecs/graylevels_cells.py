@@ -23,6 +23,7 @@ Examples
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -141,7 +142,7 @@ def cell_digits(mean: np.ndarray, sigma: np.ndarray, centres: np.ndarray,
     >>> order, clear = cell_digits(np.array([[-0.79, -0.7, 1.3]]), np.full((1, 3), 0.01),
     ...                            centres, np.int32([[0, 1, 2, 3]]), np.int32([4]), 4, 3.0, 0.5)
     >>> order.tolist(), clear.tolist()
-    ([0, 0, 3], [True, False, True])
+    ([0, 1, 3], [True, False, True])
     """
     n = mean.shape[1]
     parent = np.zeros(n, np.int64)
@@ -215,7 +216,7 @@ def cell_periods(phi: np.ndarray, cid: np.ndarray, n: int) -> np.ndarray:
 
 
 def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np.ndarray,
-             centres_of: "callable", rounds: int = 3) -> float:
+             centres_of: Callable, rounds: int = 3) -> float:
     """The blur constant ``c`` of the fringes' modulation against the code's flat levels:
     blur leaves a flat level as it is and takes the fringes' modulation down by the optics'
     transfer at the fringe's frequency, about ``exp(-c / P**2)`` (a Gaussian blur of sigma
