@@ -61,7 +61,7 @@ from ..core.regions import fringe_regions
 from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
-from .graylevels_cells import cell_digits, cell_periods, fit_blur, read_cells
+from .graylevels_cells import cell_digits, fit_blur, read_cells
 from .graylevels_jit import read_levels, row_fill
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
@@ -88,6 +88,7 @@ ROW_CUT = math.pi / 4
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
 MAX_BAND = 0.5
 ABSENT = 0.005
+SAMPLE = 5_000  # about as many values the levels are estimated on (cell means, repeated)
 
 
 def code_digits(fringes: int, levels: int) -> int:
@@ -486,16 +487,16 @@ def code_cells(prepared: Prepared, spec: Any, fs: FringeSet) -> Cells:
     used = frame_digits(spec)
     noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-    cid, mean, count, sigma, _, usable = read_cells(
+    cid, mean, count, sigma, period, usable = read_cells(
         prepared.raw, spec.steps, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
         labels, noise_d, EDGE_ZONE)
-    period = cell_periods(fs.phi, cid, count.size)
+    # each cell's mean repeated for its pixels (about SAMPLE values in all)
+    times = np.where(usable, -(-count // max(1, int(count[usable].sum()) // SAMPLE)), 0)
     blur = fit_blur(mean, count, usable, period,
-                    lambda values: frame_levels(values, used, levels)[0])
+                    lambda values: frame_levels(values, used, levels)[0], times)
     gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
     mean, sigma = mean * gain, sigma * gain
-    centres, worst = frame_levels([np.repeat(m[usable], count[usable]) for m in mean], used,
-                                  levels)
+    centres, worst = frame_levels([np.repeat(m, times) for m in mean], used, levels)
     return Cells(labels, cid, mean, sigma, count, usable, gain, blur, centres, worst)
 
 

@@ -14,10 +14,10 @@ where a region's labelling ran across two fringes, spreads wider and is not read
 Examples
 --------
 >>> import numpy as np
->>> labels = np.int32([[1, 1, 2, 2]] * 4)
->>> cid, n = cell_ids(labels, 2)
->>> cid.tolist()[0], cid.tolist()[2], n
-([2, 2, 4, 4], [3, 3, 5, 5], 6)
+>>> mean, sigma, excess = cell_stats(np.array([[0.0, 12.0]]), np.array([[0.0, 1.5]]),
+...                                  np.array([0.0, 0.1]), np.array([0, 100]))
+>>> mean.tolist(), sigma.round(3).tolist(), excess.round(2).tolist()
+([[0.0, 0.12]], [[0.0, 0.003]], [0.0, 0.6])
 """
 
 from __future__ import annotations
@@ -27,6 +27,8 @@ from collections.abc import Callable
 
 import numpy as np
 
+from .graylevels_jit import cell_sums
+
 # a cell: a fringe region's pixels within CELL_ROWS rows (along the fringe), read where it
 # holds CELL_MIN pixels away from the code's edges whose spread in v is at most MIXED
 # times the variance the noise explains (measured on renders: docs/guide/methods.md)
@@ -35,84 +37,35 @@ CELL_MIN = 30
 MIXED = 4.0
 
 
-def cell_ids(labels: np.ndarray, rows: int = CELL_ROWS) -> tuple[np.ndarray, int]:
-    """Each pixel's cell: ``label * blocks + y // rows`` (0 where the label is 0), and the
-    number of cell ids.
+def cell_stats(total: np.ndarray, square: np.ndarray, expect: np.ndarray, count: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each cell's mean ``v`` per code frame, the sigma of each mean (the larger of the
+    spread seen and the noise's, over the root of the count) and how far the widest
+    frame's spread exceeds the noise's variance, from the sums of
+    :func:`~bistair.codecs.graylevels_jit.cell_sums`.
 
     Parameters
     ----------
-    labels : (H, W) int array
-        Fringe-region labels, 0 outside any region.
-    rows : int
-        Rows of a cell along the fringe.
+    total, square : (D, n) float
+        Sums of ``v`` and ``v**2`` per frame and cell.
+    expect : (n,) float
+        Sums of the noise variance of ``v``.
+    count : (n,) int
+        Pixels summed.
 
     Returns
     -------
-    cid : (H, W) int64
-    n : int
-        One past the largest id.
-    """
-    h = labels.shape[0]
-    blocks = -(-h // rows)
-    block = (np.arange(h, dtype=np.int64) // rows)[:, None]
-    cid = np.where(labels > 0, labels.astype(np.int64) * blocks + block, 0)
-    return cid, int((int(labels.max(initial=0)) + 1) * blocks)
-
-
-def cell_means(v: np.ndarray, noise_v: np.ndarray, inner: np.ndarray, cid: np.ndarray,
-               n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Each cell's mean of ``v`` per code frame over its ``inner`` pixels, their count, the
-    sigma of each mean and how far each frame's spread exceeds the noise's.
-
-    Parameters
-    ----------
-    v : (D, H, W) float array
-        Each code frame's ``(I - A) / B``.
-    noise_v : (H, W) float array
-        The noise sigma of each pixel's ``v``.
-    inner : (H, W) bool
-        The pixels a cell is read on.
-    cid : (H, W) int64
-        Cell ids (:func:`cell_ids`).
-    n : int
-        One past the largest id.
-
-    Returns
-    -------
-    mean : (D, n) float64
-    count : (n,) int64
-    sigma : (D, n) float64
-        The sigma of each mean: the larger of the spread seen and the noise's, over the
-        root of the count.
+    mean, sigma : (D, n) float64
     excess : (n,) float64
-        The largest spread seen over the noise's variance among the frames.
-
-    Examples
-    --------
-    >>> rng = np.random.default_rng(0)
-    >>> v = rng.normal(0.3, 0.1, (1, 1, 400)); cid = np.ones((1, 400), np.int64)
-    >>> mean, count, sigma, excess = cell_means(v, np.full((1, 400), 0.1), cid > 0, cid, 2)
-    >>> round(float(mean[0, 1]), 2), int(count[1]), round(float(sigma[0, 1]), 3)
-    (0.3, 400, 0.005)
-    >>> bool(0.8 < excess[1] < 1.2)
-    True
     """
-    ids = cid[inner]
-    count = np.bincount(ids, minlength=n)
     c = np.maximum(count, 1).astype(np.float64)
-    expect = np.bincount(ids, weights=(noise_v[inner].astype(np.float64)) ** 2,
-                         minlength=n) / c
-    mean = np.empty((v.shape[0], n))
-    sigma = np.empty((v.shape[0], n))
-    excess = np.zeros(n)
-    for i, frame in enumerate(v):
-        x = frame[inner].astype(np.float64)
-        m = np.bincount(ids, weights=x, minlength=n) / c
-        var = np.maximum(np.bincount(ids, weights=x * x, minlength=n) / c - m * m, 0.0)
-        mean[i] = m
-        sigma[i] = np.sqrt(np.maximum(var, expect) / c)
-        excess = np.maximum(excess, var / np.maximum(expect, 1e-12))
-    return mean, count, sigma, excess
+    mean = total / c
+    var = np.maximum(square / c - mean * mean, 0.0)
+    noise = expect / c
+    sigma = np.sqrt(np.maximum(var, noise) / c)
+    # (a noise floor of 0.001 in v: about the 8-bit step of a well modulated pixel)
+    excess = np.max(var / np.maximum(noise, 1e-6), axis=0) if len(total) else np.zeros(c.size)
+    return mean, sigma, excess
 
 
 def cell_digits(mean: np.ndarray, sigma: np.ndarray, centres: np.ndarray,
@@ -162,61 +115,32 @@ def cell_digits(mean: np.ndarray, sigma: np.ndarray, centres: np.ndarray,
     return parent, clear
 
 
-def code_v(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
-           mod: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Each code frame's ``v = (I - A) / B`` (0 where not ``ok``), float32 (D, H, W)."""
-    safe = np.where(ok, mod, np.float32(1.0))
-    out = np.empty((digits, *avg.shape), np.float32)
-    for i in range(digits):
-        out[i] = np.where(ok, (raw[start + i].astype(np.float32) * np.float32(scale) - avg)
-                          / safe, np.float32(0.0))
-    return out
-
-
 def read_cells(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
                mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
                noise_d: float, zone: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
                                                      np.ndarray, np.ndarray, np.ndarray]:
     """The cells of a capture and their readings before the levels are known.
 
-    Returns ``(cid, mean, count, sigma, excess, usable)``: the pixels' cell ids
-    (:func:`cell_ids`), :func:`cell_means` over the valid pixels at least ``zone`` from the
-    code's edges, and the cells that may be read (``CELL_MIN`` pixels, spread at most
-    ``MIXED`` times the noise's).
+    Returns ``(cid, mean, count, sigma, period, usable)``: the pixels' cells (``label *
+    blocks + y // CELL_ROWS``, 0 outside any region), :func:`cell_stats` over the valid
+    pixels at least ``zone`` from the code's edges, each cell's fringe period along the
+    rows in pixels (``2 pi`` over its mean phase step, ``inf`` where it has none) and the
+    cells that may be read (``CELL_MIN`` pixels, spread at most ``MIXED`` times the
+    noise's).
     """
-    ok = valid & (mod > 0)
-    inner = ok & (labels > 0) & (phi >= zone) & (phi <= np.float32(2 * math.pi - zone))
-    v = code_v(raw, start, digits, scale, avg, mod, ok)
-    cid, n = cell_ids(labels)
-    noise_v = np.float32(noise_d) / np.where(ok, mod, np.float32(1.0))
-    mean, count, sigma, excess = cell_means(v, noise_v, inner, cid, n)
+    cid, total, square, expect, count, step, steps = cell_sums(
+        raw, start, digits, scale, avg, mod, valid, phi, labels, CELL_ROWS, zone, noise_d)
+    mean, sigma, excess = cell_stats(total, square, expect, count)
+    rate = np.abs(step) / np.maximum(steps, 1)
+    period = np.where(rate > 0, 2 * math.pi / np.where(rate > 0, rate, 1.0), np.inf)
     usable = (count >= CELL_MIN) & (excess <= MIXED)
     usable[0] = False  # id 0: no region
-    return cid, mean, count, sigma, excess, usable
-
-
-def cell_periods(phi: np.ndarray, cid: np.ndarray, n: int) -> np.ndarray:
-    """Each cell's fringe period along the rows in pixels, ``2 pi`` over its mean phase
-    step between neighbouring pixels (wraps and steps over 1 radian left out); ``inf``
-    where a cell has none.
-
-    Examples
-    --------
-    >>> phi = np.tile(np.float32(np.arange(8) * 0.5), (2, 1))
-    >>> cell_periods(phi, np.ones((2, 8), np.int64), 2)[1].round(2)
-    np.float64(12.57)
-    """
-    step = np.diff(phi.astype(np.float64), axis=1)
-    a, b = cid[:, :-1], cid[:, 1:]
-    keep = (a > 0) & (a == b) & (np.abs(step) < 1.0)
-    total = np.bincount(a[keep], weights=step[keep], minlength=n)
-    count = np.bincount(a[keep], minlength=n)
-    mean = np.abs(total) / np.maximum(count, 1)
-    return np.where(mean > 0, 2 * math.pi / np.where(mean > 0, mean, 1.0), np.inf)
+    return cid, mean, count, sigma, period, usable
 
 
 def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np.ndarray,
-             centres_of: Callable, rounds: int = 3) -> float:
+             centres_of: Callable, times: np.ndarray | None = None, rounds: int = 2
+             ) -> float:
     """The blur constant ``c`` of the fringes' modulation against the code's flat levels:
     blur leaves a flat level as it is and takes the fringes' modulation down by the optics'
     transfer at the fringe's frequency, about ``exp(-c / P**2)`` (a Gaussian blur of sigma
@@ -237,6 +161,9 @@ def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np
         :func:`cell_periods`.
     centres_of : callable
         ``centres_of(list of per-frame pixel-weighted values) -> (D, L) centres``.
+    times : (n,) int, optional
+        How many times each cell's mean counts there (its pixels, the default, where
+        usable, else 0).
     rounds : int
         Refits.
 
@@ -254,10 +181,11 @@ def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np
     """
     x = np.where(np.isfinite(period), 1.0 / period ** 2, 0.0)
     use = usable & np.isfinite(period)
+    times = np.where(usable, count, 0) if times is None else times
     c = 0.0
     for _ in range(rounds):
         corrected = mean * np.exp(-c * x)
-        centres = centres_of([np.repeat(m[use], count[use]) for m in corrected])
+        centres = centres_of([np.repeat(m, times) for m in corrected])
         sxy = sxx = 0.0
         for i, m in enumerate(corrected):
             levels = centres[i][np.isfinite(centres[i])]

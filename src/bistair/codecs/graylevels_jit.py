@@ -277,3 +277,100 @@ def row_fill(order: np.ndarray, nearest: np.ndarray, clear: np.ndarray, carried:
                      np.asarray(carried, np.bool_),
                      np.asarray(phi, np.float32), np.asarray(valid, np.bool_), float(zone),
                      int(reach), float(cut))
+
+
+@kernel()
+def _cell_sums(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+               mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
+               rows: int, zone: float, noise_d: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                          np.ndarray, np.ndarray]:
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    z32 = np.float32(zone)
+    top = np.float32(2.0 * math.pi - zone)
+    blocks = (h + rows - 1) // rows
+    n = (labels.max() + 1) * blocks
+    cid = np.zeros((h, w), np.int64)
+    total = np.zeros((digits, n))
+    square = np.zeros((digits, n))
+    expect = np.zeros(n)
+    count = np.zeros(n, np.int64)
+    step = np.zeros(n)
+    steps = np.zeros(n, np.int64)
+    for y in range(h):
+        block = y // rows
+        for x in range(w):
+            lab = labels[y, x]
+            if lab <= 0:
+                continue
+            c = lab * blocks + block
+            cid[y, x] = c
+            if x + 1 < w and labels[y, x + 1] == lab:
+                d = phi[y, x + 1] - phi[y, x]
+                if abs(d) < 1.0:
+                    step[c] += d
+                    steps[c] += 1
+            p = phi[y, x]
+            b = mod[y, x]
+            if not valid[y, x] or b <= 0 or p < z32 or p > top:
+                continue
+            count[c] += 1
+            expect[c] += (noise_d / b) ** 2
+            for i in range(digits):
+                v = (np.float32(raw[start + i, y, x]) * s32 - avg[y, x]) / b
+                total[i, c] += v
+                square[i, c] += v * v
+    return cid, total, square, expect, count, step, steps
+
+
+def cell_sums(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+              mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
+              rows: int, zone: float, noise_d: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                         np.ndarray, np.ndarray]:
+    """The sums a code cell is read from, in one pass: each pixel's cell (``label *
+    blocks + y // rows``, 0 outside any region), and per cell over its valid pixels at
+    least ``zone`` from the code's edges the sums of each code frame's ``v = (I - A) /
+    B`` and of its square, of the noise variance ``(noise_d / B)**2`` and the count; and
+    over all its pixels the phase steps to the next pixel along the row in the same
+    region (under 1 radian) and their count.
+
+    Parameters
+    ----------
+    raw, start, digits, scale, avg, mod, valid, phi
+        As :func:`read_levels` takes them.
+    labels : (H, W) int array
+        Fringe regions, 0 outside any.
+    rows : int
+        Rows of a cell.
+    zone : float
+        Radians from the code's edges left out of the means.
+    noise_d : float
+        The noise of ``I - A``.
+
+    Returns
+    -------
+    cid : (H, W) int64
+    total, square : (D, n) float64
+    expect : (n,) float64
+    count : (n,) int64
+    step : (n,) float64
+    steps : (n,) int64
+
+    Examples
+    --------
+    >>> raw = np.float32([[[0.25, 0.25, 0.75]]])
+    >>> ones = np.ones((1, 3), np.float32)
+    >>> cid, total, square, expect, count, step, steps = cell_sums(
+    ...     raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, np.ones((1, 3), bool),
+    ...     np.float32([[2.0, 2.5, 3.0]]), np.int32([[1, 1, 2]]), 4, 1.0, 0.01)
+    >>> cid.tolist(), total.tolist(), count.tolist(), step.tolist()
+    ([[1, 1, 2]], [[0.0, -1.0, 0.5]], [0, 2, 1], [0.0, 0.5, 0.0])
+    """
+    raw, start = kernel_frames(raw, start, digits)
+    return _cell_sums(raw, int(start), int(digits), float(np.float32(scale)),
+                      np.asarray(avg, np.float32), np.asarray(mod, np.float32),
+                      np.asarray(valid, np.bool_), np.asarray(phi, np.float32),
+                      np.ascontiguousarray(labels, np.int32), int(rows), float(zone),
+                      float(noise_d))
