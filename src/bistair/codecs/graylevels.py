@@ -61,7 +61,7 @@ from ..core.regions import fringe_regions
 from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
-from .graylevels_cells import cell_digits, fit_blur, read_cells
+from .graylevels_cells import CELL_MIN, cell_digits, fit_blur, narrow, read_cells
 from .graylevels_jit import read_levels, row_fill
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
@@ -448,7 +448,7 @@ class Cells(NamedTuple):
     mean: np.ndarray  # (D, n) each cell's v, the blur taken out
     sigma: np.ndarray  # (D, n) the sigma of each mean
     count: np.ndarray  # (n,) pixels each mean is over
-    usable: np.ndarray  # (n,) the cells read
+    usable: np.ndarray  # (n,) the cells read (not mixed)
     gain: np.ndarray  # (n,) what the blur taken out multiplies each cell's v by
     blur: float  # the blur constant c (:func:`~bistair.codecs.graylevels_cells.fit_blur`)
     centres: np.ndarray  # (D, L) the levels (:func:`frame_levels`)
@@ -487,17 +487,21 @@ def code_cells(prepared: Prepared, spec: Any, fs: FringeSet) -> Cells:
     used = frame_digits(spec)
     noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
     labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
-    cid, mean, count, sigma, period, usable = read_cells(
+    cid, mean, count, sigma, spread, period, clean = read_cells(
         prepared.raw, spec.steps, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
         labels, noise_d, EDGE_ZONE)
+    big = count >= CELL_MIN
+    big[0] = False  # (no region)
+    usable = big & clean  # the levels are estimated on these
     # each cell's mean repeated for its pixels (about SAMPLE values in all)
     times = np.where(usable, -(-count // max(1, int(count[usable].sum()) // SAMPLE)), 0)
     blur = fit_blur(mean, count, usable, period,
                     lambda values: frame_levels(values, used, levels)[0], times)
     gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
-    mean, sigma = mean * gain, sigma * gain
+    mean, sigma, spread = mean * gain, sigma * gain, spread * gain
     centres, worst = frame_levels([np.repeat(m, times) for m in mean], used, levels)
-    return Cells(labels, cid, mean, sigma, count, usable, gain, blur, centres, worst)
+    read = big & (clean | narrow(spread, mean, centres, np.array([d.size for d in used])))
+    return Cells(labels, cid, mean, sigma, count, read, gain, blur, centres, worst)
 
 
 def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
@@ -516,9 +520,11 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     Returns
     -------
     CodeMap
-        ``code``: the order where every digit is clear (-1 elsewhere); ``maps["nearest"]``
-        the order of the nearest levels, ``maps["carried"]`` where the pixel's own digits
-        carry its order; ``edge_phase`` 0; ``beyond``.
+        ``code``: the order of the pixel's cell where the cell is read (every digit clear:
+        ``maps["cells"]``), else of its own reading where every digit is clear (-1
+        elsewhere); ``maps["nearest"]`` the order of a pixel's nearest levels (read one by
+        one where its cell is not), ``maps["carried"]`` where its own digits carry its
+        order, ``maps["labels"]`` the fringe regions; ``edge_phase`` 0; ``beyond``.
 
     Raises
     ------
@@ -551,12 +557,13 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
                                          CLEAR_NOISE, CLEAR_SHARE)
     cell_order = np.where(cells.usable & cell_clear & (cell_order < spec.fringes), cell_order,
                           -1)
+    read = np.where(fs.valid, cell_order[cells.cid], -1).astype(np.int32)
     code, nearest, carried, beyond = read_levels(
         prepared.raw, start, digits, prepared.scale, fs.avg,
         (fs.mod / cells.gain[cells.cid]).astype(np.float32), fs.valid, fs.phi,
         centres, digit_of, np.array([d.size for d in used], np.int32), levels, spec.fringes,
-        noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE)
-    read = np.where(fs.valid, cell_order[cells.cid], -1).astype(np.int32)
+        noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE, read < 0)
+    code = np.where(read >= 0, read, code)
     return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": read,
                           "labels": cells.labels}, edge_phase=0.0, beyond=beyond)
 
@@ -629,9 +636,8 @@ def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     True
     """
     nearest, carried, cells = code.maps["nearest"], code.maps["carried"], code.maps["cells"]
-    # a cell read whole carries its pixels, but not one whose own clear digits say otherwise
+    # a cell read whole carries its pixels (they are not read one by one)
     k = np.where(cells >= 0, cells, np.where(carried, code.code, -1))
-    k[carried & (cells >= 0) & (code.code != cells)] = -1
     carried = k >= 0
     labels = code.maps["labels"]
     n = int(labels.max(initial=0))

@@ -9,12 +9,13 @@ rows along the fringe, at least ``EDGE_ZONE`` from the code's edges where the ca
 mixes two cells) the noise of the mean falls by the root of its hundreds of pixels and the
 levels stand many sigmas apart. A cell is read where it holds ``CELL_MIN`` such pixels and
 their spread is what one level and the noise explain (a cell that mixes two cells' digits,
-where a region's labelling ran across two fringes, spreads wider and is not read).
+where a region's labelling ran across two fringes, spreads wider and is not read:
+:func:`narrow`).
 
 Examples
 --------
 >>> import numpy as np
->>> mean, sigma, excess = cell_stats(np.array([[0.0, 12.0]]), np.array([[0.0, 1.5]]),
+>>> mean, sigma, spread, excess = cell_stats(np.array([[0.0, 12.0]]), np.array([[0.0, 1.5]]),
 ...                                  np.array([0.0, 0.1]), np.array([0, 100]))
 >>> mean.tolist(), sigma.round(3).tolist(), excess.round(2).tolist()
 ([[0.0, 0.12]], [[0.0, 0.003]], [0.0, 0.6])
@@ -30,18 +31,22 @@ import numpy as np
 from .graylevels_jit import cell_sums
 
 # a cell: a fringe region's pixels within CELL_ROWS rows (along the fringe), read where it
-# holds CELL_MIN pixels away from the code's edges whose spread in v is at most MIXED
-# times the variance the noise explains (measured on renders: docs/guide/methods.md)
+# holds CELL_MIN pixels away from the code's edges whose variance in v is at most MIXED
+# times the noise's (the levels are estimated on those) or, in every frame, whose spread
+# beyond the noise is at most SPREAD of the gap from its level to the nearer neighbour (a
+# cell mixing two cells' digits spreads wider)
 CELL_ROWS = 32
 CELL_MIN = 30
 MIXED = 4.0
+SPREAD = 0.25
 
 
 def cell_stats(total: np.ndarray, square: np.ndarray, expect: np.ndarray, count: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Each cell's mean ``v`` per code frame, the sigma of each mean (the larger of the
-    spread seen and the noise's, over the root of the count) and how far the widest
-    frame's spread exceeds the noise's variance, from the sums of
+    spread seen and the noise's, over the root of the count), the spread (sigma) beyond the
+    noise's per frame and how far the widest frame's variance exceeds the noise's, from
+    the sums of
     :func:`~bistair.codecs.graylevels_jit.cell_sums`.
 
     Parameters
@@ -55,7 +60,7 @@ def cell_stats(total: np.ndarray, square: np.ndarray, expect: np.ndarray, count:
 
     Returns
     -------
-    mean, sigma : (D, n) float64
+    mean, sigma, spread : (D, n) float64
     excess : (n,) float64
     """
     c = np.maximum(count, 1).astype(np.float64)
@@ -65,7 +70,7 @@ def cell_stats(total: np.ndarray, square: np.ndarray, expect: np.ndarray, count:
     sigma = np.sqrt(np.maximum(var, noise) / c)
     # (a noise floor of 0.001 in v: about the 8-bit step of a well modulated pixel)
     excess = np.max(var / np.maximum(noise, 1e-6), axis=0) if len(total) else np.zeros(c.size)
-    return mean, sigma, excess
+    return mean, sigma, np.sqrt(np.maximum(var - noise, 0.0)), excess
 
 
 def cell_digits(mean: np.ndarray, sigma: np.ndarray, centres: np.ndarray,
@@ -117,25 +122,21 @@ def cell_digits(mean: np.ndarray, sigma: np.ndarray, centres: np.ndarray,
 
 def read_cells(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
                mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
-               noise_d: float, zone: float) -> tuple[np.ndarray, np.ndarray, np.ndarray,
-                                                     np.ndarray, np.ndarray, np.ndarray]:
+               noise_d: float, zone: float) -> tuple[np.ndarray, ...]:
     """The cells of a capture and their readings before the levels are known.
 
-    Returns ``(cid, mean, count, sigma, period, usable)``: the pixels' cells (``label *
-    blocks + y // CELL_ROWS``, 0 outside any region), :func:`cell_stats` over the valid
-    pixels at least ``zone`` from the code's edges, each cell's fringe period along the
-    rows in pixels (``2 pi`` over its mean phase step, ``inf`` where it has none) and the
-    cells that may be read (``CELL_MIN`` pixels, spread at most ``MIXED`` times the
-    noise's).
+    Returns ``(cid, mean, count, sigma, spread, period, clean)``: the pixels' cells
+    (``label * blocks + y // CELL_ROWS``, 0 outside any region), :func:`cell_stats` over
+    the valid pixels at least ``zone`` from the code's edges, each cell's fringe period
+    along the rows in pixels (``2 pi`` over its mean phase step, ``inf`` where it has
+    none) and the cells whose variance is at most ``MIXED`` times the noise's.
     """
     cid, total, square, expect, count, step, steps = cell_sums(
         raw, start, digits, scale, avg, mod, valid, phi, labels, CELL_ROWS, zone, noise_d)
-    mean, sigma, excess = cell_stats(total, square, expect, count)
+    mean, sigma, spread, excess = cell_stats(total, square, expect, count)
     rate = np.abs(step) / np.maximum(steps, 1)
     period = np.where(rate > 0, 2 * math.pi / np.where(rate > 0, rate, 1.0), np.inf)
-    usable = (count >= CELL_MIN) & (excess <= MIXED)
-    usable[0] = False  # id 0: no region
-    return cid, mean, count, sigma, period, usable
+    return cid, mean, count, sigma, spread, period, excess <= MIXED
 
 
 def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np.ndarray,
@@ -202,3 +203,42 @@ def fit_blur(mean: np.ndarray, count: np.ndarray, usable: np.ndarray, period: np
                 sxx += float(np.sum(w * xs * xs))
         c = max(sxy / sxx, 0.0) if sxx > 0 else 0.0
     return c
+
+
+def narrow(spread: np.ndarray, mean: np.ndarray, centres: np.ndarray, used: np.ndarray
+           ) -> np.ndarray:
+    """The cells whose spread beyond the noise is at most ``SPREAD`` of the gap between
+    their level and its nearer neighbour, in every frame (two levels mixed spread by a
+    share of the gap between them).
+
+    Parameters
+    ----------
+    spread, mean : (D, n) float
+        :func:`cell_stats`.
+    centres : (D, L) float
+        The levels, the first ``used[i]`` of row ``i`` set, increasing.
+    used : (D,) int
+        Levels per frame.
+
+    Returns
+    -------
+    (n,) bool
+
+    Examples
+    --------
+    >>> centres = np.array([[-1.5, 0.0, 0.4]])
+    >>> narrow(np.array([[0.2, 0.2, 0.05]]), np.array([[-1.5, 0.4, 0.0]]), centres,
+    ...        np.array([3])).tolist()
+    [True, False, True]
+    """
+    ok = np.ones(spread.shape[1], bool)
+    for i, s in enumerate(spread):
+        c = centres[i, :used[i]].astype(np.float64)
+        if c.size < 2:
+            continue
+        gaps = np.diff(c)
+        nearest = np.searchsorted(0.5 * (c[1:] + c[:-1]), mean[i])
+        gap = np.minimum(np.concatenate([[np.inf], gaps])[nearest],
+                         np.concatenate([gaps, [np.inf]])[nearest])
+        ok &= s <= SPREAD * gap
+    return ok
