@@ -62,7 +62,7 @@ from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
 from .graylevels_cells import CELL_MIN, cell_digits, fit_blur, narrow, read_cells
-from .graylevels_jit import read_levels, row_fill
+from .graylevels_jit import read_levels, row_fill, sample_levels
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
 # a clear digit: outside the middle CLEAR_SHARE of the gap between two levels, by
@@ -88,7 +88,11 @@ ROW_CUT = math.pi / 4
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
 MAX_BAND = 0.5
 ABSENT = 0.005
+# and no two neighbouring levels of a frame closer than MIN_GAP of the fringes' modulation
+# in v (renders: right readings 0.165 and more, codes washed out to 5-10% 0.056 and less)
+MIN_GAP = 0.1
 SAMPLE = 5_000  # about as many values the levels are estimated on (cell means, repeated)
+ALONE = 100_000  # pixels the levels' separation one by one is judged on
 
 
 def code_digits(fringes: int, levels: int) -> int:
@@ -440,6 +444,24 @@ def frame_levels(samples: list[np.ndarray], used: list[np.ndarray], levels: int
     return centres, worst
 
 
+def _alone_values(prepared: Prepared, start: int, digits: int, fs: FringeSet, mod: np.ndarray
+                  ) -> list[np.ndarray]:
+    """``v`` of each code frame as a pixel read one by one reads it (averaged along the
+    fringe within ``REACH`` rows), against the modulation ``mod`` (the blur taken out), on
+    an even grid of at most ``ALONE`` valid pixels at least ``EDGE_ZONE`` from the code's
+    edges, the better modulated half of them."""
+    h, w = fs.phi.shape
+    step = max(1, int(math.ceil(math.sqrt(h * w / ALONE))))
+    sub, phi = fs.mod[::step, ::step], fs.phi[::step, ::step]
+    valid = fs.valid[::step, ::step] & (sub > 0) & (phi >= EDGE_ZONE) & (
+        phi <= TWO_PI - EDGE_ZONE)  # away from the code's edges: no level between two
+    if np.any(valid):
+        valid &= sub >= np.median(sub[valid])
+    ys, xs = np.nonzero(valid)
+    return list(sample_levels(prepared.raw, start, digits, prepared.scale, fs.avg, mod,
+                              fs.valid, fs.phi, ys * step, xs * step, REACH, SAME_FRINGE))
+
+
 class Cells(NamedTuple):
     """A capture's code cells (:mod:`~bistair.codecs.graylevels_cells`) and its levels."""
 
@@ -548,7 +570,7 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
     cells = code_cells(prepared, spec, fs)
     centres, worst = cells.centres, cells.worst
-    refuse(separation_problem(worst, levels))
+    refuse(separation_problem(worst, levels) or washed_problem(centres, used))
     digit_of = np.zeros((digits, levels), np.int32)
     for i, ds in enumerate(used):
         digit_of[i, :ds.size] = ds
@@ -558,11 +580,17 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     cell_order = np.where(cells.usable & cell_clear & (cell_order < spec.fringes), cell_order,
                           -1)
     read = np.where(fs.valid, cell_order[cells.cid], -1).astype(np.int32)
+    mod = (fs.mod / cells.gain[cells.cid]).astype(np.float32)
+    # a pixel read one by one carries its order only where the levels separate pixel by
+    # pixel too (the same check on its readings; else only the cells carry)
+    alone = frame_levels(_alone_values(prepared, start, digits, fs, mod), used, levels)
+    alone_ok = alone[1][0] <= MAX_BAND
     code, nearest, carried, beyond = read_levels(
-        prepared.raw, start, digits, prepared.scale, fs.avg,
-        (fs.mod / cells.gain[cells.cid]).astype(np.float32), fs.valid, fs.phi,
+        prepared.raw, start, digits, prepared.scale, fs.avg, mod, fs.valid, fs.phi,
         centres, digit_of, np.array([d.size for d in used], np.int32), levels, spec.fringes,
         noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE, read < 0)
+    if not alone_ok:
+        code, carried = np.where(read >= 0, code, -1), np.zeros_like(carried)
     code = np.where(read >= 0, read, code)
     return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": read,
                           "labels": cells.labels}, edge_phase=0.0, beyond=beyond)
@@ -600,6 +628,43 @@ def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None
     return (f"{where} do{'' if frame < 0 else 'es'} not show {levels} separate grey levels: "
             f"{amount}; is code_levels {levels} right (a binary code, another L), or is the "
             "code washed out?")
+
+
+def washed_problem(centres: np.ndarray, used: list[np.ndarray]) -> str | None:
+    """The one-line reason to refuse a capture two of whose neighbouring levels lie under
+    ``MIN_GAP`` apart in ``v`` (a code washed out: its levels too close for the cells'
+    systematic spread, whatever the noise), or ``None``.
+
+    Parameters
+    ----------
+    centres : (D, L) array
+        Each frame's levels (:func:`frame_levels`).
+    used : list of numpy.ndarray
+        The digits each frame draws.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> washed_problem(np.float32([[-0.75, -0.56, 0.1, 1.3]]), [np.arange(4)]) is None
+    True
+    >>> washed_problem(np.float32([[-0.05, -0.02, 0.01, 0.05]]), [np.arange(4)])
+    ... # doctest: +ELLIPSIS
+    "code frame gray-0's levels of digits 1 and 2 lie 0.030 of the fringes' modulation ..."
+    """
+    worst = (math.inf, 0, 0)
+    for i, ds in enumerate(used):
+        gaps = np.diff(centres[i, :ds.size].astype(np.float64))
+        if gaps.size and gaps.min() < worst[0]:
+            worst = (float(gaps.min()), i, int(ds[int(np.argmin(gaps))]))
+    gap, frame, low = worst
+    if gap >= MIN_GAP:
+        return None
+    return (f"code frame gray-{frame}'s levels of digits {low} and {low + 1} lie {gap:.3f} "
+            f"of the fringes' modulation apart (at least {MIN_GAP}): is the code washed "
+            "out, or do its levels crowd (compensate the projector's gamma, use more steps)?")
 
 
 def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:

@@ -21,9 +21,78 @@ import math
 
 import numpy as np
 
-from ..core.jit import kernel, kernel_frames
+from ..core.jit import _numba_inline, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
+
+
+@_numba_inline
+def _level(raw: np.ndarray, frame: int, y: int, x: int, s32: np.float32, avg: np.ndarray,
+           mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, reach: int,
+           tol: np.float32) -> tuple[np.float32, int]:
+    """``(I - A) / B`` of a frame at ``(y, x)``, averaged over the pixels of the same fringe
+    within ``reach`` rows (along the fringe, where the code does not change: valid, their
+    phase within ``tol`` of the pixel's, unwrapped), and how many were averaged."""
+    h = raw.shape[1]
+    p0 = phi[y, x]
+    total = np.float32(0.0)
+    count = 0
+    for yy in range(max(0, y - reach), min(h, y + reach + 1)):
+        if valid[yy, x] and mod[yy, x] > 0 and abs(phi[yy, x] - p0) < tol:
+            total += (np.float32(raw[frame, yy, x]) * s32 - avg[yy, x]) / mod[yy, x]
+            count += 1
+    return total / np.float32(max(count, 1)), count
+
+
+@kernel(parallel=True)
+def _sample_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+                   mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, ys: np.ndarray,
+                   xs: np.ndarray, reach: int, tol: float) -> np.ndarray:
+    s32 = np.float32(scale)
+    t32 = np.float32(tol)
+    out = np.empty((digits, ys.size), np.float32)
+    for k in prange(ys.size):
+        for i in range(digits):
+            out[i, k] = _level(raw, start + i, ys[k], xs[k], s32, avg, mod, valid, phi, reach,
+                               t32)[0]
+    return out
+
+
+def sample_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+                  mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, ys: np.ndarray,
+                  xs: np.ndarray, reach: int, tol: float) -> np.ndarray:
+    """``v = (I - A) / B`` of each code frame at the pixels ``(ys, xs)`` (valid ones),
+    averaged along the fringe as :func:`read_levels` reads it.
+
+    Parameters
+    ----------
+    raw, start, digits, scale, avg, mod, valid, phi
+        As :func:`read_levels` takes them.
+    ys, xs : numpy.ndarray
+        The pixels' rows and columns.
+    reach : int
+        Rows either side averaged along the fringe.
+    tol : float
+        The largest phase difference (radians) of a pixel averaged with.
+
+    Returns
+    -------
+    (digits, len(ys)) float32
+
+    Examples
+    --------
+    >>> raw = np.float32([[[0.0, 1 / 3], [0.0, 1 / 3]]])
+    >>> ones = np.ones((2, 2), np.float32)
+    >>> sample_levels(raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, np.ones((2, 2), bool), ones,
+    ...               np.int64([0, 1]), np.int64([0, 1]), 2, 0.5).astype(float).round(3).tolist()
+    [[-1.0, -0.333]]
+    """
+    raw, start = kernel_frames(raw, start, digits)
+    return _sample_levels(raw, int(start), int(digits), float(np.float32(scale)),
+                          np.asarray(avg, np.float32), np.asarray(mod, np.float32),
+                          np.asarray(valid, np.bool_), np.asarray(phi, np.float32),
+                          np.asarray(ys, np.int64), np.asarray(xs, np.int64), int(reach),
+                          float(tol))
 
 
 @kernel(parallel=True)
