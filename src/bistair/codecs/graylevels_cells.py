@@ -62,6 +62,13 @@ def cell_stats(total: np.ndarray, square: np.ndarray, expect: np.ndarray, count:
     -------
     mean, sigma, spread : (D, n) float64
     excess : (n,) float64
+
+    Examples
+    --------
+    >>> mean, sigma, spread, excess = cell_stats(
+    ...     np.array([[40.0]]), np.array([[20.0]]), np.array([0.5]), np.array([100]))
+    >>> mean.tolist(), sigma.round(3).tolist(), spread.round(3).tolist(), excess.round(1).tolist()
+    ([[0.4]], [[0.02]], [[0.187]], [8.0])
     """
     c = np.maximum(count, 1).astype(np.float64)
     mean = total / c
@@ -125,11 +132,36 @@ def read_cells(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.n
                noise_d: float, zone: float) -> tuple[np.ndarray, ...]:
     """The cells of a capture and their readings before the levels are known.
 
-    Returns ``(cid, mean, count, sigma, spread, period, clean)``: the pixels' cells
-    (``label * blocks + y // CELL_ROWS``, 0 outside any region), :func:`cell_stats` over
-    the valid pixels at least ``zone`` from the code's edges, each cell's fringe period
-    along the rows in pixels (``2 pi`` over its mean phase step, ``inf`` where it has
-    none) and the cells whose variance is at most ``MIXED`` times the noise's.
+    Parameters
+    ----------
+    raw, start, digits, scale, avg, mod, valid, phi
+        As :func:`~bistair.codecs.graylevels_jit.read_levels` takes them.
+    labels : (H, W) int array
+        Fringe regions, 0 outside any.
+    noise_d : float
+        The noise of ``I - A``.
+    zone : float
+        Radians from the code's edges left out of the means.
+
+    Returns
+    -------
+    tuple
+        ``(cid, mean, count, sigma, spread, period, clean)``: the pixels' cells (``label *
+        blocks + y // CELL_ROWS``, 0 outside any region), :func:`cell_stats` over the valid
+        pixels at least ``zone`` from the code's edges, each cell's fringe period along the
+        rows in pixels (``2 pi`` over its mean phase step, ``inf`` where it has none) and
+        the cells whose variance is at most ``MIXED`` times the noise's.
+
+    Examples
+    --------
+    >>> raw = np.float32(np.repeat([0.25, 0.5, 0.75], 20))[None, None].repeat(40, 1)
+    >>> ones = np.ones((40, 60), np.float32)
+    >>> phi = np.tile(np.float32(np.arange(60) % 20 * 0.3), (40, 1))
+    >>> labels = np.repeat(np.int32([1, 2, 3]), 20)[None].repeat(40, 0)
+    >>> cid, mean, count, sigma, spread, period, clean = read_cells(
+    ...     raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, ones > 0, phi, labels, 0.01, 1.0)
+    >>> mean[0, count > 0].tolist(), period[count > 0].round(1).tolist()
+    ([-0.5, -0.5, 0.0, 0.0, 0.5, 0.5], [20.9, 20.9, 20.9, 20.9, 20.9, 20.9])
     """
     cid, total, square, expect, count, step, steps = cell_sums(
         raw, start, digits, scale, avg, mod, valid, phi, labels, CELL_ROWS, zone, noise_d)
