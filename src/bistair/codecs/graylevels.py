@@ -49,7 +49,7 @@ Examples
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -61,6 +61,7 @@ from ..core.regions import fringe_regions
 from ..core.resolve import code_evidence
 from ..errors import BistairError
 from .base import CodeMap, Orders, fringe_index
+from .graylevels_cells import CELL_MIN, cell_digits, fit_blur, narrow, read_cells
 from .graylevels_jit import read_levels, row_fill, sample_levels
 
 MAX_LEVELS = 16  # an 8-bit projector's levels 17 grey values apart at most
@@ -87,7 +88,11 @@ ROW_CUT = math.pi / 4
 # docs/guide/methods.md); a level under ABSENT of a frame's sample is out of view there
 MAX_BAND = 0.5
 ABSENT = 0.005
-SAMPLE = 100_000  # pixels the levels are estimated on
+# and no two neighbouring levels of a frame closer than MIN_GAP of the fringes' modulation
+# in v (renders: right readings 0.165 and more, codes washed out to 5-10% 0.056 and less)
+MIN_GAP = 0.1
+SAMPLE = 5_000  # about as many values the levels are estimated on (cell means, repeated)
+ALONE = 100_000  # pixels the levels' separation one by one is judged on
 
 
 def code_digits(fringes: int, levels: int) -> int:
@@ -439,23 +444,86 @@ def frame_levels(samples: list[np.ndarray], used: list[np.ndarray], levels: int
     return centres, worst
 
 
-def _sample_values(prepared: Prepared, start: int, digits: int, fs: FringeSet
-                   ) -> list[np.ndarray]:
-    """``v`` of each code frame (averaged along the fringe as read) on an even grid of at
-    most ``SAMPLE`` valid pixels at least ``EDGE_ZONE`` from the code's edges (no level
-    between two there), the better modulated half of them (where the levels read with the
-    least noise)."""
+def _alone_values(prepared: Prepared, start: int, digits: int, fs: FringeSet, mod: np.ndarray
+                  ) -> list[np.ndarray]:
+    """``v`` of each code frame as a pixel read one by one reads it (averaged along the
+    fringe within ``REACH`` rows), against the modulation ``mod`` (the blur taken out), on
+    an even grid of at most ``ALONE`` valid pixels at least ``EDGE_ZONE`` from the code's
+    edges, the better modulated half of them."""
     h, w = fs.phi.shape
-    step = max(1, int(math.ceil(math.sqrt(h * w / SAMPLE))))
-    mod, phi = fs.mod[::step, ::step], fs.phi[::step, ::step]
-    valid = fs.valid[::step, ::step] & (mod > 0) & (phi >= EDGE_ZONE) & (
+    step = max(1, int(math.ceil(math.sqrt(h * w / ALONE))))
+    sub, phi = fs.mod[::step, ::step], fs.phi[::step, ::step]
+    valid = fs.valid[::step, ::step] & (sub > 0) & (phi >= EDGE_ZONE) & (
         phi <= TWO_PI - EDGE_ZONE)  # away from the code's edges: no level between two
     if np.any(valid):
-        valid &= mod >= np.median(mod[valid])
+        valid &= sub >= np.median(sub[valid])
     ys, xs = np.nonzero(valid)
-    values = sample_levels(prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod,
-                           fs.valid, fs.phi, ys * step, xs * step, REACH, SAME_FRINGE)
-    return list(values)
+    return list(sample_levels(prepared.raw, start, digits, prepared.scale, fs.avg, mod,
+                              fs.valid, fs.phi, ys * step, xs * step, REACH, SAME_FRINGE))
+
+
+class Cells(NamedTuple):
+    """A capture's code cells (:mod:`~bistair.codecs.graylevels_cells`) and its levels."""
+
+    labels: np.ndarray  # (H, W) fringe regions
+    cid: np.ndarray  # (H, W) each pixel's cell
+    mean: np.ndarray  # (D, n) each cell's v, the blur taken out
+    sigma: np.ndarray  # (D, n) the sigma of each mean
+    count: np.ndarray  # (n,) pixels each mean is over
+    usable: np.ndarray  # (n,) the cells read (not mixed)
+    gain: np.ndarray  # (n,) what the blur taken out multiplies each cell's v by
+    blur: float  # the blur constant c (:func:`~bistair.codecs.graylevels_cells.fit_blur`)
+    centres: np.ndarray  # (D, L) the levels (:func:`frame_levels`)
+    worst: tuple[float, int, int]  # the worst separation
+
+
+def code_cells(prepared: Prepared, spec: Any, fs: FringeSet) -> Cells:
+    """The code cells of a multi-level capture read, the fringes' blur fitted and taken
+    out of their ``v`` and the levels estimated on them (each cell weighted by its pixels).
+
+    Parameters
+    ----------
+    prepared : Prepared
+        The method's frames in method order, column layout.
+    spec : GrayCodeSpec
+        A spec with ``code_levels`` > 2.
+    fs : FringeSet
+        Stage 1.
+
+    Returns
+    -------
+    Cells
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=480, height=64, period=30, code_levels=4)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> cells = code_cells(cols, spec, measure_shifts(cols, spec))
+    >>> cells.centres.astype(float).round(2).tolist(), cells.worst[0] < 0.01
+    ([[-1.0, -0.33, 0.33, 1.0], [-1.0, -0.33, 0.33, 1.0]], True)
+    """
+    levels, digits = spec.code_levels, spec.code_bits
+    used = frame_digits(spec)
+    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    labels, _ = fringe_regions(fs.phi, fs.valid, phase_noise=fs.phase_noise)
+    cid, mean, count, sigma, spread, period, clean = read_cells(
+        prepared.raw, spec.steps, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
+        labels, noise_d, EDGE_ZONE)
+    big = count >= CELL_MIN
+    big[0] = False  # (no region)
+    usable = big & clean  # the levels are estimated on these
+    # each cell's mean repeated for its pixels (about SAMPLE values in all)
+    times = np.where(usable, -(-count // max(1, int(count[usable].sum()) // SAMPLE)), 0)
+    blur = fit_blur(mean, count, usable, period,
+                    lambda values: frame_levels(values, used, levels)[0], times)
+    gain = np.exp(-blur * np.where(np.isfinite(period), 1.0 / period ** 2, 0.0))
+    mean, sigma, spread = mean * gain, sigma * gain, spread * gain
+    centres, worst = frame_levels([np.repeat(m, times) for m in mean], used, levels)
+    read = big & (clean | narrow(spread, mean, centres, np.array([d.size for d in used])))
+    return Cells(labels, cid, mean, sigma, count, read, gain, blur, centres, worst)
 
 
 def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
@@ -474,9 +542,11 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     Returns
     -------
     CodeMap
-        ``code``: the order where every digit is clear (-1 elsewhere); ``maps["nearest"]``
-        the order of the nearest levels, ``maps["carried"]`` where the pixel's own digits
-        carry its order; ``edge_phase`` 0; ``beyond``.
+        ``code``: the order of the pixel's cell where the cell is read (every digit clear:
+        ``maps["cells"]``), else of its own reading where every digit is clear (-1
+        elsewhere); ``maps["nearest"]`` the order of a pixel's nearest levels (read one by
+        one where its cell is not), ``maps["carried"]`` where its own digits carry its
+        order, ``maps["labels"]`` the fringe regions; ``edge_phase`` 0; ``beyond``.
 
     Raises
     ------
@@ -497,18 +567,33 @@ def levels_code(prepared: Prepared, spec: Any, fs: FringeSet) -> CodeMap:
     """
     levels, digits, start = spec.code_levels, spec.code_bits, spec.steps
     used = frame_digits(spec)
-    centres, worst = frame_levels(_sample_values(prepared, start, digits, fs), used, levels)
-    refuse(separation_problem(worst, levels))
+    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    cells = code_cells(prepared, spec, fs)
+    centres, worst = cells.centres, cells.worst
+    refuse(separation_problem(worst, levels) or washed_problem(centres, used))
     digit_of = np.zeros((digits, levels), np.int32)
     for i, ds in enumerate(used):
         digit_of[i, :ds.size] = ds
-    noise_d = fs.noise * math.sqrt(1.0 + 1.0 / spec.steps)
+    cell_order, cell_clear = cell_digits(cells.mean, cells.sigma, centres, digit_of,
+                                         np.array([d.size for d in used]), levels,
+                                         CLEAR_NOISE, CLEAR_SHARE)
+    cell_order = np.where(cells.usable & cell_clear & (cell_order < spec.fringes), cell_order,
+                          -1)
+    read = np.where(fs.valid, cell_order[cells.cid], -1).astype(np.int32)
+    mod = (fs.mod / cells.gain[cells.cid]).astype(np.float32)
+    # a pixel read one by one carries its order only where the levels separate pixel by
+    # pixel too (the same check on its readings; else only the cells carry)
+    alone = frame_levels(_alone_values(prepared, start, digits, fs, mod), used, levels)
+    alone_ok = alone[1][0] <= MAX_BAND
     code, nearest, carried, beyond = read_levels(
-        prepared.raw, start, digits, prepared.scale, fs.avg, fs.mod, fs.valid, fs.phi,
+        prepared.raw, start, digits, prepared.scale, fs.avg, mod, fs.valid, fs.phi,
         centres, digit_of, np.array([d.size for d in used], np.int32), levels, spec.fringes,
-        noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE)
-    return CodeMap(code, {"nearest": nearest, "carried": carried}, edge_phase=0.0,
-                   beyond=beyond)
+        noise_d, CLEAR_NOISE, CLEAR_SHARE, EDGE_ZONE, REACH, SAME_FRINGE, read < 0)
+    if not alone_ok:
+        code, carried = np.where(read >= 0, code, -1), np.zeros_like(carried)
+    code = np.where(read >= 0, read, code)
+    return CodeMap(code, {"nearest": nearest, "carried": carried, "cells": read,
+                          "labels": cells.labels}, edge_phase=0.0, beyond=beyond)
 
 
 def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None:
@@ -545,6 +630,43 @@ def separation_problem(worst: tuple[float, int, int], levels: int) -> str | None
             "code washed out?")
 
 
+def washed_problem(centres: np.ndarray, used: list[np.ndarray]) -> str | None:
+    """The one-line reason to refuse a capture two of whose neighbouring levels lie under
+    ``MIN_GAP`` apart in ``v`` (a code washed out: its levels too close for the cells'
+    systematic spread, whatever the noise), or ``None``.
+
+    Parameters
+    ----------
+    centres : (D, L) array
+        Each frame's levels (:func:`frame_levels`).
+    used : list of numpy.ndarray
+        The digits each frame draws.
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> washed_problem(np.float32([[-0.75, -0.56, 0.1, 1.3]]), [np.arange(4)]) is None
+    True
+    >>> washed_problem(np.float32([[-0.05, -0.02, 0.01, 0.05]]), [np.arange(4)])
+    ... # doctest: +ELLIPSIS
+    "code frame gray-0's levels of digits 1 and 2 lie 0.030 of the fringes' modulation ..."
+    """
+    worst = (math.inf, 0, 0)
+    for i, ds in enumerate(used):
+        gaps = np.diff(centres[i, :ds.size].astype(np.float64))
+        if gaps.size and gaps.min() < worst[0]:
+            worst = (float(gaps.min()), i, int(ds[int(np.argmin(gaps))]))
+    gap, frame, low = worst
+    if gap >= MIN_GAP:
+        return None
+    return (f"code frame gray-{frame}'s levels of digits {low} and {low + 1} lie {gap:.3f} "
+            f"of the fringes' modulation apart (at least {MIN_GAP}): is the code washed "
+            "out, or do its levels crowd (compensate the projector's gamma, use more steps)?")
+
+
 def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     """Stage 3 of a multi-level code, per pixel: the carried pixels keep their order; every
     other pixel read takes its fringe region's settled order where its own reading is
@@ -578,9 +700,12 @@ def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     >>> bool((orders.order[:, :-1] == np.arange(480)[:-1] // 30).all())
     True
     """
-    nearest, carried = code.maps["nearest"], code.maps["carried"]
-    k = np.where(carried, code.code, -1)
-    labels, n = fringe_regions(fs.phi, fs.valid & (nearest >= 0), phase_noise=fs.phase_noise)
+    nearest, carried, cells = code.maps["nearest"], code.maps["carried"], code.maps["cells"]
+    # a cell read whole carries its pixels (they are not read one by one)
+    k = np.where(cells >= 0, cells, np.where(carried, code.code, -1))
+    carried = k >= 0
+    labels = code.maps["labels"]
+    n = int(labels.max(initial=0))
     shares = code_evidence(labels, n, k, spec.fringes)
     strong = np.bincount(labels[k >= 0], minlength=n + 1)
     settled = np.where((shares.max(axis=1) > SETTLED) & (strong >= MIN_STRONG),
@@ -598,5 +723,6 @@ def order_levels(fs: FringeSet, code: CodeMap, spec: Any, info: dict) -> Orders:
     order = row_fill(order, nearest, clear, carried, phi, fs.valid, EDGE_ZONE, ROW_REACH,
                      ROW_CUT)
     info["region_carried"] = int(np.count_nonzero(order >= 0)) - int(np.count_nonzero(k >= 0))
-    info["left_out"] = int(np.count_nonzero(nearest >= 0)) - int(np.count_nonzero(order >= 0))
+    info["left_out"] = int(np.count_nonzero((nearest >= 0) | (cells >= 0))) - int(
+        np.count_nonzero(order >= 0))
     return Orders(order, info)

@@ -99,8 +99,8 @@ def sample_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: n
 def _read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
                  mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, centres: np.ndarray,
                  digit_of: np.ndarray, used: np.ndarray, levels: int, fringes: int,
-                 noise_d: float, z: float, share: float, zone: float, reach: int, tol: float
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                 noise_d: float, z: float, share: float, zone: float, reach: int, tol: float,
+                 need: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     _, h, w = raw.shape
     s32 = np.float32(scale)
     t32 = np.float32(tol)
@@ -109,36 +109,26 @@ def _read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np
     carried = np.zeros((h, w), np.bool_)
     beyond = np.zeros(h, np.int64)
     two_pi = np.float32(2.0 * math.pi)
-    ok = np.empty((h, w), np.bool_)  # the pixels whose v counts
-    v = np.empty((digits, h, w), np.float32)
     for y in prange(h):
+        total = np.zeros(digits, np.float32)
         for x in range(w):
-            ok[y, x] = valid[y, x] and mod[y, x] > 0
-            for i in range(digits):
-                v[i, y, x] = (np.float32(raw[start + i, y, x]) * s32 - avg[y, x]) / mod[y, x] \
-                    if ok[y, x] else np.float32(0.0)
-    for y in prange(h):
-        # each digit's v summed along the fringe, row by row (as :func:`_level` sums it)
-        total = np.zeros((digits, w), np.float32)
-        count = np.zeros(w, np.float32)
-        for yy in range(max(0, y - reach), min(h, y + reach + 1)):
-            for x in range(w):  # (without branches: the loop vectorises)
-                same = np.float32(1.0) if ok[yy, x] and abs(phi[yy, x] - phi[y, x]) < t32 \
-                    else np.float32(0.0)
-                count[x] += same
-            for i in range(digits):
-                for x in range(w):
-                    same = np.float32(1.0) if ok[yy, x] and abs(phi[yy, x] - phi[y, x]) < t32 \
-                        else np.float32(0.0)
-                    total[i, x] += v[i, yy, x] * same
-        for x in range(w):
-            if not ok[y, x]:
+            if not (valid[y, x] and mod[y, x] > 0 and need[y, x]):
                 continue
+            # each digit's v = (I - A) / B summed along the fringe (its pixels within reach
+            # rows: valid, modulated, their phase within tol)
+            total[:] = 0.0
+            count = np.float32(0.0)
+            for yy in range(max(0, y - reach), min(h, y + reach + 1)):
+                if valid[yy, x] and mod[yy, x] > 0 and abs(phi[yy, x] - phi[y, x]) < t32:
+                    count += np.float32(1.0)
+                    for i in range(digits):
+                        total[i] += (np.float32(raw[start + i, yy, x]) * s32 - avg[yy, x]) \
+                            / mod[yy, x]
             b = mod[y, x]
             parent = 0
             clear = True
             for i in range(digits):
-                value = total[i, x] / max(count[x], np.float32(1.0))
+                value = total[i] / max(count, np.float32(1.0))
                 n = used[i]
                 j = 0  # the nearest level: the first whose upper threshold value is under
                 while j < n - 1 and value >= np.float32(0.5) * (centres[i, j]
@@ -153,7 +143,7 @@ def _read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np
                     half = (c - centres[i, j - 1]) * np.float32(0.5) if j > 0 else \
                         np.float32(np.inf)
                     margin = half - (c - value)
-                if margin < share * half or margin * b * math.sqrt(count[x]) < z * noise_d:
+                if margin < share * half or margin * b * math.sqrt(count) < z * noise_d:
                     clear = False
                 g = digit_of[i, j]
                 digit = g if parent % 2 == 0 else levels - 1 - g
@@ -174,7 +164,8 @@ def read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.
                 mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, centres: np.ndarray,
                 digit_of: np.ndarray, used: np.ndarray, levels: int, fringes: int,
                 noise_d: float, z: float, share: float, zone: float, reach: int = 0,
-                tol: float = 0.5) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+                tol: float = 0.5, need: np.ndarray | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """The multi-level code read per pixel in one pass.
 
     Digit ``i`` of a pixel is read from frame ``start + i`` as ``v = (I - avg) / mod`` (the
@@ -223,6 +214,9 @@ def read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.
         Rows either side averaged along the fringe.
     tol : float, default 0.5
         The largest phase difference (radians) of a pixel averaged with.
+    need : (H, W) bool array, optional
+        The pixels to read (every valid one if not given; the others still count in
+        their neighbours' averages and read as -1).
 
     Returns
     -------
@@ -252,7 +246,8 @@ def read_levels(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.
         np.asarray(mod, np.float32), np.asarray(valid, np.bool_), np.asarray(phi, np.float32),
         np.ascontiguousarray(centres, np.float32), np.ascontiguousarray(digit_of, np.int32),
         np.ascontiguousarray(used, np.int32), int(levels), int(fringes), float(noise_d),
-        float(z), float(share), float(zone), int(reach), float(tol))
+        float(z), float(share), float(zone), int(reach), float(tol),
+        np.ones(np.shape(valid), np.bool_) if need is None else np.asarray(need, np.bool_))
     return code, nearest, carried, int(beyond.sum())
 
 
@@ -346,3 +341,100 @@ def row_fill(order: np.ndarray, nearest: np.ndarray, clear: np.ndarray, carried:
                      np.asarray(carried, np.bool_),
                      np.asarray(phi, np.float32), np.asarray(valid, np.bool_), float(zone),
                      int(reach), float(cut))
+
+
+@kernel()
+def _cell_sums(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+               mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
+               rows: int, zone: float, noise_d: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                          np.ndarray, np.ndarray]:
+    _, h, w = raw.shape
+    s32 = np.float32(scale)
+    z32 = np.float32(zone)
+    top = np.float32(2.0 * math.pi - zone)
+    blocks = (h + rows - 1) // rows
+    n = (labels.max() + 1) * blocks
+    cid = np.zeros((h, w), np.int64)
+    total = np.zeros((digits, n))
+    square = np.zeros((digits, n))
+    expect = np.zeros(n)
+    count = np.zeros(n, np.int64)
+    step = np.zeros(n)
+    steps = np.zeros(n, np.int64)
+    for y in range(h):
+        block = y // rows
+        for x in range(w):
+            lab = labels[y, x]
+            if lab <= 0:
+                continue
+            c = lab * blocks + block
+            cid[y, x] = c
+            if x + 1 < w and labels[y, x + 1] == lab:
+                d = phi[y, x + 1] - phi[y, x]
+                if abs(d) < 1.0:
+                    step[c] += d
+                    steps[c] += 1
+            p = phi[y, x]
+            b = mod[y, x]
+            if not valid[y, x] or b <= 0 or p < z32 or p > top:
+                continue
+            count[c] += 1
+            expect[c] += (noise_d / b) ** 2
+            for i in range(digits):
+                v = (np.float32(raw[start + i, y, x]) * s32 - avg[y, x]) / b
+                total[i, c] += v
+                square[i, c] += v * v
+    return cid, total, square, expect, count, step, steps
+
+
+def cell_sums(raw: np.ndarray, start: int, digits: int, scale: float, avg: np.ndarray,
+              mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, labels: np.ndarray,
+              rows: int, zone: float, noise_d: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                         np.ndarray, np.ndarray]:
+    """The sums a code cell is read from, in one pass: each pixel's cell (``label *
+    blocks + y // rows``, 0 outside any region), and per cell over its valid pixels at
+    least ``zone`` from the code's edges the sums of each code frame's ``v = (I - A) /
+    B`` and of its square, of the noise variance ``(noise_d / B)**2`` and the count; and
+    over all its pixels the phase steps to the next pixel along the row in the same
+    region (under 1 radian) and their count.
+
+    Parameters
+    ----------
+    raw, start, digits, scale, avg, mod, valid, phi
+        As :func:`read_levels` takes them.
+    labels : (H, W) int array
+        Fringe regions, 0 outside any.
+    rows : int
+        Rows of a cell.
+    zone : float
+        Radians from the code's edges left out of the means.
+    noise_d : float
+        The noise of ``I - A``.
+
+    Returns
+    -------
+    cid : (H, W) int64
+    total, square : (D, n) float64
+    expect : (n,) float64
+    count : (n,) int64
+    step : (n,) float64
+    steps : (n,) int64
+
+    Examples
+    --------
+    >>> raw = np.float32([[[0.25, 0.25, 0.75]]])
+    >>> ones = np.ones((1, 3), np.float32)
+    >>> cid, total, square, expect, count, step, steps = cell_sums(
+    ...     raw, 0, 1, 1.0, ones * 0.5, ones * 0.5, np.ones((1, 3), bool),
+    ...     np.float32([[2.0, 2.5, 3.0]]), np.int32([[1, 1, 2]]), 4, 1.0, 0.01)
+    >>> cid.tolist(), total.tolist(), count.tolist(), step.tolist()
+    ([[1, 1, 2]], [[0.0, -1.0, 0.5]], [0, 2, 1], [0.0, 0.5, 0.0])
+    """
+    raw, start = kernel_frames(raw, start, digits)
+    return _cell_sums(raw, int(start), int(digits), float(np.float32(scale)),
+                      np.asarray(avg, np.float32), np.asarray(mod, np.float32),
+                      np.asarray(valid, np.bool_), np.asarray(phi, np.float32),
+                      np.ascontiguousarray(labels, np.int32), int(rows), float(zone),
+                      float(noise_d))
