@@ -272,6 +272,12 @@ def measure_columns(prepared: Prepared, spec: MultiFreqSpec,
         (H, W) float32 wrapped phase of the shortest period in [0, 2*pi) (radians), average
         and modulation (fractions of full scale), the validity mask and the camera noise.
 
+    Raises
+    ------
+    BistairError
+        A single-period spec (one period narrower than the coded axis,
+        :func:`single_period_refusal`): it gives no fringe order alone.
+
     Examples
     --------
     >>> from bistair.codecs import encode, make_spec

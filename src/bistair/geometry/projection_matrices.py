@@ -31,6 +31,18 @@ from .stereo_calibration import ProjectorPose, StereoCalibration
 def read_matrix(path: str | Path) -> np.ndarray:
     """The one 3x4 projection matrix of a ``.npy``, ``.mat`` or text file (float64).
 
+    Parameters
+    ----------
+    path : str or pathlib.Path
+        The file: ``.npy``, ``.mat`` (exactly one 3x4 numeric array) or any other suffix
+        read as text (three rows of four numbers, spaces or commas, ``#`` comments).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(3, 4)`` float64, finite: ``s * (u, v, 1) = P @ (X, Y, Z, 1)`` (pixels, world
+        units).
+
     Raises
     ------
     BistairError
@@ -96,10 +108,37 @@ def decompose(P: np.ndarray, name: str = "projection matrix"
     """``P = K [R | t]`` up to scale: ``K`` upper triangular with ``K[2, 2] = 1`` and
     positive focal lengths, ``R`` a proper rotation, ``X_device = R X_world + t``.
 
+    Parameters
+    ----------
+    P : numpy.ndarray
+        A 3x4 projection matrix (any overall scale and sign; 12 numbers reshaped to 3x4).
+    name : str, optional
+        What the error messages call the matrix.
+
+    Returns
+    -------
+    K : numpy.ndarray
+        ``(3, 3)`` intrinsics (pixels), ``K[2, 2] = 1``, positive diagonal.
+    R : numpy.ndarray
+        ``(3, 3)`` rotation (``det R = +1``), world frame to the device's.
+    t : numpy.ndarray
+        ``(3,)`` translation (world units): the world origin in the device's frame.
+
     Raises
     ------
     BistairError
         A matrix of rank under 3, or whose left 3x3 block is singular (no pinhole device).
+
+    Examples
+    --------
+    >>> K = np.array([[1000.0, 0, 320], [0, 1000, 240], [0, 0, 1]])
+    >>> k, r, t = decompose(-3 * K @ np.hstack([np.eye(3), [[-100.0], [0], [0]]]))
+    >>> k.round(6).tolist() == K.tolist(), np.allclose(r, np.eye(3)), t.round(6).tolist()
+    (True, True, [-100.0, 0.0, 0.0])
+    >>> decompose(np.zeros((3, 4)), "LEFT projection matrix")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: LEFT projection matrix has rank 0 (a projection matrix has rank 3)
     """
     P = np.asarray(P, np.float64).reshape(3, 4)
     if np.linalg.matrix_rank(P) < 3:
@@ -130,6 +169,27 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     """The two-camera-and-projector calibration of three projection matrices of one world
     frame, in the left camera's frame (no distortion).
 
+    Parameters
+    ----------
+    matrices : tuple of numpy.ndarray
+        The left camera's, the right camera's and the projector's 3x4 matrices, one world
+        frame (:func:`decompose` of each).
+    camera_size, projector_size : tuple of int
+        ``(width, height)`` in pixels of each camera and of the projector.
+    names : tuple of str, optional
+        What the error messages call the three matrices.
+
+    Returns
+    -------
+    StereoCalibration
+        The cameras' intrinsics, the right camera's ``R, T`` (``X_right = R X_left + T``,
+        world units) and the ``projector`` pose the same way, all without distortion.
+
+    Raises
+    ------
+    BistairError
+        What :func:`decompose` refuses, naming the matrix.
+
     Examples
     --------
     >>> K = np.array([[1000.0, 0, 319.5], [0, 1000, 239.5], [0, 0, 1]])
@@ -157,7 +217,41 @@ def import_matrices(files: tuple[str | Path, str | Path, str | Path],
                     camera_size: tuple[int, int], projector_size: tuple[int, int]
                     ) -> StereoCalibration:
     """:func:`read_matrix` of three files (left camera, right camera, projector) and
-    :func:`rig_from_matrices` of them."""
+    :func:`rig_from_matrices` of them.
+
+    Parameters
+    ----------
+    files : tuple of str or pathlib.Path
+        The left camera's, the right camera's and the projector's matrix files.
+    camera_size, projector_size : tuple of int
+        ``(width, height)`` in pixels of each camera and of the projector.
+
+    Returns
+    -------
+    StereoCalibration
+        As :func:`rig_from_matrices`; its errors name the role and the file.
+
+    Raises
+    ------
+    BistairError
+        Not three files, or what :func:`read_matrix` or :func:`decompose` refuses.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> K = np.array([[1000.0, 0, 319.5], [0, 1000, 239.5], [0, 0, 1]])
+    >>> for name, x in (("L.npy", 50.0), ("R.npy", -150.0), ("P.npy", -50.0)):
+    ...     np.save(tmp / name, K @ np.hstack([np.eye(3), [[x], [0], [0]]]))
+    >>> files = (tmp / "L.npy", tmp / "R.npy", tmp / "P.npy")
+    >>> import_matrices(files, (640, 480), (1280, 800)).T.round(6).tolist()
+    [-200.0, 0.0, 0.0]
+    >>> import_matrices(files[:2], (640, 480), (1280, 800))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: --projection-matrices takes ...: three files, got 2
+    >>> shutil.rmtree(tmp)
+    """
     if len(files) != 3:
         raise BistairError(f"--projection-matrices takes LEFT,RIGHT,PROJECTOR: three files, "
                            f"got {len(files)}")
