@@ -112,6 +112,13 @@ def ghost_spacing(baseline: float, projector_offset: float, depth: float, period
     -------
     float
         The spacing (mm); a depth range narrower than this decides every pixel it sees.
+
+    Examples
+    --------
+    >>> round(ghost_spacing(200.0, 100.0, 600.0, 16.0, 2000.0), 1)  # halfway: q = 2
+    28.8
+    >>> round(ghost_spacing(200.0, 50.0, 600.0, 16.0, 2000.0), 1)  # a quarter: q = 4
+    57.6
     """
     step = depth * (period * depth / projector_focal) / baseline
     ratio = abs(projector_offset) / baseline
@@ -182,6 +189,25 @@ def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
     one the projector happens to confirm lands on a right pixel that decided its own,
     other point.
 
+    Parameters
+    ----------
+    left : numpy.ndarray
+        ``(H, W)`` float32 disparities decided for the left grid's pixels (rectified
+        pixels, ``d = x_l - x_r - shift``), NaN where undecided.
+    right : numpy.ndarray
+        ``(H, W_right)`` float32 disparities decided for the right grid's pixels (the same
+        rows, the same convention), NaN where undecided.
+    shift : float
+        ``cx_left - cx_right`` of the rectification (pixels).
+    agree : float, optional
+        The largest difference (pixels) of the two disparities.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32: ``left`` where the right pixel at ``x_l - shift - d`` (rounded)
+        decided a disparity within ``agree``, NaN elsewhere.
+
     Examples
     --------
     >>> left = np.float32([[np.nan, 3.0, 3.0, 9.0]])
@@ -239,6 +265,22 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
     (or :data:`CHECK_SHARE` of the valid pixels searched) are not judged: ``share`` 0 and
     ``depths`` ``None``.
 
+    Parameters
+    ----------
+    lrect, rrect : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase of the left and right camera on the rectified grids
+        (:func:`rectified_phase`), NaN where unknown.
+    rect : Rectification
+        :func:`~.stereo.rectify` of ``calibration``.
+    calibration : StereoCalibration
+        The cameras and the projector.
+    period : float
+        The fringe period (projector pixels).
+    tolerance : float
+        The largest disagreement (radians) of the projector's phase.
+    low, high : float
+        The depth range (left camera frame, mm) to check.
+
     Returns
     -------
     share : float
@@ -247,6 +289,30 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
         The points found.
     depths : tuple of float or None
         Their 5th and 95th percentile depth (mm), ``None`` when not judged.
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size,
+    ...                          projector_at=0.3)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> x = [trace(srig.rig(side), scene).truth.coord_x for side in ("left", "right")]
+    >>> lp, rp = (np.float32(2 * np.pi * c / 48 % (2 * np.pi)) for c in x)  # period 48
+    >>> from bistair.geometry.stereo import rectify
+    >>> rect = rectify(cal)
+    >>> lrect = rectified_phase(lp, rect.maps_left)
+    >>> rrect = rectified_phase(rp, rect.maps_right)
+    >>> share, points, depths = check_range(lrect, rrect, rect, cal, 48.0, 0.1, 500.0, 700.0)
+    >>> round(share, 3), points, [round(d) for d in depths]  # 4% outside: kept
+    (0.038, 633, [599, 601])
+    >>> share, points, depths = check_range(lrect, rrect, rect, cal, 48.0, 0.1, 650.0, 750.0)
+    >>> round(share, 3), points, [round(d) for d in depths]  # the plane is nearer: refused
+    (1.0, 625, [599, 601])
+    >>> check_range(lrect, rrect, rect, cal, 48.0, 0.1, 800.0, 900.0)  # 700-1000 finds none
+    (0.0, 0, None)
     """
     width = high - low
     wide = (max(low - width, 0.5 * low), high + width)
@@ -306,6 +372,27 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         No projector in the calibration, a depth range that is not finite and positive, a
         tolerance that is not positive, maps of other sizes than the calibration's, or
         (without ``force``) a depth range that most points fall outside.
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size,
+    ...                          projector_at=0.3)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> x = [trace(srig.rig(side), scene).truth.coord_x for side in ("left", "right")]
+    >>> lp, rp = (np.float32(2 * np.pi * c / 48 % (2 * np.pi)) for c in x)  # period 48
+    >>> found = unwrap_stereo(lp, rp, cal, 48.0, 500.0, 700.0)
+    >>> found.info["decided_fraction"], found.info["undecided"]
+    (0.723333, 0)
+    >>> round(float(np.median(found.depth[found.mask])), 1)  # mm
+    600.3
+    >>> unwrap_stereo(lp, rp, cal, 48.0, 650.0, 750.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: 100% of the points ... at 599 to 601 mm): correct --depth-range
     """
     if calibration.projector is None:
         raise BistairError("stereo phase unwrapping needs the projector in the calibration "
@@ -375,12 +462,43 @@ def absolute_phase(unwrapped: Unwrapped, phase: np.ndarray, calibration: StereoC
     decided a point: the order that puts the wrapped phase nearest the projector column of
     the point.
 
+    Parameters
+    ----------
+    unwrapped : Unwrapped
+        What :func:`unwrap_stereo` found for ``phase``.
+    phase : numpy.ndarray
+        ``(H, W)`` the left camera's wrapped phase given to :func:`unwrap_stereo` (radians,
+        ``[0, 2*pi)``, NaN where unknown).
+    calibration : StereoCalibration
+        The cameras and the projector (its ``projector`` entry).
+    period : float
+        The fringe period (projector pixels).
+
     Returns
     -------
     Phi : numpy.ndarray
         ``(H, W)`` float32 absolute phase (radians), NaN where undecided.
     order : numpy.ndarray
         ``(H, W)`` int32 fringe order, -1 where undecided.
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size,
+    ...                          projector_at=0.3)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> x = [trace(srig.rig(side), scene).truth.coord_x for side in ("left", "right")]
+    >>> lp, rp = (np.float32(2 * np.pi * c / 48 % (2 * np.pi)) for c in x)  # period 48
+    >>> found = unwrap_stereo(lp, rp, cal, 48.0, 500.0, 700.0)
+    >>> Phi, order = absolute_phase(found, lp, cal, 48.0)
+    >>> decided = order >= 0
+    >>> bool(np.all(order[decided] == np.floor(x[0][decided] / 48)))  # k = floor(x_p / T)
+    True
+    >>> float(np.abs(Phi[decided] - 2 * np.pi * x[0][decided] / 48).max()) < 1e-4  # radians
+    True
     """
     rect = unwrapped.rectification
     rows, cols = np.nonzero(unwrapped.mask)
@@ -399,11 +517,23 @@ def is_single_period(spec: Any) -> bool:
     """Whether a spec is one N-step set of one period (``patterns multifreq --periods T``):
     what stereo phase unwrapping reads.
 
+    Parameters
+    ----------
+    spec : object
+        A pattern spec of any method (:func:`~bistair.codecs.make_spec`).
+
+    Returns
+    -------
+    bool
+        ``True`` for a multi-frequency spec of exactly one period.
+
     Examples
     --------
     >>> from bistair.codecs import make_spec
     >>> is_single_period(make_spec("multifreq", width=300, height=32, periods=(300, 30)))
     False
+    >>> is_single_period(make_spec("multifreq", width=300, height=32, periods=(30,)))
+    True
     """
     return getattr(spec, "method", None) == "multifreq" and len(spec.periods) == 1
 
@@ -412,7 +542,35 @@ def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = Non
                ) -> tuple[np.ndarray, FringeSet]:
     """The wrapped phase of a single-period capture (NaN where not valid) and its
     :class:`~bistair.core.measure.FringeSet` (stage 1 of the multi-frequency codec: the one
-    N-step set, in the spec's phase convention)."""
+    N-step set, in the spec's phase convention).
+
+    Parameters
+    ----------
+    images : numpy.ndarray
+        ``(frames, height, width)`` captures of the spec's frames, in its frame order.
+    spec : MultiFreqSpec
+        A single-period spec (:func:`is_single_period`); its ``steps``, ``shift_sign`` and
+        ``phase_offset`` are read.
+    min_modulation : float, optional
+        The modulation (fraction of full scale) a valid pixel needs; by default a threshold
+        from the measured camera noise.
+
+    Returns
+    -------
+    phase : numpy.ndarray
+        ``(height, width)`` float32 wrapped phase ``2*pi*x_p/T`` mod ``2*pi`` (radians, in
+        ``[0, 2*pi)``), NaN where not valid.
+    fs : FringeSet
+        The N-step set's phase, average, modulation, validity and phase noise.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> spec = make_spec("multifreq", width=96, height=8, periods=(48,))
+    >>> phase, fs = wrapped_of(encode(spec), spec)
+    >>> phase.shape, round(float(phase[0, 24]), 3), bool(fs.valid.all())  # half a period
+    ((8, 96), 3.142, True)
+    """
     prepared = prepare(images, spec.frame_count, spec.method)
     fs = measure(prepared, 0, spec.steps, min_modulation, shift_sign=spec.shift_sign,
                  phase_offset=spec.phase_offset)
@@ -454,6 +612,29 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     ------
     BistairError
         A spec that is not one period of columns, or what :func:`unwrap_stereo` refuses.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.render import Imaging, expose
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size,
+    ...                          projector_at=0.3)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> spec = make_spec("multifreq", width=rig.projector.size[0],
+    ...                  height=rig.projector.size[1], periods=(48,))
+    >>> traced = [trace(srig.rig(side), scene) for side in ("left", "right")]
+    >>> left, right = (expose(t, encode(spec), Imaging()) for t in traced)  # noisy 8-bit
+    >>> res = stereo_unwrap(left, right, spec, cal, 500.0, 700.0)
+    >>> res.info["matched_fraction"]
+    0.622083
+    >>> decided = res.left.order >= 0
+    >>> err = res.left.phase[decided] - 2 * np.pi * traced[0].truth.coord_x[decided] / 48
+    >>> round(float(np.abs(err).max()), 2)  # radians, under pi: no order off
+    0.31
     """
     if not is_single_period(spec) or spec.orientation != "columns":
         raise BistairError("stereo phase unwrapping needs one N-step set of one period "
