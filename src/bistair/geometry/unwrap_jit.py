@@ -210,6 +210,25 @@ def unwrap_rows(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift
     z_all : numpy.ndarray
         ``(rows, W)`` float32: the depth ``z`` of the consistent candidate whose phase
         agrees best, NaN without one.
+
+    Examples
+    --------
+    The module's rig (``f`` = 100 px, cameras 100 mm apart, the projector 25 mm right of
+    the left camera, a period of 8 px) and its plane at 500 mm, two rows, the second alone
+    searched, with a depth range that leaves the plane out:
+
+    >>> cols = np.arange(80, dtype=np.float32)[None].repeat(2, axis=0)
+    >>> left = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)
+    >>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)
+    >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+    >>> n_in, disparity, n_all, z_all = unwrap_rows(
+    ...     left, right, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k, np.zeros(5),
+    ...     np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 600.0, 900.0, 1000,
+    ...     rows=np.array([1]))
+    >>> n_in.shape, int(n_in[0, 50]), bool(np.isnan(disparity[0, 50]))  # none in range
+    ((1, 80), 0, True)
+    >>> int(n_all[0, 50]), round(float(z_all[0, 50]), 3)  # one over all disparities
+    (1, 500.0)
     """
     left = np.ascontiguousarray(left, np.float32)
     right = np.ascontiguousarray(right, np.float32)
