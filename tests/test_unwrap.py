@@ -231,3 +231,16 @@ def test_stereo_command_unwraps_a_single_period_set(tmp_path):
                     str(tmp_path / "pair.json"), "--depth-range", "460:710", "--out",
                     str(tmp_path / "refused")])
     assert res.exit_code == 2 and "needs the projector in the calibration" in res.output
+
+
+def test_a_range_beyond_the_first_looks_reach_is_refused():
+    """two-masks (560-630 mm) given 800-900 mm: the first look (700-1000 mm) finds only the
+    fringes' repeats, most inside the range, and decided 3728 pixels 250 mm off; the second
+    look (400-1800 mm) finds the masks and refuses."""
+    (lp, rp), noise, cal, truth = _render("two-masks", 48.0)
+    assert np.nanmax(truth.depth) < 650
+    with pytest.raises(BistairError, match=r"outside it \(800 to 900 mm; they lie at 5\d\d to"):
+        unwrap_stereo(lp, rp, cal, 48.0, 800.0, 900.0, noise)
+    right = unwrap_stereo(lp, rp, cal, 48.0, 500.0, 700.0, noise)
+    wrong, decided, _ = _wrong(right, lp, cal, 48.0, truth)
+    assert decided.mean() > 0.2 and wrong.sum() <= 0.001 * decided.sum()
