@@ -132,7 +132,7 @@ def reflected_digits(index: np.ndarray, levels: int, digits: int) -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        (digits, *index.shape) int64.
+        Shape ``(digits, *index.shape)``, int64.
 
     Examples
     --------
