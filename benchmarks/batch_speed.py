@@ -14,6 +14,10 @@ the figures printed are the median and the best of the rounds and each round's r
 its own plain loop; the load average and a probe of the free cores are printed alongside.
 
     python benchmarks/batch_speed.py [--sets 20] [--rounds 3] [--data bench-out/batch-data]
+                                     [--markdown docs/results/batch.md]
+
+``--markdown docs/results/batch.md`` writes the page of the documentation's results: the
+medians' table, then what the script printed.
 
 Targets (issue 23): overhead per set at most 10% of the loop's time per set (1 worker
 against the loop); 2 workers at least 1.6 times the plain loop's scans per second.
@@ -31,6 +35,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+from markdown_page import markdown_page
 
 from bistair.app.simulate import simulate_many
 
@@ -125,7 +131,54 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--data", type=Path, default=Path("bench-out/batch-data"))
     parser.add_argument("--previews", choices=("both", "yes", "no"), default="both")
+    parser.add_argument("--markdown", type=Path, default=None,
+                        help="also write the page of the results (e.g. docs/results/batch.md)")
     args = parser.parse_args()
+    found: dict[str, object] = {}
+    with markdown_page(args.markdown, TITLE, ABOUT, lambda: page_sections(found)):
+        run(args, found)
+
+
+TITLE = "Batch speed"
+ABOUT = ("Scans per second of `bistair batch` on a local cluster of 1 and 2 workers against a "
+         "plain loop of the same decodes (`decode_folder` per set), each way in a new process "
+         "as a user runs it, interleaved in rounds, with the previews and without them. "
+         "The many-scans guide says what a batch is for.")
+
+
+def page_sections(found: dict[str, object]) -> list[str]:
+    """The page's table: the median of the rounds for each way, with and without previews,
+    and what the loop, 1 worker and 2 workers compare to."""
+    times = found.get("times")
+    if not isinstance(times, dict):
+        return []
+    n = found["sets"]
+    kinds = sorted({previews for previews, _ in times}, reverse=True)
+    head = ["| |"]
+    for previews in kinds:
+        on = "previews" if previews else "no previews"
+        head.append(f" {on}: wall time | scans/s | against the loop |")
+    lines = ["## The median of the rounds", "", "".join(head),
+             "| --- |" + " --- | --- | --- |" * len(kinds)]
+    names = {"loop": "plain loop", "1": "batch, 1 worker", "2": "batch, 2 workers"}
+    for way in WAYS:
+        row = f"| {names[way]} |"
+        for previews in kinds:
+            t = statistics.median(times[(previews, way)])
+            loop = statistics.median(times[(previews, "loop")])
+            row += f" {t:.1f} s | {n / t:.2f} | {loop / t:.2f} |"
+        lines.append(row)
+    lines += ["", f"{n} sets of {CAMERA[0]} x {CAMERA[1]}, {METHOD}, {found['rounds']} "
+              f"round(s), load average {found['loads']} during the run; `against the loop`: "
+              "the loop's wall time over the way's (above 1: faster than the loop). Issue "
+              "23's targets: 1 worker's overhead per set at most 10% of the loop's time per "
+              "set; 2 workers at least 1.6 times the loop's scans per second."]
+    return lines
+
+
+def run(args: argparse.Namespace, found: dict[str, object]) -> None:
+    """Render the sets (once), time the three ways in rounds, print the tables; keep the
+    times in ``found`` for the page."""
     captures = data_set(args.data, args.sets)
     n = len(captures)
     work = Path(tempfile.mkdtemp(prefix="batch-speed-"))
@@ -168,6 +221,8 @@ def main() -> None:
             f"{a / b:.2f}" for a, b in zip(loop, times[(previews, "1")], strict=True))
               + "; 2 workers " + ", ".join(
             f"{a / b:.2f}" for a, b in zip(loop, times[(previews, "2")], strict=True)))
+    found.update(times=times, sets=n, rounds=args.rounds,
+                 loads=f"{min(loads):.1f}-{max(loads):.1f}")
     print("\nthe cores two processes got at the end of each round (a NumPy probe, 2.00 = "
           "two free cores): " + ", ".join(f"{c:.2f}" for c in cores))
 
