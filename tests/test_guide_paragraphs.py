@@ -131,4 +131,5 @@ def test_list_items_count_one_by_one_with_their_continuation_lines():
 
 def test_a_long_paragraph_is_named_by_its_line_and_first_words():
     page = "# T\n\nShort.\n\n" + "Long " + "word " * 150 + "\nend.\n"
-    assert long_paragraphs(page) == ["line 5 (152 words): Long word word word word word word word..."]
+    assert long_paragraphs(page) == [
+        "line 5 (152 words): Long word word word word word word word..."]
