@@ -122,7 +122,8 @@ class StereoStream:
         The modulation a valid pixel needs (fraction of full scale); by default from the
         noise measured on the first ``N`` frames.
     margin : float, optional
-        :data:`MARGIN`.
+        :data:`MARGIN`; 0 searches every window in full (:func:`~.unwrap.unwrap_stereo`,
+        its range checked on the first window alone).
     force : bool, optional
         Keep the first window when its depth range check would refuse it (a warning).
     tolerance : float, optional
@@ -148,8 +149,8 @@ class StereoStream:
         if not (0 < min_depth < max_depth and math.isfinite(max_depth)):
             raise BistairError(f"stereo phase unwrapping needs a finite depth range above 0 "
                                f"mm (--depth-range ZMIN:ZMAX), got {min_depth:g}:{max_depth:g}")
-        if not margin > 0:
-            raise BistairError(f"the search margin must be positive, got {margin}")
+        if not margin >= 0:
+            raise BistairError(f"the search margin must be 0 or more, got {margin}")
         self.calibration, self.spec = calibration, spec
         self.period = float(spec.periods[0])
         self.range = (float(min_depth), float(max_depth))
@@ -253,12 +254,14 @@ class StereoStream:
         rect = self.rect
         lo, hi = self.bounds
         info: dict[str, Any]
-        if self.previous is None:
+        if self.previous is None or self.margin == 0:
             found = unwrap_stereo(lphase, rphase, self.calibration, self.period,
                                   *self.range, self.noise, self.tolerance,
-                                  rectification=rect, force=self.force)
+                                  rectification=rect, force=self.force,
+                                  check=self.previous is None)
             disparity = found.disparity
-            self.check = found.info["range_check"]
+            if self.previous is None:
+                self.check = found.info["range_check"]
             info = {k: found.info[k] for k in ("no_candidate", "undecided", "not_confirmed",
                                                 "unsupported", "warnings")}
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
