@@ -87,8 +87,11 @@ def test_windows_against_truth(sim, tmp_path, monkeypatch, capsys):
 
 def test_orders_and_the_full_search(sim):
     """Where the tracker and the full search of the same window both decide, they decide
-    the same disparity; the tracker decides a few more (0.6%: a ghost two fringes away lies
-    outside its margin), never fewer here; orders off at most 0.1% of the decided pixels."""
+    the same disparity. The tracker decides about 1% more (a ghost two fringes away lies
+    outside its margin; a single candidate the rows beside did not confirm last window is
+    searched near again), of the right order; and at most one pixel in a thousand fewer
+    (its narrow search found one candidate, which the right camera does not confirm, where
+    the full search found another). Orders off: at most 0.1% of the decided pixels."""
     tracked, lag = windows(sim, 0, 3.0)
     full, _ = windows(sim, 0, 0.0)
     near = 0
@@ -96,11 +99,13 @@ def test_orders_and_the_full_search(sim):
         da, db = np.isfinite(a.disparity), np.isfinite(b.disparity)
         both = da & db
         assert np.array_equal(a.disparity[both], b.disparity[both])
-        assert np.sum(da & ~db) <= 0.01 * da.sum() and np.sum(db & ~da) == 0
+        assert np.sum(da & ~db) <= 0.02 * da.sum() and np.sum(db & ~da) <= 0.001 * db.sum()
         near += a.info["searched_near"]
         truth = truth_at(sim, a.start + lag, "coord_x")
-        off = np.abs(a.phase - 2 * np.pi * truth / PERIOD)[a.mask]
-        assert np.sum(off[np.isfinite(off)] > np.pi) <= 0.001 * a.mask.sum()
+        off = np.abs(a.phase - 2 * np.pi * truth / PERIOD)
+        assert np.sum(off[a.mask & np.isfinite(off)] > np.pi) <= 0.001 * a.mask.sum()
+        extra = a.mask & ~b.mask & np.isfinite(off)
+        assert np.sum(off[extra] > np.pi) <= 0.001 * a.mask.sum()
         assert np.array_equal(a.mask, a.order >= 0)
     assert near > 0.5 * sum(a.info["left_decoded"] for a in tracked[1:])
 

@@ -10,11 +10,12 @@ multiply-adds a pixel; order ``K`` compensates motion). For each window:
    (:func:`~bistair.geometry.unwrap.rectified_phase`).
 2. The first window is unwrapped by :func:`~bistair.geometry.unwrap.unwrap_stereo`, as the
    one-set ``stereo`` command does, its depth range checked. Each later window searches
-   each pixel only within :data:`MARGIN` rectified pixels of the previous window's
-   disparity (:func:`~.unwrap_stream_jit.track_rows`); a pixel without one, or whose narrow
-   search finds no candidate or two, is searched over the whole range. The decisions are
-   confirmed as the full search's are: by the right grid's own search at the match, by a
-   row above or below, and dropped beside an occlusion.
+   each pixel of both rectified grids only within :data:`MARGIN` pixels of its single
+   candidate in the previous window (:func:`~.unwrap_stream_jit.track_rows`); a pixel
+   without one, or whose narrow search finds no candidate or two, is searched over the
+   whole range. The decisions are confirmed as the full search's are
+   (:func:`~.unwrap_stream_jit.confirm`): by the right grid's own candidate at the match,
+   by a row above or below, and dropped beside an occlusion.
 3. The depth: the left camera's ray cut by the projector's plane of the column of the
    absolute phase (the pixel's own wrapped phase and the order its rectified neighbours
    decided; :func:`~.unwrap_stream_jit.plane_depth`). NaN where undecided.
@@ -74,12 +75,11 @@ from .unwrap import (
     MIN_TOLERANCE,
     SUPPORT,
     TOLERANCE_SIGMAS,
-    cross_checked,
     is_single_period,
     rectified_phase,
     unwrap_stereo,
 )
-from .unwrap_stream_jit import plane_depth, projector_pixels, track_rows
+from .unwrap_stream_jit import confirm, plane_depth, projector_pixels, track_rows
 
 #: Half the width (rectified pixels) of a later window's search about the previous
 #: window's disparity (module docstring).
@@ -163,7 +163,8 @@ class StereoStream:
         self.thresholds: tuple[float, float] | None = None
         self.noise: tuple[float, float] = (0.0, 0.0)
         self.check: dict[str, Any] | None = None
-        self.previous: np.ndarray | None = None
+        self.previous: np.ndarray | None = None  # the single candidates of each grid
+        self.previous_right: np.ndarray | None = None
         self._setup()
 
     def _setup(self) -> None:
@@ -254,7 +255,8 @@ class StereoStream:
         rect = self.rect
         lo, hi = self.bounds
         info: dict[str, Any]
-        if self.previous is None or self.margin == 0:
+        tracked = not (self.previous is None or self.margin == 0)
+        if not tracked:
             found = unwrap_stereo(lphase, rphase, self.calibration, self.period,
                                   *self.range, self.noise, self.tolerance,
                                   rectification=rect, force=self.force,
@@ -272,10 +274,11 @@ class StereoStream:
         cols, rows = projector_pixels(disparity, *self.geometry)
         proj = self.calibration.projector
         u, v = rect.positions
-        depth, order, column = plane_depth(cols, rows, u, v, lphase, self.ax, self.az, self.period,
-                                   self.period / 2, proj.device.K, proj.device.dist, proj.T,
-                                   *self.range)
-        self.previous = disparity
+        depth, order, column = plane_depth(cols, rows, u, v, lphase, self.ax, self.az,
+                                           self.period, self.period / 2, proj.device.K,
+                                           proj.device.dist, proj.T, *self.range)
+        if not tracked:  # (a tracked window keeps its single candidates: _track)
+            self.previous, self.previous_right = disparity, None
         mask = np.isfinite(depth)
         valid = int(np.isfinite(lphase).sum())
         decided = int(mask.sum())
@@ -289,26 +292,25 @@ class StereoStream:
 
     def _track(self, lrect: np.ndarray, rrect: np.ndarray
                ) -> tuple[np.ndarray, dict[str, Any]]:
-        """A later window: each grid searched near the previous disparities, confirmed as
-        the full search confirms."""
+        """A later window: each grid searched near its previous single candidates,
+        confirmed as the full search confirms."""
         assert self.previous is not None
         lo, hi = self.bounds
         args = (*self.geometry, self.period, self.tolerance, *self.range,
                 self.calibration.projector.device.width)
+        right_before = (self.previous_right if self.previous_right is not None
+                        else _on_right(self.previous, self.rect.shift, rrect.shape[1]))
         n_in, disparity, near = track_rows(lrect, rrect, self.previous, self.margin, lo, hi,
                                            *args)
-        _, from_right, _ = track_rows(rrect, lrect, _on_right(self.previous, self.rect.shift,
-                                                              rrect.shape[1]),
-                                      self.margin, lo, hi, *args, from_right=True)
-        crossed = cross_checked(disparity, from_right, self.rect.shift, SUPPORT)
+        _, from_right, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
+                                      *args, from_right=True)
         valid = np.isfinite(lrect)
-        kept = _beside_occlusion(_supported(crossed, SUPPORT), valid & (
-            (n_in == 0) | ((n_in == 1) & np.isnan(crossed))), EDGE)
+        kept, not_confirmed, unsupported = confirm(disparity, n_in, valid, from_right,
+                                                   self.rect.shift, SUPPORT, EDGE)
+        self.previous, self.previous_right = disparity, from_right
         info = {"no_candidate": int(np.sum(valid & (n_in == 0))),
-                "undecided": int(np.sum(n_in >= 2)),
-                "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed))),
-                "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(kept))),
-                "searched_near": int(near.sum()),
+                "undecided": int(np.sum(n_in >= 2)), "not_confirmed": not_confirmed,
+                "unsupported": unsupported, "searched_near": int(near.sum()),
                 "searched_full": int(np.sum(valid & (near == 0))), "warnings": []}
         return kept, info
 
@@ -323,24 +325,3 @@ def _on_right(disparity: np.ndarray, shift: float, width: int) -> np.ndarray:
     out = np.full((disparity.shape[0], width), np.nan, np.float32)
     out[rows[inside], xr[inside]] = d[inside]
     return out
-
-
-def _supported(disparity: np.ndarray, support: float) -> np.ndarray:
-    """``disparity`` where the row above or below confirms it within ``support`` px (as
-    the full search: :mod:`.unwrap`)."""
-    d = disparity
-    ok = np.zeros(d.shape, bool)
-    with np.errstate(invalid="ignore"):
-        ok[1:] |= np.abs(d[1:] - d[:-1]) <= support
-        ok[:-1] |= np.abs(d[:-1] - d[1:]) <= support
-    return np.where(ok, d, np.float32(np.nan)).astype(np.float32)
-
-
-def _beside_occlusion(disparity: np.ndarray, occluded: np.ndarray, reach: int) -> np.ndarray:
-    """``disparity``, NaN within ``reach`` pixels along the row of an ``occluded`` pixel
-    (as the full search: :mod:`.unwrap`)."""
-    near = occluded.copy()
-    for k in range(1, reach + 1):
-        near[:, k:] |= occluded[:, :-k]
-        near[:, :-k] |= occluded[:, k:]
-    return np.where(near, np.float32(np.nan), disparity).astype(np.float32)

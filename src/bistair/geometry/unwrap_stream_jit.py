@@ -414,3 +414,94 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndar
                         np.asarray(ax, np.float32), np.asarray(az, np.float32), float(period),
                         float(max_step), k, d, float(t[0]), float(t[2]), float(zmin),
                         float(zmax))
+
+
+@kernel(parallel=True)
+def _confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
+             shift: float, support: float, edge: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    h, w = disparity.shape
+    wr = right.shape[1]
+    crossed = np.full((h, w), np.nan, np.float32)
+    occluded = np.zeros((h, w), np.uint8)
+    out = np.full((h, w), np.nan, np.float32)
+    counts = np.zeros((h, 2), np.int64)  # not confirmed, unsupported
+    for y in prange(h):
+        for x in range(w):
+            d = float(disparity[y, x])
+            if d == d:
+                xr = int(np.rint(x - shift - d))
+                if 0 <= xr < wr and abs(float(right[y, xr]) - d) <= support:
+                    crossed[y, x] = d
+            if valid[y, x] and (n_in[y, x] == 0 or (n_in[y, x] == 1 and
+                                                    crossed[y, x] != crossed[y, x])):
+                occluded[y, x] = 1
+            if n_in[y, x] == 1 and crossed[y, x] != crossed[y, x]:
+                counts[y, 0] += 1
+    for y in prange(h):
+        for x in range(w):
+            c = float(crossed[y, x])
+            if c != c:
+                continue
+            ok = (y > 0 and abs(c - float(crossed[y - 1, x])) <= support) or (
+                y < h - 1 and abs(c - float(crossed[y + 1, x])) <= support)
+            if ok:
+                for k in range(max(x - edge, 0), min(x + edge + 1, w)):
+                    if occluded[y, k]:
+                        ok = False
+                        break
+            if ok:
+                out[y, x] = c
+            else:
+                counts[y, 1] += 1
+    return out, crossed, counts[:, 0].copy(), counts[:, 1].copy()
+
+
+def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
+            shift: float, support: float, edge: int) -> tuple[np.ndarray, int, int]:
+    """The decided disparities that the full search would keep: confirmed by the right
+    grid's decision at the match (within ``support`` px), by the row above or below
+    (within ``support``), and not within ``edge`` pixels along the row of an occluded pixel
+    (a valid one with no candidate, or with one the right grid does not confirm); what
+    :func:`~bistair.geometry.unwrap.unwrap_stereo` does after its search, in one pass.
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 the left grid's single candidates, NaN elsewhere.
+    n_in : numpy.ndarray
+        ``(H, W)`` int16 the candidates counted (:func:`track_rows`).
+    valid : numpy.ndarray
+        ``(H, W)`` bool: the left grid's pixels of known phase.
+    right : numpy.ndarray
+        ``(H, W_right)`` float32 the right grid's single candidates.
+    shift, support : float
+        ``cx_left - cx_right``; the largest disagreement (px).
+    edge : int
+        The reach (px) of an occlusion along the row.
+
+    Returns
+    -------
+    kept : numpy.ndarray
+        ``(H, W)`` float32 the confirmed disparities, NaN elsewhere.
+    not_confirmed : int
+        Single candidates the right grid does not confirm.
+    unsupported : int
+        Confirmed ones dropped by the rows beside or an occlusion.
+
+    Examples
+    --------
+    >>> d = np.float32([[5, 5, 5, 5], [5, 5, 5, 5]])
+    >>> n = np.ones((2, 4), np.int16)
+    >>> right = np.full((2, 4), 5.0, np.float32)
+    >>> right[0, 1] = np.nan
+    >>> kept, nc, un = confirm(d, n, np.ones((2, 4), bool), right, -3.0, 1.0, 0)
+    >>> kept.tolist(), nc, un  # left x matches right x - 2: 0 and 1 beyond, (0, 3) unknown
+    ([[nan, nan, 5.0, nan], [nan, nan, 5.0, nan]], 5, 1)
+    """
+    out, _, nc, un = _confirm(np.ascontiguousarray(disparity, np.float32),
+                              np.ascontiguousarray(n_in, np.int16),
+                              np.ascontiguousarray(valid, np.bool_),
+                              np.ascontiguousarray(right, np.float32), float(shift),
+                              float(support), int(edge))
+    return out, int(nc.sum()), int(un.sum())
