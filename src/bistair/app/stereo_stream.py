@@ -185,18 +185,21 @@ def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: W
 
     Examples
     --------
-    >>> import tempfile
+    >>> import json, tempfile
     >>> from types import SimpleNamespace
     >>> from bistair.geometry.stereo import _toy_stereo, rectify
     >>> depth = np.full((480, 640), np.nan, np.float32)
     >>> depth[10, 20] = 500.0
+    >>> info = {"decided": 1, "decided_fraction": 0.5, "left_decoded": 2, "warnings": []}
     >>> res = StreamDepth(3, depth, np.zeros(depth.shape, np.int32), depth, np.isfinite(depth),
-    ...                   depth, np.zeros(depth.shape, np.uint8), {"warnings": []})
+    ...                   depth, np.zeros(depth.shape, np.uint8), info)
     >>> fake = SimpleNamespace(range=(400.0, 600.0), check=None, rect=rectify(_toy_stereo()))
     >>> folder = Path(tempfile.mkdtemp()) / "0003"
     >>> write_window(folder, res, fake, Window(4, 1))
     >>> sorted(p.name for p in folder.iterdir())
     ['cloud.ply', 'depth.npy', 'info.json']
+    >>> json.loads((folder / "info.json").read_text())["frames"]
+    [3, 7]
     """
     folder.mkdir()
     np.save(folder / "depth.npy", result.depth.astype(np.float32))
