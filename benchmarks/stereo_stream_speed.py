@@ -7,8 +7,8 @@ steady state is timed: each new frame pair updates both cameras' sums, unwraps (
 near the previous disparity, the full range where that fails, the confirmations) and
 triangulates (the projector's column planes). Process CPU time, the minimum of interleaved
 rounds, per depth map, beside two bare baselines of the same run: one ``cv2.remap`` of a
-640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. ``--parts`` times each
-stage alone.
+640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. The decided pixels an
+order off are counted against the renderer's truth after the timing.
 
     python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
 """
@@ -32,18 +32,21 @@ RANGE = (520.0, 650.0)
 
 
 def scene_frames(width: int, height: int, count: int
-                 ) -> tuple[StereoCalibration, object, np.ndarray, np.ndarray]:
-    """The calibration, the spec and ``count`` frames of each camera."""
+                 ) -> tuple[StereoCalibration, object, np.ndarray, np.ndarray, np.ndarray]:
+    """The calibration, the spec, ``count`` frames of each camera and the left camera's
+    true projector column (NaN where it sees no surface)."""
     rig, scene = preset("two-masks", camera_size=(width, height))
     srig = StereoRig.default(camera_size=(width, height), projector_size=rig.projector.size)
     spec = make_spec("multifreq", width=rig.projector.size[0], height=rig.projector.size[1],
                      periods=(48,), steps=4)
     patterns = encode(spec)[np.arange(count) % 4]
-    frames = []
+    frames, columns = [], []
     for i, side in enumerate(("left", "right")):
         imaging = Imaging(seed=i)
-        frames.append(expose(trace(srig.rig(side), scene, imaging), patterns, imaging))
-    return StereoCalibration.from_rig(srig), spec, frames[0], frames[1]
+        traced = trace(srig.rig(side), scene, imaging)
+        frames.append(expose(traced, patterns, imaging))
+        columns.append(traced.truth.coord_x)
+    return StereoCalibration.from_rig(srig), spec, frames[0], frames[1], columns[0]
 
 
 def cpu(fn, repeat: int = 1) -> float:
@@ -61,7 +64,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rounds", type=int, default=5)
     args = parser.parse_args(argv)
     width, height = (int(v) for v in args.camera.lower().split("x"))
-    cal, spec, left, right = scene_frames(width, height, args.frames)
+    cal, spec, left, right, truth = scene_frames(width, height, args.frames)
     streams: dict[str, StereoStream] = {}
     for window, order in (("4", 0), ("4+2", 2)):  # warm: the first window, the kernels
         stream = StereoStream(cal, spec, *RANGE, order=order)
@@ -70,6 +73,7 @@ def main(argv: list[str] | None = None) -> int:
         streams[window] = stream
     position = {name: 8 for name in streams}
     shares: dict[str, list[float]] = {name: [] for name in streams}
+    kept: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {name: [] for name in streams}
     image = left[0].astype(np.float32)
     maps = np.mgrid[:height, :width][::-1].astype(np.float32) + np.float32(0.3)
     four = left[:4]
@@ -77,7 +81,9 @@ def main(argv: list[str] | None = None) -> int:
     def push(name: str) -> None:
         i = position[name] % args.frames
         position[name] += 1
-        shares[name].append(streams[name].push(left[i], right[i]).info["decided_fraction"])
+        result = streams[name].push(left[i], right[i])
+        kept[name].append((result.phase, result.mask))
+        shares[name].append(result.info["decided_fraction"])
 
     tasks = {
         "cv2.remap 640x480 float32 (baseline)": lambda: cv2.remap(
@@ -103,9 +109,16 @@ def main(argv: list[str] | None = None) -> int:
     for name in tasks:
         print(f"| {name} | {1000 * best[name]:.2f} | {best[name] / base:.1f} | "
               f"{1 / best[name]:.0f} | {1000 * wall[name]:.2f} | {1 / wall[name]:.0f} |")
+    off = {name: [0, 0] for name in streams}
+    for name, results in kept.items():  # (after the timing)
+        for phase, mask in results:
+            error = np.abs(phase - 2 * np.pi * truth / 48)[mask]
+            off[name][0] += int(np.sum(error[np.isfinite(error)] > np.pi))  # an order off
+            off[name][1] += int(mask.sum())
     for name, values in shares.items():
         print(f"decided, --window {name}: {100 * min(values):.1f}-{100 * max(values):.1f}% "
-              "of the decoded left pixels")
+              f"of the decoded left pixels; an order off: {off[name][0]} of {off[name][1]} "
+              f"({100 * off[name][0] / max(off[name][1], 1):.3f}%)")
     return 0
 
 
