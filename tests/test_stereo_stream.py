@@ -154,13 +154,15 @@ def bad_cases(sim, tmp_path):
         "spec": (base, ["--window", "4", "--depth-range", RANGE, "--spec", periods],
                  "a stream needs a single-period N-step spec"),
         "range": (base, ["--window", "4"], "needs --depth-range"),
+        "wrong range": (base, ["--window", "4", "--depth-range", "700:800"],
+                        "correct --depth-range"),
         "starts alone": (base, ["--starts", "0", "--depth-range", RANGE],
                          "--starts needs --window"),
     }
 
 
 @pytest.mark.parametrize("case", ["window", "order", "starts", "count", "size", "spec",
-                                  "range", "starts alone"])
+                                  "range", "wrong range", "starts alone"])
 def test_bad_inputs_refused(sim, tmp_path, monkeypatch, capsys, case):
     sides, extra, message = bad_cases(sim, tmp_path)[case]
     out = tmp_path / "out"
