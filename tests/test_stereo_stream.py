@@ -92,7 +92,7 @@ def test_orders_and_the_full_search(sim):
     searched near again), of the right order; and at most one pixel in a thousand fewer
     (its narrow search found one candidate, which the right camera does not confirm, where
     the full search found another). Orders off: at most 0.1% of the decided pixels."""
-    tracked, lag = windows(sim, 0, 3.0)
+    tracked, lag = windows(sim, 0, 6.0)
     full, _ = windows(sim, 0, 0.0)
     near = 0
     for a, b in zip(tracked, full, strict=True):
@@ -121,8 +121,8 @@ def ripple(result, sim, lag):
 
 
 def test_compensation_lowers_the_ripple(sim):
-    plain, lag0 = windows(sim, 0, 3.0)
-    compensated, lag2 = windows(sim, 2, 3.0)
+    plain, lag0 = windows(sim, 0, 6.0)
+    compensated, lag2 = windows(sim, 2, 6.0)
     before = np.median([ripple(r, sim, lag0) for r in plain])
     after = np.median([ripple(r, sim, lag2) for r in compensated])
     assert before > 0.05 and after < 0.1 * before, (before, after)  # 0.077 and 0.002 rad
