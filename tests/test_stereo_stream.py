@@ -184,3 +184,33 @@ def test_starts_and_old_windows(sim, tmp_path, monkeypatch, capsys):
     info = json.loads((out / "0004" / "info.json").read_text())
     assert (info["window"], info["order"], info["lag"], info["frames"], info["time"]) == (
         "4+2", 2, 2.5, [4, 9], 6.5)
+
+
+def test_depth_through_a_distorted_projector():
+    """The column planes of a projector with radial distortion (k1 = 0.3): the pixel's
+    column undistorted at the row its point projects to. Median 0.37 mm off the truth
+    (2.5 mm with the distortion ignored)."""
+    from bistair.codecs import encode
+    from bistair.geometry.stereo_calibration import StereoCalibration
+    from bistair.sim import Imaging, expose, preset, trace
+    from bistair.sim.stereo import StereoRig
+
+    rig, scene = preset("two-masks", camera_size=SIZE)
+    srig = StereoRig.default(camera_size=SIZE, projector_size=rig.projector.size,
+                             projector_dist=(0.3, 0, 0, 0, 0))
+    spec = make_spec("multifreq", width=rig.projector.size[0], height=rig.projector.size[1],
+                     periods=(PERIOD,), steps=4)
+    patterns = encode(spec)[np.arange(6) % 4]
+    frames, truths = [], []
+    for i, side in enumerate(("left", "right")):
+        imaging = Imaging(seed=i)
+        traced = trace(srig.rig(side), scene, imaging)
+        frames.append(expose(traced, patterns, imaging))
+        truths.append(traced.truth)
+    stream = StereoStream(StereoCalibration.from_rig(srig), spec, 540.0, 650.0)
+    results = [stream.push(a, b) for a, b in zip(*frames, strict=True)][3:]
+    for result in results:
+        err = np.abs(result.depth - truths[0].depth)[result.mask]
+        err = err[np.isfinite(err)]
+        assert result.info["decided_fraction"] > 0.6
+        assert np.median(err) < 1.0 and np.max(err) < TOLERANCE_MM
