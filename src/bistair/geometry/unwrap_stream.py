@@ -256,7 +256,6 @@ class StereoStream:
     def _window(self, lphase: np.ndarray, rphase: np.ndarray, start: int) -> StreamDepth:
         """One window's depth from the two wrapped phases."""
         rect = self.rect
-        lo, hi = self.bounds
         info: dict[str, Any]
         tracked = not (self.previous is None or self.margin == 0)
         if not tracked:
