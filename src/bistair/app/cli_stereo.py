@@ -35,13 +35,20 @@ from .cli_options import Input, Output, _quiet, _strategy, _threads, board_file,
               help="Gaussian sigma of a smoothing of the projector coordinates before "
               "matching (never across surfaces): less depth noise, less lateral detail; 0: none")
 @click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
+@click.option("--window", default=None, metavar="N|N+K",
+              help="two streams of one single-period N-step set whose shift advances one "
+              "step per frame: a depth map for every window of N frames (N+K: motion "
+              "compensated to order K) into OUT/<start>/ (depth.npy, cloud.ply, info.json); "
+              "needs --depth-range")
+@click.option("--starts", default=None, metavar="S,S,...",
+              help="with --window: the window starts to write [default: every one]")
 @_threads
 @_quiet
 @reports_errors
 def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
            depth_range: str | None, force: bool, strategy: str | None,
            min_modulation: float | None, smooth: float, no_previews: bool,
-           quiet: bool) -> None:
+           window: str | None, starts: str | None, quiet: bool) -> None:
     """Two cameras and a projector: decode both cameras' captures of one pattern set, match
     equal absolute phase along rectified rows, triangulate.
 
@@ -56,6 +63,10 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     from .stereo import stereo_folder, warnings
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
+    if window is not None or starts is not None:
+        _stereo_stream(left, right, spec_path, calibration, out, (low, high), window, starts,
+                       force, strategy, min_modulation, quiet)
+        return
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
     with Progress(quiet) as say:
@@ -82,6 +93,34 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
                f"({100 * info['matched_fraction']:.1f}%; {info['unmatched']} without a match "
                f"in the right camera{within}, {rejected} rejected by the checks); wrote {out}")
 
+
+
+def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: Path,
+                   out: Path, depth: tuple[float, float], window: str | None,
+                   starts: str | None, force: bool, strategy: str | None,
+                   min_modulation: float | None, quiet: bool) -> None:
+    """``stereo --window``: a depth map per window of two streams
+    (:mod:`bistair.app.stereo_stream`)."""
+    from .cli_options import CliError
+    from .progress import Progress
+    from .stereo_stream import stereo_stream
+
+    if window is None:
+        raise CliError("--starts needs --window N or N+K")
+    if strategy is not None:
+        raise CliError("--strategy does not apply to a stream (--window): stereo phase "
+                       "unwrapping decodes it")
+    with Progress(quiet) as say:
+        kept = stereo_stream(left, right, out, calibration, spec_path, window, starts,
+                             *depth, force=force, min_modulation=min_modulation,
+                             progress=say)
+    if quiet:
+        return
+    shares = [r.info["decided_fraction"] for r in kept]
+    ms = 1000 * float(np.median([r.info["cpu_seconds"] for r in kept[1:] or kept]))
+    click.echo(f"{len(kept)} depth maps of --window {window.strip()} at {depth[0]:g}-"
+               f"{depth[1]:g} mm: {100 * min(shares):.1f}-{100 * max(shares):.1f}% of the "
+               f"decoded left pixels decided, {ms:.1f} ms CPU a window; wrote {out}")
 
 
 @click.command("calibrate-stereo")

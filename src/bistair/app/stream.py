@@ -117,7 +117,7 @@ def parse_starts(text: str | Sequence[int] | None, count: int, window: Window) -
     """
     last = count - window.frames
     if last < 0:
-        raise BistairError(f"--window {_shown(window)} needs {window.frames} frames, the "
+        raise BistairError(f"--window {shown_window(window)} needs {window.frames} frames, the "
                            f"stream has {count}")
     if text is None:
         return list(range(last + 1))
@@ -133,7 +133,7 @@ def parse_starts(text: str | Sequence[int] | None, count: int, window: Window) -
     if beyond:
         raise BistairError(f"--starts {','.join(map(str, beyond))} is beyond the stream: "
                            f"{count} frames give window starts 0 to {last} for --window "
-                           f"{_shown(window)}")
+                           f"{shown_window(window)}")
     return sorted(set(starts))
 
 
@@ -219,7 +219,7 @@ def decode_stream(captures: Captures | np.ndarray, spec: BaseSpec | str | Path |
         stack = None
     spec = check_stream_spec(spec)
     win = parse_window(window, spec.steps)
-    count = len(stack) if stack is not None else _frame_count(files)
+    count = len(stack) if stack is not None else frame_count(files)
     chosen = parse_starts(starts, count, win)
     last = chosen[-1] + win.frames  # the frames read: up to the last window's end
     if stack is None:
@@ -232,7 +232,7 @@ def decode_stream(captures: Captures | np.ndarray, spec: BaseSpec | str | Path |
     fs = measure(first, 0, spec.steps, min_modulation, check=False, shift_sign=spec.shift_sign,
                  phase_offset=spec.phase_offset)
     threshold = fs.threshold
-    say(f"decoding {len(chosen)} windows of {_shown(win)} frames "
+    say(f"decoding {len(chosen)} windows of {shown_window(win)} frames "
         f"({stack.shape[2]}x{stack.shape[1]})")
     stream = PhaseStream(spec.steps, win.order, spec.shift_sign, spec.phase_offset)
     wanted = set(chosen)
@@ -243,13 +243,37 @@ def decode_stream(captures: Captures | np.ndarray, spec: BaseSpec | str | Path |
             if result is None or start not in wanted:
                 continue
             _write_window(tmp / f"{start:04d}", result, spec, win, start, threshold, fs.noise)
-    _remove_other_windows(Path(out), {f"{s:04d}" for s in chosen})
+    remove_other_windows(Path(out), {f"{s:04d}" for s in chosen})
     return Path(out)
 
 
-def _remove_other_windows(out: Path, written: set[str]) -> None:
-    """The window folders an earlier stream decode left in ``out`` and this one did not
-    write (an earlier run's windows must not mix with this one's); other files stay."""
+def remove_other_windows(out: Path, written: set[str]) -> None:
+    """Remove the window folders an earlier stream left in ``out`` and this one did not
+    write (an earlier run's windows must not mix with this one's); other files stay.
+
+    Parameters
+    ----------
+    out : Path
+        The output folder (it exists).
+    written : set of str
+        The names of the window folders this run wrote (``"0000"`` ...).
+
+    Returns
+    -------
+    None
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> out = Path(tempfile.mkdtemp())
+    >>> for name in ("0000", "0003"):
+    ...     (out / name).mkdir()
+    ...     _ = (out / name / "info.json").write_text("{}")
+    >>> remove_other_windows(out, {"0000"})
+    >>> sorted(p.name for p in out.iterdir())
+    ['0000']
+    >>> shutil.rmtree(out)
+    """
     for old in out.iterdir():
         if (old.is_dir() and re.fullmatch(r"\d{4,}", old.name) and old.name not in written
                 and (old / "info.json").is_file()):
@@ -271,15 +295,30 @@ def _write_window(folder: Path, result: tuple[np.ndarray, np.ndarray], spec: Mul
         np.save(folder / "phase.npy", np.where(valid, phase, np.nan))
     info: dict[str, Any] = {
         "method": spec.method, "start": start, "frames": [start, start + win.frames - 1],
-        "window": _shown(win), "steps": spec.steps, "order": win.order, "lag": win.lag,
+        "window": shown_window(win), "steps": spec.steps, "order": win.order, "lag": win.lag,
         "time": start + win.lag, "period": period, "absolute_phase": absolute,
         "threshold": float(threshold), "noise": float(noise),
         "valid": int(valid.sum()), "pixels": int(valid.size)}
     write_json(folder / "info.json", info)
 
 
-def _frame_count(files: Sequence[Path]) -> int:
-    """Frames in the captures: one a file, or the frames of one ``.npy`` stack."""
+def frame_count(files: Sequence[Path]) -> int:
+    """Frames in the captures: one a file, or the frames of one ``.npy`` stack.
+
+    Parameters
+    ----------
+    files : sequence of Path
+        The captures' files (:func:`~bistair.io.read.capture_files`).
+
+    Returns
+    -------
+    int
+
+    Examples
+    --------
+    >>> frame_count([Path("a.png"), Path("b.png")])
+    2
+    """
     if len(files) == 1 and files[0].suffix.lower() == ".npy":
         try:
             shape = np.load(files[0], mmap_mode="r").shape
@@ -289,5 +328,21 @@ def _frame_count(files: Sequence[Path]) -> int:
     return len(files)
 
 
-def _shown(win: Window) -> str:
+def shown_window(win: Window) -> str:
+    """``--window`` as given: ``"N"`` or ``"N+K"``.
+
+    Parameters
+    ----------
+    win : Window
+        The window.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> shown_window(Window(4, 2)), shown_window(Window(4, 0))
+    ('4+2', '4')
+    """
     return f"{win.steps}+{win.order}" if win.order else str(win.steps)

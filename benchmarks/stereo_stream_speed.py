@@ -1,0 +1,126 @@
+"""Depth maps per second of a two-camera stream (issue 34): ``stereo --window`` at 640 x 480.
+
+two-masks seen by the virtual rig's two cameras (640 x 480 each, 200 mm apart, the
+projector halfway), a four-step stream of period 48 (uint8 frames, default imaging: frame
+``i`` shows shift ``i mod 4``, each frame its own noise), depth range 520:650 mm. The
+steady state is timed: each new frame pair updates both cameras' sums, unwraps (the search
+near the previous disparity, the full range where that fails, the confirmations) and
+triangulates (the projector's column planes). Process CPU time, the minimum of interleaved
+rounds, per depth map, beside two bare baselines of the same run: one ``cv2.remap`` of a
+640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. The decided pixels an
+order off are counted against the renderer's truth after the timing.
+
+    python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import cv2
+import numba
+import numpy as np
+
+from bistair.codecs import encode, make_spec
+from bistair.geometry.stereo_calibration import StereoCalibration
+from bistair.geometry.unwrap_stream import StereoStream
+from bistair.sim import Imaging, expose, preset, trace
+from bistair.sim.stereo import StereoRig
+
+RANGE = (520.0, 650.0)
+
+
+def scene_frames(width: int, height: int, count: int
+                 ) -> tuple[StereoCalibration, object, np.ndarray, np.ndarray, np.ndarray]:
+    """The calibration, the spec, ``count`` frames of each camera and the left camera's
+    true projector column (NaN where it sees no surface)."""
+    rig, scene = preset("two-masks", camera_size=(width, height))
+    srig = StereoRig.default(camera_size=(width, height), projector_size=rig.projector.size)
+    spec = make_spec("multifreq", width=rig.projector.size[0], height=rig.projector.size[1],
+                     periods=(48,), steps=4)
+    patterns = encode(spec)[np.arange(count) % 4]
+    frames, columns = [], []
+    for i, side in enumerate(("left", "right")):
+        imaging = Imaging(seed=i)
+        traced = trace(srig.rig(side), scene, imaging)
+        frames.append(expose(traced, patterns, imaging))
+        columns.append(traced.truth.coord_x)
+    return StereoCalibration.from_rig(srig), spec, frames[0], frames[1], columns[0]
+
+
+def cpu(fn, repeat: int = 1) -> float:
+    """Process CPU seconds of one call, over ``repeat`` calls."""
+    start = time.process_time()
+    for _ in range(repeat):
+        fn()
+    return (time.process_time() - start) / repeat
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--camera", default="640x480")
+    parser.add_argument("--frames", type=int, default=24)
+    parser.add_argument("--rounds", type=int, default=5)
+    args = parser.parse_args(argv)
+    width, height = (int(v) for v in args.camera.lower().split("x"))
+    cal, spec, left, right, truth = scene_frames(width, height, args.frames)
+    streams: dict[str, StereoStream] = {}
+    for window, order in (("4", 0), ("4+2", 2)):  # warm: the first window, the kernels
+        stream = StereoStream(cal, spec, *RANGE, order=order)
+        for i in range(8):
+            stream.push(left[i], right[i])
+        streams[window] = stream
+    position = {name: 8 for name in streams}
+    shares: dict[str, list[float]] = {name: [] for name in streams}
+    kept: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {name: [] for name in streams}
+    image = left[0].astype(np.float32)
+    maps = np.mgrid[:height, :width][::-1].astype(np.float32) + np.float32(0.3)
+    four = left[:4]
+
+    def push(name: str) -> None:
+        i = position[name] % args.frames
+        position[name] += 1
+        result = streams[name].push(left[i], right[i])
+        kept[name].append((result.phase, result.mask))
+        shares[name].append(result.info["decided_fraction"])
+
+    tasks = {
+        "cv2.remap 640x480 float32 (baseline)": lambda: cv2.remap(
+            image, maps[0], maps[1], cv2.INTER_LINEAR),
+        "numpy sum of 4 frames (baseline)": lambda: four.sum(axis=0, dtype=np.float32),
+        "depth map, --window 4": lambda: push("4"),
+        "depth map, --window 4+2": lambda: push("4+2"),
+    }
+    repeat = {name: 20 if "baseline" in name else 8 for name in tasks}
+    best = {name: float("inf") for name in tasks}
+    wall = {name: float("inf") for name in tasks}
+    for _ in range(args.rounds):  # interleaved: each round runs every task
+        for name, task in tasks.items():
+            clock = time.perf_counter()
+            best[name] = min(best[name], cpu(task, repeat[name]))
+            wall[name] = min(wall[name], (time.perf_counter() - clock) / repeat[name])
+    base = best["cv2.remap 640x480 float32 (baseline)"]
+    print(f"# two-masks {width}x{height}, both cameras, 4 steps, period 48, "
+          f"{RANGE[0]:g}:{RANGE[1]:g} mm; min of {args.rounds} interleaved rounds; "
+          f"{numba.get_num_threads()} numba threads")
+    print("| per depth map | CPU ms | / remap | maps/s (CPU) | wall ms | maps/s (wall) |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: |")
+    for name in tasks:
+        print(f"| {name} | {1000 * best[name]:.2f} | {best[name] / base:.1f} | "
+              f"{1 / best[name]:.0f} | {1000 * wall[name]:.2f} | {1 / wall[name]:.0f} |")
+    off = {name: [0, 0] for name in streams}
+    for name, results in kept.items():  # (after the timing)
+        for phase, mask in results:
+            error = np.abs(phase - 2 * np.pi * truth / 48)[mask]
+            off[name][0] += int(np.sum(error[np.isfinite(error)] > np.pi))  # an order off
+            off[name][1] += int(mask.sum())
+    for name, values in shares.items():
+        print(f"decided, --window {name}: {100 * min(values):.1f}-{100 * max(values):.1f}% "
+              f"of the decoded left pixels; an order off: {off[name][0]} of {off[name][1]} "
+              f"({100 * off[name][0] / max(off[name][1], 1):.3f}%)")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,507 @@
+"""Compiled passes of stereo phase unwrapping over a stream (:mod:`bistair.geometry.
+unwrap_stream`): the search near the previous window's disparity, the projector column of
+each decided pixel, and the depth where the left camera's ray cuts the projector's column
+plane.
+
+They run over rows on every core and have no NumPy twin (the row search has no one-pass
+NumPy form); ``tests/test_stereo_stream.py`` checks them against the renderer's truth and
+against :func:`~bistair.geometry.unwrap.unwrap_stereo`'s full search.
+
+Examples
+--------
+The rig of :mod:`bistair.geometry.unwrap_jit` (``f`` = 100 px, cameras 100 mm apart, a
+projector 25 mm right of the left camera, a period of 8 px) and its plane at 500 mm (a
+disparity of 20 px); the previous window found 19.5 px, so only 17.5-21.5 is searched:
+
+>>> import numpy as np
+>>> cols = np.arange(80, dtype=np.float32)[None]
+>>> left = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)
+>>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)
+>>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+>>> previous = np.full((1, 80), 19.5, np.float32)
+>>> n_in, disparity, near = track_rows(
+...     left, right, previous, 2.0, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
+...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
+>>> int(n_in[0, 50]), round(float(disparity[0, 50]), 4), int(near[0, 50])
+(1, 20.0, 1)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..core.jit import _numba_inline, kernel
+
+prange = range  # numba's prange once the first kernel of this module compiles
+TWO_PI = 2.0 * math.pi
+
+
+@_numba_inline
+def _near(difference: float) -> float:
+    """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)``."""
+    if difference >= math.pi:
+        return difference - TWO_PI
+    if difference < -math.pi:
+        return difference + TWO_PI
+    return difference
+
+
+@_numba_inline
+def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int, j1: int,
+          lo: float, hi: float, shift: float, f: float, cx: float, yr: float, tx: float,
+          back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
+          period: float, tolerance: float, zmin: float, zmax: float, width: int,
+          from_right: bool) -> tuple[int, float]:
+    """The consistent candidates in the depth range of one pixel among the crossings of
+    ``a`` on ``other``'s row between columns ``j0`` and ``j1`` (disparities ``lo..hi``):
+    their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``)."""
+    wr = other.shape[1]
+    count = 0
+    found = math.nan
+    first = max(j0, 0)
+    e1 = _near(float(other[y, first]) - a)
+    for j in range(first, min(j1, wr - 1)):
+        e0 = e1
+        e1 = _near(float(other[y, j + 1]) - a)
+        if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
+            continue
+        xs = j + e0 / (e0 - e1)
+        d = xs - x - shift if from_right else x - xs - shift
+        if not (lo <= d <= hi):
+            continue
+        zr = -f * tx / d
+        if not zr > 0.0:
+            continue
+        xl = ((xs if from_right else x) - cx) / f
+        qx, qy = xl * zr, yr * zr
+        px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
+        py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
+        pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
+        u, _ = _project(px, py, pz, kp, dp, rp, tp)
+        if not (-0.5 <= u <= width - 0.5):
+            continue
+        miss = TWO_PI * u / period - a
+        miss = abs(miss - TWO_PI * math.floor((miss + math.pi) / TWO_PI))
+        if miss > tolerance:
+            continue
+        if zmin <= pz <= zmax:
+            count += 1
+            found = d if count == 1 else math.nan
+    return count, found
+
+
+@_numba_inline
+def _project(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
+             rp: np.ndarray, tp: np.ndarray) -> tuple[float, float]:
+    """The projector pixel (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of a point of
+    the left camera's frame; NaN behind the projector."""
+    x = rp[0, 0] * px + rp[0, 1] * py + rp[0, 2] * pz + tp[0]
+    y = rp[1, 0] * px + rp[1, 1] * py + rp[1, 2] * pz + tp[1]
+    z = rp[2, 0] * px + rp[2, 1] * py + rp[2, 2] * pz + tp[2]
+    if not z > 0.0:
+        return math.nan, math.nan
+    x /= z
+    y /= z
+    r2 = x * x + y * y
+    radial = 1.0 + r2 * (dp[0] + r2 * (dp[1] + r2 * dp[4]))
+    xd = x * radial + 2.0 * dp[2] * x * y + dp[3] * (r2 + 2.0 * x * x)
+    yd = y * radial + dp[2] * (r2 + 2.0 * y * y) + 2.0 * dp[3] * x * y
+    return kp[0, 0] * xd + kp[0, 1] * yd + kp[0, 2], kp[1, 1] * yd + kp[1, 2]
+
+
+@kernel(parallel=True)
+def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: float,
+           lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
+           back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
+           period: float, tolerance: float, zmin: float, zmax: float, width: int,
+           from_right: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    h, w = own.shape
+    wr = other.shape[1]
+    n_in = np.zeros((h, w), np.int16)
+    disparity = np.full((h, w), np.nan, np.float32)
+    near = np.zeros((h, w), np.uint8)
+    for y in prange(h):
+        yr = (y - cy) / f
+        for x in range(w):
+            a = float(own[y, x])
+            if a != a:
+                continue
+            if from_right:
+                j0, j1 = int(math.floor(x + shift + lo)), int(math.ceil(x + shift + hi))
+            else:
+                j0, j1 = int(math.floor(x - shift - hi)), int(math.ceil(x - shift - lo))
+            if j0 < 0 or j1 > wr - 1:  # as the full search: a candidate may lie beyond
+                n_in[y, x] = -1
+                continue
+            p = float(previous[y, x])
+            if p == p:
+                plo, phi = max(lo, p - margin), min(hi, p + margin)
+                if from_right:
+                    k0, k1 = int(math.floor(x + shift + plo)), int(math.ceil(x + shift + phi))
+                else:
+                    k0, k1 = int(math.floor(x - shift - phi)), int(math.ceil(x - shift - plo))
+                count, d = _scan(own, other, y, x, a, k0, k1, plo, phi, shift, f, cx, yr, tx,
+                                 back, kp, dp, rp, tp, period, tolerance, zmin, zmax, width,
+                                 from_right)
+                if count == 1:
+                    n_in[y, x] = 1
+                    disparity[y, x] = d
+                    near[y, x] = 1
+                    continue
+            count, d = _scan(own, other, y, x, a, j0, j1, lo, hi, shift, f, cx, yr, tx, back,
+                             kp, dp, rp, tp, period, tolerance, zmin, zmax, width, from_right)
+            n_in[y, x] = min(count, 32000)
+            if count == 1:
+                disparity[y, x] = d
+    return n_in, disparity, near
+
+
+def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: float,
+               lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
+               back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
+               tp: np.ndarray, period: float, tolerance: float, zmin: float, zmax: float,
+               width: int, from_right: bool = False
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The consistent candidates of each rectified pixel, searched first within
+    ``margin`` of its ``previous`` disparity and over the full range ``[lo, hi]`` where
+    that finds none or two or more (or there is no previous disparity).
+
+    A candidate is what :func:`~bistair.geometry.unwrap_jit.unwrap_rows` takes: a place
+    of equal wrapped phase on the other grid's row whose point the projector confirms
+    within ``tolerance`` and whose depth lies in ``[zmin, zmax]``.
+
+    Parameters
+    ----------
+    own, other : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase on the rectified grids (``own``: the pixels
+        searched for; the left grid's, or the right grid's with ``from_right``), NaN where
+        unknown.
+    previous : numpy.ndarray
+        ``(H, W)`` float32 disparities of ``own``'s pixels in the previous window, NaN
+        where none.
+    margin : float
+        Half the width (rectified pixels) of the search about a previous disparity.
+    lo, hi, shift, f, cx, cy, tx, back, kp, dp, rp, tp, period, tolerance, zmin, zmax, width
+        As for :func:`~bistair.geometry.unwrap_jit.unwrap_rows`.
+    from_right : bool, optional
+        ``own`` is the right grid (the same disparity convention).
+
+    Returns
+    -------
+    n_in : numpy.ndarray
+        ``(H, W)`` int16 consistent candidates in the range of the search that decided
+        (1 from the narrow one; else the full one's count), -1 where the full search would
+        reach past the other view.
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 the one candidate's disparity, NaN elsewhere.
+    near : numpy.ndarray
+        ``(H, W)`` uint8 1 where the narrow search decided.
+
+    Examples
+    --------
+    No previous disparity: the full search, as ``unwrap_rows`` (the module's rig):
+
+    >>> cols = np.arange(80, dtype=np.float32)[None]
+    >>> left = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)
+    >>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)
+    >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+    >>> none = np.full((1, 80), np.nan, np.float32)
+    >>> n_in, d, near = track_rows(
+    ...     left, right, none, 2.0, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
+    ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
+    >>> int(n_in[0, 50]), round(float(d[0, 50]), 4), int(near[0, 50]), int(n_in[0, 30])
+    (1, 20.0, 0, -1)
+    """
+    def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
+
+    return _track(np.ascontiguousarray(own, np.float32), np.ascontiguousarray(other, np.float32),
+                  np.ascontiguousarray(previous, np.float32), float(margin), float(lo),
+                  float(hi), float(shift), float(f), float(cx), float(cy), float(tx),
+                  arr(back, (3, 3)), arr(kp, (3, 3)), arr(dp, (5,)), arr(rp, (3, 3)),
+                  arr(tp, (3,)), float(period), float(tolerance), float(zmin), float(zmax),
+                  int(width), bool(from_right))
+
+
+@kernel(parallel=True)
+def _columns(disparity: np.ndarray, shift: float, f: float, cx: float, cy: float, tx: float,
+             back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
+             tp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    h, w = disparity.shape
+    cols = np.full((h, w), np.nan, np.float32)
+    rows = np.full((h, w), np.nan, np.float32)
+    for y in prange(h):
+        for x in range(w):
+            d = float(disparity[y, x])
+            if not d * tx < 0.0:
+                continue
+            zr = -f * tx / d
+            qx, qy = (x - cx) / f * zr, (y - cy) / f * zr
+            px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
+            py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
+            pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
+            u, v = _project(px, py, pz, kp, dp, rp, tp)
+            cols[y, x] = u
+            rows[y, x] = v
+    return cols, rows
+
+
+def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, cy: float,
+                     tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
+                     rp: np.ndarray, tp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The projector pixel (column, row) of each rectified left pixel's point.
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 on the rectified left grid, NaN where undecided.
+    shift, f, cx, cy, tx, back, kp, dp, rp, tp
+        As for :func:`track_rows` (``shift`` is not used: disparities are relative to it).
+
+    Returns
+    -------
+    columns, rows : numpy.ndarray
+        ``(H, W)`` float32 projector pixel, NaN where ``disparity`` is.
+
+    Examples
+    --------
+    >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+    >>> u, v = projector_pixels(np.float32([[20.0, np.nan]]), 0.0, 100.0, 0.0, 0.0, -100.0,
+    ...                         np.eye(3), k, np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]))
+    >>> [round(float(a), 3) for a in (u[0, 0], v[0, 0])], bool(np.isnan(u[0, 1]))
+    ([-5.0, 0.0], True)
+    """
+    def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
+
+    return _columns(np.ascontiguousarray(disparity, np.float32), float(shift), float(f),
+                    float(cx), float(cy), float(tx), arr(back, (3, 3)), arr(kp, (3, 3)),
+                    arr(dp, (5,)), arr(rp, (3, 3)), arr(tp, (3,)))
+
+
+@_numba_inline
+def _corner(grid: np.ndarray, y: int, x: int, w: float, total: float, low: float,
+            high: float) -> tuple[float, float, float]:
+    """Add one corner of a bilinear sample: its weighted value, and the spread seen."""
+    g = float(grid[y, x])
+    return total + w * g, min(low, g), max(high, g)
+
+
+@kernel(parallel=True)
+def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+                 phase: np.ndarray, ax: np.ndarray, az: np.ndarray, period: float,
+                 max_step: float, kp: np.ndarray, dp: np.ndarray, t0: float, t2: float,
+                 zmin: float, zmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    h, w = u.shape
+    gh, gw = cols.shape
+    depth = np.full((h, w), np.nan, np.float32)
+    order = np.full((h, w), -1, np.int32)
+    column = np.full((h, w), np.nan, np.float32)
+    fx, skew, cxp, fy, cyp = kp[0, 0], kp[0, 1], kp[0, 2], kp[1, 1], kp[1, 2]
+    distorted = dp[0] != 0.0 or dp[1] != 0.0 or dp[2] != 0.0 or dp[3] != 0.0 or dp[4] != 0.0
+    for y in prange(h):
+        for x in range(w):
+            phi = float(phase[y, x])
+            if phi != phi:
+                continue
+            su, sv = float(u[y, x]), float(v[y, x])
+            x0, y0 = int(math.floor(su)), int(math.floor(sv))
+            if x0 < 0 or y0 < 0 or x0 + 1 >= gw or y0 + 1 >= gh:
+                continue
+            fu, fv = su - x0, sv - y0
+            c, lo, hi = 0.0, math.inf, -math.inf
+            c, lo, hi = _corner(cols, y0, x0, (1 - fu) * (1 - fv), c, lo, hi)
+            c, lo, hi = _corner(cols, y0, x0 + 1, fu * (1 - fv), c, lo, hi)
+            c, lo, hi = _corner(cols, y0 + 1, x0, (1 - fu) * fv, c, lo, hi)
+            c, lo, hi = _corner(cols, y0 + 1, x0 + 1, fu * fv, c, lo, hi)
+            if not hi - lo <= max_step:  # (NaN: a corner undecided)
+                continue
+            k = math.floor((TWO_PI * c / period - phi) / TWO_PI + 0.5)
+            xp = (phi / TWO_PI + k) * period  # the column of the absolute phase
+            yn = 0.0
+            if distorted:  # the row of the sample, for the column plane's local slope
+                r = (1 - fv) * ((1 - fu) * rows[y0, x0] + fu * rows[y0, x0 + 1]) + fv * (
+                    (1 - fu) * rows[y0 + 1, x0] + fu * rows[y0 + 1, x0 + 1])
+                yd = (r - cyp) / fy
+                xd = (xp - cxp - skew * yd) / fx
+                xn, yn = xd, yd
+                for _ in range(8):  # undistort (OpenCV's iteration)
+                    r2 = xn * xn + yn * yn
+                    radial = 1.0 + r2 * (dp[0] + r2 * (dp[1] + r2 * dp[4]))
+                    dx = 2.0 * dp[2] * xn * yn + dp[3] * (r2 + 2.0 * xn * xn)
+                    dy = dp[2] * (r2 + 2.0 * yn * yn) + 2.0 * dp[3] * xn * yn
+                    xn, yn = (xd - dx) / radial, (yd - dy) / radial
+            else:
+                xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) / fy)) / fx
+            den = float(ax[y, x]) - xn * float(az[y, x])
+            if den == 0.0:
+                continue
+            z = (xn * t2 - t0) / den
+            if zmin <= z <= zmax:
+                depth[y, x] = z
+                order[y, x] = int(k)
+                column[y, x] = xp
+    return depth, order, column
+
+
+def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+                phase: np.ndarray, ax: np.ndarray, az: np.ndarray, period: float,
+                max_step: float, kp: np.ndarray, dp: np.ndarray, tp: np.ndarray,
+                zmin: float, zmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The depth where each left pixel's ray cuts the projector's plane of the column of
+    its absolute phase.
+
+    The order comes from the projector columns decided on the rectified grid, read
+    bilinearly at the pixel's rectified position (four decided corners that spread by at
+    most ``max_step`` columns); the absolute phase is the pixel's own wrapped phase plus
+    ``2*pi`` times the order that puts it nearest that column. The point ``z * (x, y, 1)``
+    of the pixel's ray lies on the column's plane where the projector's normalised
+    ``X - x_n Z`` is 0: ``z = (x_n t_z - t_x) / (a_x - x_n a_z)`` with ``a = R (x, y, 1)``
+    (``ax``, ``az``) precomputed per pixel.
+
+    Parameters
+    ----------
+    columns, rows : numpy.ndarray
+        ``(h, w)`` float32 projector pixel of each rectified left pixel
+        (:func:`projector_pixels`), NaN where undecided.
+    u, v : numpy.ndarray
+        ``(H, W)`` float32 the left pixels' rectified positions.
+    phase : numpy.ndarray
+        ``(H, W)`` float32 the left camera's wrapped phase (radians), NaN where unknown.
+    ax, az : numpy.ndarray
+        ``(H, W)`` float32 the projector frame's x and z of each pixel's ray.
+    period : float
+        The fringe period (projector pixels).
+    max_step : float
+        The largest spread (projector columns) of the four corners.
+    kp, dp, tp : numpy.ndarray
+        The projector's intrinsics, distortion (5) and translation from the left camera.
+    zmin, zmax : float
+        The depth range kept (mm).
+
+    Returns
+    -------
+    depth : numpy.ndarray
+        ``(H, W)`` float32 ``z`` (mm), NaN where undecided or outside the range.
+    order : numpy.ndarray
+        ``(H, W)`` int32 fringe order, -1 where ``depth`` is NaN.
+    column : numpy.ndarray
+        ``(H, W)`` float32 the projector column of the absolute phase
+        (``Phi * period / (2*pi)``), NaN where ``depth`` is.
+
+    Examples
+    --------
+    A projector 25 mm right of the camera, both ``f`` = 100 px, columns ``x - 5`` on a
+    plane at 500 mm (the ray of pixel 50 is ``(0.5, 0, 1)``), period 8:
+
+    >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+    >>> ones = np.ones((1, 1), np.float32)
+    >>> cols, rows = np.full((2, 2), 45.2, np.float32), np.zeros((2, 2), np.float32)
+    >>> phase = np.float32([[2 * np.pi * 45 / 8 % (2 * np.pi)]])
+    >>> z, order, column = plane_depth(cols, rows, 0.5 * ones, 0.5 * ones, phase, 0.5 * ones, ones,
+    ...                        8.0, 2.0, k, np.zeros(5), np.array([-25.0, 0, 0]), 400, 600)
+    >>> round(float(z[0, 0]), 3), int(order[0, 0]), round(float(column[0, 0]), 3)
+    (500.0, 5, 45.0)
+    """
+    k = np.ascontiguousarray(np.asarray(kp, np.float64).reshape(3, 3))
+    d = np.ascontiguousarray(np.asarray(dp, np.float64).reshape(5))
+    t = np.asarray(tp, np.float64).reshape(3)
+    return _plane_depth(np.ascontiguousarray(columns, np.float32),
+                        np.ascontiguousarray(rows, np.float32), np.asarray(u, np.float32),
+                        np.asarray(v, np.float32), np.asarray(phase, np.float32),
+                        np.asarray(ax, np.float32), np.asarray(az, np.float32), float(period),
+                        float(max_step), k, d, float(t[0]), float(t[2]), float(zmin),
+                        float(zmax))
+
+
+@kernel(parallel=True)
+def _confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
+             shift: float, support: float, edge: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    h, w = disparity.shape
+    wr = right.shape[1]
+    crossed = np.full((h, w), np.nan, np.float32)
+    occluded = np.zeros((h, w), np.uint8)
+    out = np.full((h, w), np.nan, np.float32)
+    counts = np.zeros((h, 2), np.int64)  # not confirmed, unsupported
+    for y in prange(h):
+        for x in range(w):
+            d = float(disparity[y, x])
+            if d == d:
+                xr = int(np.rint(x - shift - d))
+                if 0 <= xr < wr and abs(float(right[y, xr]) - d) <= support:
+                    crossed[y, x] = d
+            if valid[y, x] and (n_in[y, x] == 0 or (n_in[y, x] == 1 and
+                                                    crossed[y, x] != crossed[y, x])):
+                occluded[y, x] = 1
+            if n_in[y, x] == 1 and crossed[y, x] != crossed[y, x]:
+                counts[y, 0] += 1
+    for y in prange(h):
+        for x in range(w):
+            c = float(crossed[y, x])
+            if c != c:
+                continue
+            ok = (y > 0 and abs(c - float(crossed[y - 1, x])) <= support) or (
+                y < h - 1 and abs(c - float(crossed[y + 1, x])) <= support)
+            if ok:
+                for k in range(max(x - edge, 0), min(x + edge + 1, w)):
+                    if occluded[y, k]:
+                        ok = False
+                        break
+            if ok:
+                out[y, x] = c
+            else:
+                counts[y, 1] += 1
+    return out, crossed, counts[:, 0].copy(), counts[:, 1].copy()
+
+
+def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
+            shift: float, support: float, edge: int) -> tuple[np.ndarray, int, int]:
+    """The decided disparities that the full search would keep: confirmed by the right
+    grid's decision at the match (within ``support`` px), by the row above or below
+    (within ``support``), and not within ``edge`` pixels along the row of an occluded pixel
+    (a valid one with no candidate, or with one the right grid does not confirm); what
+    :func:`~bistair.geometry.unwrap.unwrap_stereo` does after its search, in one pass.
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 the left grid's single candidates, NaN elsewhere.
+    n_in : numpy.ndarray
+        ``(H, W)`` int16 the candidates counted (:func:`track_rows`).
+    valid : numpy.ndarray
+        ``(H, W)`` bool: the left grid's pixels of known phase.
+    right : numpy.ndarray
+        ``(H, W_right)`` float32 the right grid's single candidates.
+    shift, support : float
+        ``cx_left - cx_right``; the largest disagreement (px).
+    edge : int
+        The reach (px) of an occlusion along the row.
+
+    Returns
+    -------
+    kept : numpy.ndarray
+        ``(H, W)`` float32 the confirmed disparities, NaN elsewhere.
+    not_confirmed : int
+        Single candidates the right grid does not confirm.
+    unsupported : int
+        Confirmed ones dropped by the rows beside or an occlusion.
+
+    Examples
+    --------
+    >>> d = np.float32([[5, 5, 5, 5], [5, 5, 5, 5]])
+    >>> n = np.ones((2, 4), np.int16)
+    >>> right = np.full((2, 4), 5.0, np.float32)
+    >>> right[0, 1] = np.nan
+    >>> kept, nc, un = confirm(d, n, np.ones((2, 4), bool), right, -3.0, 1.0, 0)
+    >>> kept.tolist(), nc, un  # left x matches right x - 2: 0 and 1 beyond, (0, 3) unknown
+    ([[nan, nan, 5.0, nan], [nan, nan, 5.0, nan]], 5, 1)
+    """
+    out, _, nc, un = _confirm(np.ascontiguousarray(disparity, np.float32),
+                              np.ascontiguousarray(n_in, np.int16),
+                              np.ascontiguousarray(valid, np.bool_),
+                              np.ascontiguousarray(right, np.float32), float(shift),
+                              float(support), int(edge))
+    return out, int(nc.sum()), int(un.sum())
