@@ -63,9 +63,15 @@ from ..core.jit import side_by_side
 from ..core.result import AxesResult, DecodeResult, make_result
 from ..errors import BistairError
 from ..spec import BaseSpec
-from .calibration import Calibration, Device
+from .calibration import (
+    STEREO,
+    Calibration,
+    Device,
+    StereoCalibration,
+    load_calibration,
+    short_baseline,
+)
 from .match import Matched, match
-from .stereo_calibration import StereoCalibration, load_stereo_calibration, short_baseline
 from .stereo_checks import (
     MIN_MATCHED,
     MISFIT_SAMPLE,
@@ -565,7 +571,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
     if not isinstance(calibration, StereoCalibration):
-        calibration = load_stereo_calibration(calibration)
+        calibration = load_calibration(calibration, STEREO)
     opts = decode_options(spec.method, force, options)
 
     def decoded(side: str, images: np.ndarray) -> DecodeResult | AxesResult:
