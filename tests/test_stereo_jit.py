@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 from support import stereo_before
 
-from bistair.geometry.stereo_checks import projector_misfits
 from bistair.geometry.match_jit import (
     ALONE,
     AMBIGUOUS,
@@ -28,6 +27,7 @@ from bistair.geometry.match_jit import (
     smooth_runs,
     supported,
 )
+from bistair.geometry.stereo_checks import projector_misfits
 from bistair.geometry.stereo_jit import (
     cloud_points,
     depth_counts,

@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from bistair.geometry.stereo_checks import MISFIT_PX, MISFIT_SAMPLE, _dlt
 from bistair.geometry.match_jit import line_coefficients
+from bistair.geometry.stereo_checks import MISFIT_PX, MISFIT_SAMPLE, _dlt
 
 
 def drop_kinks(values: np.ndarray, limit: float, reach: int) -> np.ndarray:
