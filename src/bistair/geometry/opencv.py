@@ -463,7 +463,7 @@ def read_opencv_stereo(paths: Sequence[str | Path],
         differently, a matrix of the wrong shape, distortion terms bistair's model lacks,
         ``R`` not a rotation, non-finite values, a bad or missing size, a right camera on the
         left of the left one or a baseline under 1 mm
-        (:func:`~bistair.geometry.stereo_calibration.check_pair`).
+        (:func:`~bistair.geometry.calibration.check_pair`).
 
     Examples
     --------
