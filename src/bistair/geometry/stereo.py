@@ -33,8 +33,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
-   on the left camera's own (distorted) image grid.
-   Steps 2-4 are :func:`~.match.match`.
+   on the left camera's own (distorted) image grid. The resampling and steps 2 to 4 are
+   :func:`~.match.match`.
 5. Checks of the inputs against each other (:mod:`.stereo_checks`): too few matches,
    projector rows that disagree (both axes), points that one projector explains only with
    the cameras exchanged or the right images upside down.
