@@ -23,9 +23,8 @@ import numpy as np
 
 import bistair
 from bistair.geometry.board import Board
-from bistair.geometry.calibrate import feature_spacing, sample_local
 from bistair.geometry.calibration import Calibration
-from bistair.geometry.corners import local_homography
+from bistair.geometry.corners import feature_spacing, local_homography, sample_local
 from bistair.sim import Imaging, Rig, Scene, expose, trace
 from bistair.sim.boards import POSES, board_plane
 from bistair.sim.rig import euler

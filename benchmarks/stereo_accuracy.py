@@ -30,8 +30,8 @@ import numpy as np
 
 import bistair
 from bistair.evaluation.stereo import score_stereo
+from bistair.geometry.calibration import StereoCalibration
 from bistair.geometry.stereo import stereo
-from bistair.geometry.stereo_calibration import StereoCalibration
 from bistair.sim import Box, Imaging, Plane, Scene, Sphere, euler, preset
 from bistair.sim.stereo import StereoRig, render_stereo
 

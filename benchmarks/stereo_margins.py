@@ -32,8 +32,8 @@ import bistair
 from bistair.errors import BistairError
 from bistair.evaluation.benchmark import method_specs
 from bistair.evaluation.stereo import depth_errors
+from bistair.geometry.calibration import StereoCalibration
 from bistair.geometry.stereo import readings, reconstruct_stereo
-from bistair.geometry.stereo_calibration import StereoCalibration
 from bistair.geometry.stereo_checks import (
     MIN_MATCHED,
     MISFIT_FLOOR,

@@ -33,7 +33,7 @@ from bistair.core.jit import set_threads
 from bistair.core.memory import keep_freed_memory
 from bistair.evaluation.speed import opencv_floor
 from bistair.geometry import stereo as st
-from bistair.geometry.stereo_calibration import StereoCalibration
+from bistair.geometry.calibration import StereoCalibration
 from bistair.sim import Imaging, preset
 from bistair.sim.stereo import StereoRig, render_stereo
 

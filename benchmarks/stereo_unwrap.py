@@ -28,7 +28,7 @@ import time
 import numpy as np
 
 from bistair.core.phase import phase_shift_patterns
-from bistair.geometry.stereo_calibration import StereoCalibration
+from bistair.geometry.calibration import StereoCalibration
 from bistair.geometry.unwrap import absolute_phase, unwrap_stereo, wrapped_of
 from bistair.sim import preset, scene_names, trace
 from bistair.sim.render import Imaging, expose

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 import bistair
-from bistair.geometry.stereo_calibration import StereoCalibration
+from bistair.geometry.calibration import StereoCalibration
 from bistair.io.atomic import write_image
 from bistair.io.previews import colorize
 from bistair.sim import Imaging, preset

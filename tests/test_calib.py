@@ -17,21 +17,14 @@ from bistair.app.jobs import reconstruct_folder
 from bistair.errors import BistairError
 from bistair.evaluation.metrics import fit_sphere
 from bistair.geometry.board import Board
-from bistair.geometry.calibrate import (
-    CORNER_FITS,
-    MIN_POSES,
-    PoseCapture,
-    board_view,
-    calibrate_points,
-    calibrate_poses,
-    sample_local,
-)
+from bistair.geometry.calibrate import MIN_POSES, calibrate_points, calibrate_poses
 from bistair.geometry.calibration import (
     Calibration,
     Device,
     load_calibration,
     save_calibration,
 )
+from bistair.geometry.corners import CORNER_FITS, PoseCapture, board_view, sample_local
 from bistair.io.atomic import write_image
 from bistair.sim import Imaging, Rig, Scene, Sphere, expose, trace
 from bistair.sim.boards import POSES, board_plane, synthetic_views, write_board_captures

@@ -16,8 +16,8 @@ from test_calib import BOARD, assert_close, check_board_view, one_line, sim_rig
 import bistair
 from bistair.app.calibrate import calibrate_folder, read_pose
 from bistair.errors import BistairError
-from bistair.geometry.calibrate import CORNER_FITS, board_view
 from bistair.geometry.calibration import Calibration, load_calibration
+from bistair.geometry.corners import CORNER_FITS, board_view
 from bistair.io.atomic import write_image
 from bistair.sim import Imaging
 from bistair.sim.boards import POSES, write_board_captures

@@ -29,13 +29,13 @@ from bistair.app.stereo import simulate_stereo
 from bistair.core.jit import set_threads
 from bistair.errors import BistairError
 from bistair.evaluation.stereo import score_stereo
-from bistair.geometry.calibration import Calibration
-from bistair.geometry.stereo import rectify, stereo
-from bistair.geometry.stereo_calibration import (
+from bistair.geometry.calibration import (
+    Calibration,
     StereoCalibration,
     load_stereo_calibration,
     save_stereo_calibration,
 )
+from bistair.geometry.stereo import rectify, stereo
 from bistair.geometry.stereo_checks import MISFIT_FLOOR
 from bistair.io.atomic import write_image
 from bistair.sim import Imaging, preset

@@ -16,17 +16,19 @@ import numpy as np
 import pytest
 from conftest import cli_run
 
-from bistair.app.stereo import parse_board
+import bistair
 from bistair.errors import BistairError
-from bistair.geometry.board import Board
-from bistair.geometry.calibration import Calibration, load_calibration, save_calibration
-from bistair.geometry.stereo_calibrate import calibrate_stereo_images
-from bistair.geometry.stereo_calibration import (
+from bistair.geometry.board import Board, parse_board
+from bistair.geometry.calibrate import calibrate_stereo_images
+from bistair.geometry.calibration import (
+    Calibration,
     StereoCalibration,
+    load_calibration,
     load_stereo_calibration,
+    save_calibration,
     save_stereo_calibration,
 )
-from bistair.geometry.stereo_opencv import _example_stereo
+from bistair.geometry.opencv import _example_stereo
 from bistair.io.read import read_image
 from bistair.sim.stereo import StereoRig, write_board_pairs
 
@@ -230,7 +232,8 @@ def test_calibrate_stereo_refusals(boards, tmp_path, monkeypatch, capfd):
     cases = [
         ([few, "--board", "chessboard:9x6:20"], "board found in both images of 2 of 2 poses, "
                                                 "need at least 3"),
-        ([boards, "--board", "chessboard:9x6"], "--board must be chessboard:COLSxROWS:SQUARE"),
+        ([boards, "--board", "chessboard:9x6"], "a board is TYPE:COLUMNSxROWS:SPACING (e.g. "
+                                                "chessboard:9x7:25"),
         ([boards, "--board", "chessboard:9x6:inf"], "board spacing must be a positive number "
                                                     "of mm, got inf"),  # not OpenCV's error
         ([boards, "--board", "chessboard:9x6:20", "--min-poses", "2"],
@@ -293,11 +296,23 @@ def test_the_two_kinds_of_calibration_file(tmp_path):
     assert load_calibration(tmp_path / "kind.json").baseline == pytest.approx(150)
     stereo = save_stereo_calibration(pair, tmp_path / "stereo.json")
     assert_same(load_stereo_calibration(stereo), pair)
+    # one loader, either kind as the file says (issue 35); a kind asked for refuses the other
+    assert isinstance(load_calibration(mono), Calibration)
+    assert isinstance(load_calibration(stereo), StereoCalibration)
+    assert_same(load_calibration(stereo), pair)
+    assert bistair.load_calibration is load_calibration
     with pytest.raises(BistairError, match="a stereo calibration .two cameras: for bistair "
                                            "stereo., not a camera-projector one"):
-        load_calibration(stereo)
+        load_calibration(stereo, "camera-projector")
     with pytest.raises(BistairError, match="a camera-projector calibration, not a stereo one"):
         load_stereo_calibration(mono)
+    with pytest.raises(BistairError, match="a camera-projector calibration, not a stereo one"):
+        load_calibration(mono, "stereo")
+    (tmp_path / "odd.json").write_text(json.dumps({**data, "kind": "three-cameras"}))
+    with pytest.raises(BistairError, match=r"odd.json: calibration kind 'three-cameras' is "
+                                           "neither 'camera-projector' .a camera and a "
+                                           "projector. nor 'stereo' .two cameras.$"):
+        load_calibration(tmp_path / "odd.json")
     # negative focal lengths, refused by name (QA of issue 31, S19)
     data = json.loads(stereo.read_text())
     data["right"]["K"][0][0] = data["right"]["K"][1][1] = -1200.0
@@ -305,3 +320,73 @@ def test_the_two_kinds_of_calibration_file(tmp_path):
     with pytest.raises(BistairError, match="calibration field 'right.K' has the focal lengths "
                                            "fx -1200 and fy -1200 px: both must be positive"):
         load_stereo_calibration(tmp_path / "focal.json")
+
+
+def test_uncertainty_names_the_devices_after_the_kind(boards, tmp_path):
+    """A pair's uncertainty has a left and a right camera (issue 35), in memory as in the
+    file (which keeps its layout: the cameras last); camera and projector still read them;
+    a camera-projector calibration's has no left."""
+    names = sorted(p.name for p in boards.iterdir() if p.is_dir())
+    left, right = ([read_image(boards / n / f"{side}.png") for n in names]
+                   for side in ("left", "right"))
+    cal, _ = calibrate_stereo_images(left, right, Board("checkerboard", 9, 6, 20.0), names)
+    sd = cal.uncertainty
+    assert sd.kind == "stereo" and sd.devices == ("left", "right")
+    assert sd.left is sd.camera and sd.right is sd.projector and sd.left[0] > 0
+    data = json.loads(save_calibration(cal, tmp_path / "s.json").read_text())
+    assert list(data["uncertainty"]) == ["rotation_deg", "T", "baseline", "noise", "left",
+                                         "right"]
+    assert list(data["uncertainty"]["noise"]) == ["left", "right"]
+    assert data["uncertainty"]["right"]["fx"] == float(sd.right[0])
+    back = load_calibration(tmp_path / "s.json").uncertainty
+    assert back.kind == "stereo"
+    np.testing.assert_array_equal(back.right, sd.right)
+    assert back.noise == sd.noise
+    mono = Calibration(cal.left, cal.right, cal.R, cal.T, uncertainty=sd)
+    assert mono.uncertainty.devices == ("camera", "projector")
+    assert list(mono.to_dict()["uncertainty"])[:2] == ["camera", "projector"]
+    with pytest.raises(AttributeError, match="names its devices camera and projector"):
+        _ = mono.uncertainty.left
+
+
+def test_the_old_module_names_read_on():
+    """The two-camera modules merged into their concepts (issue 35) stay importable for a
+    release, naming the same objects."""
+    from bistair.geometry import (
+        calibrate,
+        calibration,
+        corners,
+        opencv,
+        stereo_calibrate,
+        stereo_opencv,
+    )
+    from bistair.geometry import stereo_calibration as old
+
+    assert old.StereoCalibration is calibration.StereoCalibration
+    assert old.load_stereo_calibration is calibration.load_stereo_calibration
+    assert old.save_stereo_calibration is calibration.save_calibration
+    assert old.ProjectorPose is calibration.ProjectorPose
+    assert stereo_calibrate.calibrate_stereo_images is calibrate.calibrate_stereo_images
+    assert stereo_opencv.read_opencv_stereo is opencv.read_opencv_stereo
+    assert calibrate.sample_local is corners.sample_local
+    assert calibrate.board_view is corners.board_view
+
+
+def test_one_board_parser_for_both_calibrations(boards, tmp_path, monkeypatch, capfd):
+    """calibrate and calibrate-stereo read --board alike (one parser, issue 35): the same
+    option and the same refusal of a description without its spacing."""
+    from bistair.app.cli import calibrate
+    from bistair.app.cli_stereo import calibrate_stereo
+
+    options = [next(p for p in cmd.params if p.name == "board")
+               for cmd in (calibrate, calibrate_stereo)]
+    assert options[0].metavar == options[1].metavar == "FILE|TYPE:COLSxROWS:SPACING"
+    errors = []
+    for command, folder in (("calibrate", tmp_path), ("calibrate-stereo", boards)):
+        code, stdout, err = cli_run(monkeypatch, capfd, command, folder, "--board",
+                                    "chessboard:9x6", "--out", tmp_path / "out.json")
+        assert code == 2 and stdout == "", err
+        errors.append(err.strip())
+    assert errors[0] == errors[1] == (
+        "Error: a board is TYPE:COLUMNSxROWS:SPACING (e.g. chessboard:9x7:25 for 9 x 7 inner "
+        "corners of 25 mm squares), got 'chessboard:9x6'")

@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 from support import stereo_before
 
-from bistair.geometry.stereo_checks import projector_misfits
-from bistair.geometry.stereo_jit import (
+from bistair.geometry.match_jit import (
     ALONE,
     AMBIGUOUS,
     INCONSISTENT,
@@ -23,17 +22,20 @@ from bistair.geometry.stereo_jit import (
     NOT_MONOTONIC,
     OTHER_AXIS,
     UNMATCHED,
-    cloud_points,
     count_status,
+    match_pair,
+    smooth_runs,
+    supported,
+)
+from bistair.geometry.stereo_checks import projector_misfits
+from bistair.geometry.stereo_jit import (
+    cloud_points,
     depth_counts,
     grid_depth,
     grid_points,
-    match_pair,
     pick_finite,
     rectified_positions,
     remap_valid,
-    smooth_runs,
-    supported,
 )
 
 

@@ -55,7 +55,7 @@ from tqdm import tqdm
 from ..core.captures import check_min_modulation
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
-from ..geometry.calibration import load_calibration
+from ..geometry.calibration import Calibration, StereoCalibration, load_calibration
 from ..geometry.triangulate import check_depth_range
 from ..io.atomic import check_output, output_file, replace_folder
 from ..io.jsonfile import read_json, write_json
@@ -76,7 +76,7 @@ from .engine import (
     run_tasks,
 )
 from .jobs import decode_folder, reconstruct_folder
-from .stereo import check_calibration_file, is_stereo_calibration, stereo_folder, stereo_pair
+from .stereo import stereo_folder, stereo_pair
 
 MARKER = "batch-set.json"  # written last into every complete set folder
 MARKER_FORMAT = "bistair-batch-set"
@@ -322,9 +322,9 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
     start = time.perf_counter()
     try:
         check_output(job.out, [job.captures, job.spec, job.calibration])  # (None: none)
-        if is_stereo_calibration(job.calibration) or stereo_pair(job.captures):
-            return _stereo_set(job, options, prefix, start)
         calibration = None if job.calibration is None else load_calibration(job.calibration)
+        if isinstance(calibration, StereoCalibration) or stereo_pair(job.captures):
+            return _stereo_set(job, calibration, options, prefix, start)
         with replace_folder(job.out, prefix) as tmp:
             result = decode_folder(job.captures, tmp, job.spec, previews=options.previews,
                                    **options.decode)
@@ -353,7 +353,9 @@ def run_set(job: SetJob, options: Options, prefix: str = BATCH_PREFIX) -> dict[s
                     seconds=time.perf_counter() - start)
 
 
-def _stereo_set(job: SetJob, options: Options, prefix: str, start: float) -> dict[str, Any]:
+def _stereo_set(job: SetJob, calibration: Calibration | StereoCalibration | None,
+                options: Options, prefix: str,
+                start: float) -> dict[str, Any]:
     """:func:`run_set` for a stereo set (``L/`` and ``R/``) with a stereo calibration: what
     ``bistair stereo`` writes, and the marker. ``valid_fraction``: the share of the left
     camera's pixels with a point; ``noise``: the left decode's."""
@@ -361,11 +363,11 @@ def _stereo_set(job: SetJob, options: Options, prefix: str, start: float) -> dic
     if pair is None:
         raise BistairError(f"a stereo calibration needs a stereo set: {job.captures} holds no "
                            "L/ and R/ folders")
-    if not is_stereo_calibration(job.calibration):
+    if not isinstance(calibration, StereoCalibration):
         raise BistairError(f"{job.captures} holds L/ and R/: a stereo set needs "
                            "--calibration with a stereo calibration (two cameras)")
     with replace_folder(job.out, prefix) as tmp:
-        result = stereo_folder(*pair, tmp, job.calibration, job.spec,
+        result = stereo_folder(*pair, tmp, calibration, job.spec,
                                min_depth=options.min_depth, max_depth=options.max_depth,
                                previews=options.previews, **options.decode)
         row = _row(job.name, "ok", valid_fraction=round(float(result.mask.mean()), 6),
@@ -492,7 +494,7 @@ def run_batch(source: str | Path, out: str | Path, spec: str | Path | None = Non
     if spec is not None:
         load_spec(spec)  # refuse a bad default spec once, not once per set
     if calibration is not None:
-        check_calibration_file(calibration)
+        load_calibration(calibration)  # either kind; refused once, not once per set
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")

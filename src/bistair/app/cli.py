@@ -34,7 +34,7 @@ from .cli_options import (
     _Text,
     _threads,
     _warn,
-    board_file,
+    board_choice,
     reports_errors,
 )
 from .cli_scan import scan
@@ -264,10 +264,7 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 @click.argument("captures", type=Input())
 @click.option("--out", "-o", required=True, type=Output(file=True),
               help="calibration file to write (JSON)")
-@click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
-              type=Input(text=True, path_of=board_file),
-              help="board.json, or e.g. chessboard:9x7:25 (inner corners, square in mm) "
-              "[default: CAPTURES/board.json]")
+@board_choice("CAPTURES")
 @click.option("--spec", "spec_path", type=Input(), default=None,
               help="spec of both axes for pose folders of captures [default: each "
               "folder's spec.json, else CAPTURES/spec.json]")

@@ -70,10 +70,9 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
         raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if calibration is not None:  # a stereo one's baseline under 10 mm: said once
-        from ..geometry.stereo_calibration import StereoCalibration, short_baseline
-        from .stereo import check_calibration_file
+        from ..geometry.calibration import StereoCalibration, load_calibration, short_baseline
 
-        cal = check_calibration_file(calibration)
+        cal = load_calibration(calibration)
         if isinstance(cal, StereoCalibration) and short_baseline(cal):
             click.echo(f"Warning: {calibration}: {short_baseline(cal)}", err=True)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),

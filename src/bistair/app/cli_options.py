@@ -77,6 +77,21 @@ class Input(click.Path):
 
 
 
+def board_choice(default: str) -> Callable[[Callable], Callable]:
+    """The ``--board`` option of ``calibrate`` and ``calibrate-stereo`` (a ``board.json`` or
+    a description such as ``chessboard:9x7:25``, read by
+    :func:`bistair.app.calibrate.board_option`); ``default``: the folder whose
+    ``board.json`` is read without it.
+
+    >>> board_choice("POSES")(lambda board: board).__click_params__[0].metavar
+    'FILE|TYPE:COLSxROWS:SPACING'
+    """
+    return click.option("--board", default=None, metavar="FILE|TYPE:COLSxROWS:SPACING",
+                        type=Input(text=True, path_of=board_file),
+                        help="board.json, or e.g. chessboard:9x7:25 (inner corners, square "
+                        f"in mm) [default: {default}/board.json]")
+
+
 def board_file(value: str) -> str | None:
     """The file a ``--board`` value names, ``None`` for a description such as
     ``chessboard:9x7:25`` (:func:`bistair.geometry.board.is_board_text`).

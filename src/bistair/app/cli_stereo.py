@@ -9,7 +9,15 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import Input, Output, _quiet, _strategy, _threads, board_file, reports_errors
+from .cli_options import (
+    Input,
+    Output,
+    _quiet,
+    _strategy,
+    _threads,
+    board_choice,
+    reports_errors,
+)
 
 
 @click.command("stereo")
@@ -125,10 +133,7 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
 
 @click.command("calibrate-stereo")
 @click.argument("poses", type=Input())
-@click.option("--board", default=None, metavar="chessboard:COLSxROWS:SQUARE",
-              type=Input(text=True, path_of=board_file),
-              help="the board: inner corners and square size (mm), or a board.json "
-              "[default: POSES/board.json]")
+@board_choice("POSES")
 @click.option("--out", "-o", required=True, type=Output(file=True),
               help="stereo calibration file to write (JSON)")
 @click.option("--min-poses", type=int, default=3, show_default=True,

@@ -32,11 +32,16 @@ from ..core.captures import full_scale_of, to_bit_depth
 from ..core.response import Response, estimate_response, ramp_levels
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
-from ..geometry.calibration import Calibration, load_calibration, save_calibration
+from ..geometry.calibration import (
+    CAMERA_PROJECTOR,
+    Calibration,
+    StereoCalibration,
+    load_calibration,
+    save_calibration,
+)
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
 from ..geometry.projection_matrices import import_matrices
-from ..geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.atomic import check_output, output_file, output_folder, write_image
 from ..io.jsonfile import read_json, write_json
@@ -239,7 +244,7 @@ def reconstruct_folder(captures: str | Path, spec: BaseSpec | str | Path | None,
     else:
         spec, shape = find_spec(captures, spec), decoded.mask.shape
     if not isinstance(calibration, Calibration):
-        calibration = load_calibration(calibration)
+        calibration = load_calibration(calibration, CAMERA_PROJECTOR)
     blank: DecodeResult | AxesResult = DecodeResult(*(np.zeros(shape),) * 8,
                                                     period=1.0, method="")
     if spec.orientation == "both":
@@ -312,7 +317,7 @@ def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Pat
                                "hold the image size)")
         sizes.append(parse_size(size, name) if isinstance(size, str) else size)
     cal = import_matrices(tuple(files), *sizes)
-    save_stereo_calibration(cal, out)
+    save_calibration(cal, out)
     return cal
 
 

@@ -41,7 +41,7 @@ from ..acquire import Latency, Scan, measure_latency, parse_camera, parse_displa
 from ..acquire.latency import default_latency_file, save_latency
 from ..core.result import AxesResult, DecodeResult
 from ..errors import BistairError
-from ..geometry.calibration import Calibration, load_calibration
+from ..geometry.calibration import CAMERA_PROJECTOR, Calibration, load_calibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit
 from ..io.atomic import TEMP_PREFIX, check_output, replace_folder, write_image
 from ..io.jsonfile import to_jsonable, write_json
@@ -82,7 +82,7 @@ def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str
     if calibration is not None:
         check_depth_range(*depth_range)
         cal = calibration if isinstance(calibration, Calibration) else \
-            load_calibration(calibration)
+            load_calibration(calibration, CAMERA_PROJECTOR)
         check_fit(_blank(cal.camera.size, spec), cal, spec)  # before the work of scanning
     # devices parsed (every string and setting checked) before either opens
     devices = (parse_display(display), parse_camera(camera, options.pop("exposure", None),

@@ -15,11 +15,6 @@ leaves nothing behind.
     cloud.ply          x, y, z (mm) in the left camera's frame, grey from the white frame
                        (else the fringes' average)
     info.json          the matching's counts, the rectification, both decodes' warnings
-
-Examples
---------
->>> parse_board("chessboard:9x6:20")
-Board(type='checkerboard', columns=9, rows=6, spacing=20.0)
 """
 
 from __future__ import annotations
@@ -34,17 +29,17 @@ import numpy as np
 from ..codecs import encode
 from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
-from ..geometry.board import BOARD_TYPES, Board
-from ..geometry.calibration import Calibration, load_calibration, save_calibration
-from ..geometry.stereo import StereoResult, stereo
-from ..geometry.stereo_calibrate import calibrate_stereo_images
-from ..geometry.stereo_calibration import (
+from ..geometry.board import Board
+from ..geometry.calibrate import calibrate_stereo_images
+from ..geometry.calibration import (
+    STEREO,
+    Calibration,
     StereoCalibration,
-    is_stereo_file,
-    load_stereo_calibration,
-    save_stereo_calibration,
+    load_calibration,
+    save_calibration,
 )
-from ..geometry.stereo_opencv import read_opencv_stereo
+from ..geometry.opencv import read_opencv_stereo
+from ..geometry.stereo import StereoResult, stereo
 from ..geometry.unwrap import is_single_period, stereo_unwrap
 from ..io.atomic import check_output, output_folder, write_image
 from ..io.jsonfile import write_json
@@ -61,6 +56,7 @@ from ..sim import preset, scene_names, trace
 from ..sim.render import expose
 from ..sim.stereo import StereoRig, write_board_pairs
 from ..spec import BaseSpec
+from .calibrate import board_option
 from .jobs import parse_keys, parse_size
 from .simulate import _imaging, write_truth
 
@@ -102,7 +98,7 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
     if not isinstance(calibration, StereoCalibration):
-        calibration = load_stereo_calibration(calibration)
+        calibration = load_calibration(calibration, STEREO)
     spec = find_spec(left, spec) if spec is not None else _one_spec(left, right)
     stacks = []
     for name, captures in (("left", left), ("right", right)):
@@ -241,34 +237,7 @@ def stereo_pair(captures: str | Path) -> tuple[Path, Path] | None:
     return None
 
 
-def is_stereo_calibration(path: str | Path | None) -> bool:
-    """Whether ``path`` names a stereo calibration file (``False`` for ``None``)."""
-    return path is not None and is_stereo_file(path)
-
-
-def check_calibration_file(path: str | Path) -> StereoCalibration | Calibration:
-    """Read a calibration file of either kind (one-line error if it is neither)."""
-    return load_stereo_calibration(path) if is_stereo_file(path) else load_calibration(path)
-
-
 # -- calibrate -------------------------------------------------------------------------------
-def parse_board(text: str) -> Board:
-    """``"chessboard:COLSxROWS:SQUARE"`` (inner corners, mm; also ``checkerboard``,
-    ``circles``, ``asymmetric-circles``) as a :class:`~bistair.geometry.board.Board`."""
-    parts = text.strip().split(":")
-    kind = parts[0].strip().lower()
-    kind = "checkerboard" if kind == "chessboard" else kind
-    try:
-        if len(parts) != 3 or kind not in BOARD_TYPES:
-            raise ValueError
-        cols, rows = parse_size(parts[1], "board")
-        square = float(parts[2])
-    except (ValueError, BistairError):
-        raise BistairError(f"--board must be chessboard:COLSxROWS:SQUARE (inner corners, "
-                           f"square in mm), e.g. chessboard:9x6:20, got {text!r}") from None
-    return Board(kind, cols, rows, square)
-
-
 def board_pairs(folder: str | Path) -> tuple[list[str], list[Path], list[Path]]:
     """The poses of a stereo calibration folder: ``(names, left images, right images)``.
 
@@ -323,19 +292,14 @@ def calibrate_stereo_folder(folder: str | Path, out: str | Path | None = None,
     ``board.json``, or by default ``FOLDER/board.json``."""
     say = progress or _silent
     names, lefts, rights = board_pairs(folder)
-    if board is None:
-        board = Board.load(Path(folder) / "board.json")
-    elif isinstance(board, str) and ":" in board:
-        board = parse_board(board)
-    elif not isinstance(board, Board):
-        board = Board.load(board)
+    board = board_option(board, Path(folder))
     say(f"reading {len(names)} image pairs")
     left = [read_image(p) for p in lefts]
     right = [read_image(p) for p in rights]
     say(f"finding the board and calibrating from {len(names)} poses")
     cal, skipped = calibrate_stereo_images(left, right, board, names, min_poses)
     if out is not None:
-        save_stereo_calibration(cal, out)
+        save_calibration(cal, out)
     return cal, skipped
 
 
@@ -351,7 +315,7 @@ def import_stereo_calibration(files: Sequence[str | Path], out: str | Path,
     if isinstance(keys, str):
         keys = parse_keys(keys)
     cal = read_opencv_stereo(list(files), camera_size, keys)
-    save_stereo_calibration(cal, out)
+    save_calibration(cal, out)
     return cal
 
 
@@ -409,7 +373,7 @@ def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
         first = next(iter(specs.values()))[0]
         for folder, truth in truths.items():
             write_truth(tmp / "truth" / folder, truth, first)
-        save_stereo_calibration(StereoCalibration.from_rig(srig), tmp / "stereo.json")
+        save_calibration(StereoCalibration.from_rig(srig), tmp / "stereo.json")
         save_calibration(Calibration.from_rig(srig.rig("left")), tmp / "calibration.json")
         write_json(tmp / "scene.json", {
             "scene": scene, "methods": list(methods), "compensated": compensated,

@@ -1,5 +1,5 @@
-"""Calibrating a camera and a projector from board captures (Zhang and Huang, Opt. Eng.
-45(8), 083601, 2006).
+"""Calibrating a rig from views of a board: a camera and a projector from board captures
+(Zhang and Huang, Opt. Eng. 45(8), 083601, 2006), or two cameras from image pairs.
 
 For every pose of a planar board the board features are found in the camera's white frame
 (or, without one, the mean image of the captures); the decoded projector coordinates of both
@@ -39,6 +39,18 @@ the intrinsics fixed understates the baseline's (its error comes mostly from the
 intrinsics). Errors common to all poses (a board printed at the wrong scale, a biased
 feature detector, an unmodelled lens) are not in it.
 
+**Two cameras** (:func:`calibrate_stereo_images`, ``bistair calibrate-stereo``): the board's
+corners are found in each image (OpenCV ``findChessboardCornersSB``, else
+``findChessboardCorners`` + ``cornerSubPix``; circle grids with ``findCirclesGrid``:
+:meth:`~bistair.geometry.board.Board.detect`); a pose whose board is not found in both
+images is skipped. :func:`calibrate_points` calibrates the pair as it does a camera and a
+projector (any two devices that see the same board points), with one standard deviation of
+each parameter, and the result is read as two cameras
+(:class:`~bistair.geometry.calibration.StereoCalibration`). A chessboard's corners come back
+from OpenCV starting at either end of the board; both images of a pose are put in the same
+order (the first corner the one nearer the image's top-left), which is the same corner of
+the board for two cameras side by side.
+
 Examples
 --------
 >>> from bistair.sim.boards import synthetic_views
@@ -51,13 +63,14 @@ Examples
 >>> cal = calibrate_points(obj, cpts, ppts, (640, 480), (800, 600))
 >>> round(cal.baseline, 3), round(float(cal.projector.K[0, 0]), 2), cal.rms < 1e-3
 (156.605, 1000.0, True)
+>>> pts = Board("checkerboard", 4, 3, 10.0).object_points()[:, :2] * 3 + 50  # upright
+>>> bool(np.array_equal(_upright(pts[::-1]), pts))
+True
 """
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any
 
 import cv2
@@ -65,8 +78,22 @@ import numpy as np
 
 from ..errors import BistairError
 from .board import Board
-from .calibration import Calibration, Device, Uncertainty
-from .corners import local_homography
+from .calibration import (
+    MIN_BASELINE,
+    Calibration,
+    Device,
+    StereoCalibration,
+    Uncertainty,
+    on_the_left,
+)
+from .corners import (  # noqa: F401  (sample_local, feature_spacing: here until a release)
+    CORNER_FITS,
+    BoardView,
+    PoseCapture,
+    board_view,
+    feature_spacing,
+    sample_local,
+)
 
 MIN_POSES = 3  # the fewest board poses that calibrate a pair (see the module's notes)
 
@@ -325,200 +352,6 @@ def _rotation_jacobian(rot: np.ndarray, step: float = 1e-6) -> np.ndarray:
     return out
 
 
-def sample_local(values: np.ndarray, points: np.ndarray, radius: int, min_pixels: int = 12,
-                 rounds: int = 3) -> np.ndarray:
-    """Robust values of smooth maps at sub-pixel points: a weighted quadratic fit per point.
-
-    Parameters
-    ----------
-    values : ``(C, H, W)`` maps (e.g. projector x and y per camera pixel), NaN where invalid.
-    points : ``(N, 2)`` pixel coordinates ``(u, v)``.
-    radius : half-size of the square window around each point (pixels).
-    min_pixels : fewest pixels valid in every map that a fit needs.
-    rounds : fits; after each, pixels off by more than 3.5 robust sigmas (at least 0.1) are
-        dropped (e.g. a wrong fringe order).
-
-    Returns
-    -------
-    ``(C, N)`` fitted values at the points, NaN where the window holds too few valid pixels or
-    they do not surround the point.
-
-    Examples
-    --------
-    >>> v, u = np.mgrid[0:40, 0:50].astype(float)
-    >>> maps = np.stack([2 * u + 0.01 * v**2, 3 * v])
-    >>> maps[0, 20, 21] = 500.0  # an outlier
-    >>> sample_local(maps, np.array([[20.3, 19.6], [0.0, 45.0]]), 4).round(4).tolist()
-    [[44.4416, nan], [58.8, nan]]
-    """
-    values = np.asarray(values, float)
-    h, w = values.shape[1:]
-    pts = np.asarray(points, float).reshape(-1, 2)
-    off = np.arange(-radius, radius + 1)
-    uu = np.rint(pts[:, 0])[:, None, None].astype(int) + off[None, None, :]
-    vv = np.rint(pts[:, 1])[:, None, None].astype(int) + off[None, :, None]
-    uu, vv = np.broadcast_arrays(uu, vv)
-    inside = (uu >= 0) & (uu < w) & (vv >= 0) & (vv < h)
-    vals = values[:, np.clip(vv, 0, h - 1), np.clip(uu, 0, w - 1)].reshape(len(values),
-                                                                           len(pts), -1)
-    good = (inside.reshape(len(pts), -1) & np.isfinite(vals).all(axis=0))
-    vals = np.where(good, vals, 0.0)
-    du = ((uu - pts[:, 0, None, None]) / radius).reshape(len(pts), -1)
-    dv = ((vv - pts[:, 1, None, None]) / radius).reshape(len(pts), -1)
-    design = np.stack([np.ones_like(du), du, dv, du * du, du * dv, dv * dv], axis=-1)
-    weight = good.astype(float)
-    coef = np.zeros((len(values), len(pts), 6))
-    for _ in range(rounds):
-        normal = np.einsum("npi,np,npj->nij", design, weight, design) + 1e-9 * np.eye(6)
-        rhs = np.einsum("npi,np,cnp->cni", design, weight, vals)
-        coef = np.linalg.solve(normal[None], rhs[..., None])[..., 0]
-        resid = np.abs(vals - np.einsum("npi,cni->cnp", design, coef)).max(axis=0)
-        masked = np.where(weight > 0, resid, np.nan)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN windows
-            sigma = 1.4826 * np.nanmedian(masked, axis=1)
-        limit = np.maximum(3.5 * np.nan_to_num(sigma, nan=0.0), 0.1)
-        weight = weight * (resid <= limit[:, None])
-    # the kept pixels must surround the point: some on every side of it
-    kept = weight > 0
-    sides = [(du < 0) & kept, (du > 0) & kept, (dv < 0) & kept, (dv > 0) & kept]
-    ok = (kept.sum(axis=1) >= min_pixels) & np.all([s.any(axis=1) for s in sides], axis=0)
-    return np.where(ok, coef[..., 0], np.nan)
-
-
-@dataclass(frozen=True)
-class PoseCapture:
-    """One board pose in memory: the camera image the board is found in (``white``: the
-    white frame, or without one the mean image of the captures) and the projector column
-    ``x`` and row ``y`` decoded per camera pixel (NaN where invalid)."""
-
-    name: str
-    white: np.ndarray
-    x: np.ndarray
-    y: np.ndarray
-
-
-@dataclass(frozen=True)
-class BoardView:
-    """The board in one pose: its features found in the camera and mapped to the projector.
-
-    ``features`` is the board's number of features; ``object_points`` ``(n, 3)`` (mm),
-    ``camera_points`` and ``projector_points`` ``(n, 2)`` (pixels) hold the ``n`` of them
-    mapped (none when the board is not ``found``); ``usable`` when enough are (see
-    :func:`board_view`); ``why`` says why not."""
-
-    name: str
-    found: bool
-    features: int
-    object_points: np.ndarray
-    camera_points: np.ndarray
-    projector_points: np.ndarray
-    needed: int = 6
-
-    @property
-    def usable(self) -> bool:
-        """The board was found and at least ``needed`` features were mapped."""
-        return self.found and len(self.object_points) >= self.needed
-
-    @property
-    def why(self) -> str:
-        """Why the view is not usable (empty when it is)."""
-        if not self.found:
-            return "board not found"
-        if not self.usable:
-            return (f"{len(self.object_points)} of {self.features} board features mapped to "
-                    f"the projector, need {self.needed} (are the phases valid on the board?)")
-        return ""
-
-
-CORNER_FITS = ("homography", "quadratic")  # how a feature is mapped to the projector
-
-
-def feature_spacing(points: np.ndarray, columns: int) -> float:
-    """Median image distance between neighbouring features of a row-by-row grid (pixels).
-
-    Parameters
-    ----------
-    points : numpy.ndarray
-        ``(columns * rows, 2)`` image points ``(u, v)`` in pixels, row by row (as
-        :meth:`Board.detect <bistair.geometry.board.Board.detect>` returns them).
-    columns : int
-        Features per row.
-
-    Returns
-    -------
-    float
-        The median length (pixels) of the steps to the next feature along the rows and
-        down the columns.
-
-    Examples
-    --------
-    >>> u, v = np.meshgrid(np.arange(4) * 12.0, np.arange(3) * 10.0)
-    >>> feature_spacing(np.stack([u.ravel(), v.ravel()], axis=1), 4)
-    12.0
-    """
-    grid = np.asarray(points, float).reshape(-1, columns, 2)
-    steps = np.concatenate([np.diff(grid, axis=1).reshape(-1, 2),
-                            np.diff(grid, axis=0).reshape(-1, 2)])
-    return float(np.median(np.hypot(steps[:, 0], steps[:, 1])))
-
-
-def board_view(pose: PoseCapture, board: Board, corner_fit: str = "homography",
-               min_mapped: float = 0.5) -> BoardView:
-    """Find the board in a pose and map its features to the projector.
-
-    The board is detected in ``pose.white``; each feature's projector ``x`` and ``y`` come
-    from the decoded maps in a window around it: a local homography
-    (:func:`~bistair.geometry.corners.local_homography`, Moreno and Taubin) or a quadratic
-    fit (:func:`sample_local`). The window is ``0.7`` (checkerboards) or one (circle grids)
-    feature spacing wide, at least 7 and at most 61 pixels.
-
-    Parameters
-    ----------
-    pose : PoseCapture
-        The board image and the decoded projector coordinates.
-    board : Board
-        The board it shows.
-    corner_fit : {"homography", "quadratic"}
-        How a feature is mapped (:data:`CORNER_FITS`).
-    min_mapped : float, default 0.5
-        The view is usable when at least this share of the features (and at least 6) are
-        mapped.
-
-    Returns
-    -------
-    BoardView
-
-    Raises
-    ------
-    BistairError
-        An unknown ``corner_fit``.
-
-    Examples
-    --------
-    >>> blank = np.ones((60, 80))
-    >>> view = board_view(PoseCapture("pose-0", blank, blank, blank), Board())
-    >>> view.found, view.usable, view.why
-    (False, False, 'board not found')
-    """
-    if corner_fit not in CORNER_FITS:
-        raise BistairError(f"corner fit must be one of {', '.join(CORNER_FITS)}, got "
-                           f"{corner_fit!r}")
-    model = board.object_points()
-    needed = max(6, int(np.ceil(min_mapped * len(model))))
-    pts = board.detect(pose.white)
-    if pts is None:
-        none = np.empty((0, 2))
-        return BoardView(pose.name, False, len(model), np.empty((0, 3), np.float32), none,
-                         none, needed)
-    share = 0.35 if board.type == "checkerboard" else 0.5
-    radius = int(np.clip(round(share * feature_spacing(pts, board.columns)), 3, 30))
-    fit = local_homography if corner_fit == "homography" else sample_local
-    xy = fit(np.stack([pose.x, pose.y]), pts, radius).T
-    ok = np.isfinite(xy).all(axis=1)
-    return BoardView(pose.name, True, len(model), model[ok], pts[ok], xy[ok], needed)
-
-
 def calibrate_views(views: Sequence[BoardView], board: Board, camera_size: tuple[int, int],
                     projector_size: tuple[int, int], min_poses: int = MIN_POSES,
                     poses_total: int | None = None, **options: Any) -> Calibration:
@@ -664,3 +497,104 @@ def check_min_poses(min_poses: int) -> None:
     if min_poses < MIN_POSES:
         raise BistairError(f"min_poses {min_poses} is too few: a camera-projector calibration "
                            f"needs at least {MIN_POSES} board poses")
+
+
+def calibrate_stereo_images(left: Sequence[np.ndarray], right: Sequence[np.ndarray],
+                            board: Board, names: Sequence[str] | None = None,
+                            min_poses: int = MIN_POSES, fix_k3: bool = True
+                            ) -> tuple[StereoCalibration, list[str]]:
+    """Calibrate two cameras from grey images of a board, pose by pose.
+
+    Parameters
+    ----------
+    left, right : sequence of numpy.ndarray
+        Per pose, the left and the right camera's grey image (2-D, any dtype; every left
+        image of one size, every right image of one size).
+    board : Board
+        The board (``columns x rows`` inner corners or circles, spacing in mm).
+    names : sequence of str, optional
+        The poses' names (for the per-pose errors and the skipped poses).
+    min_poses : int, optional
+        The fewest poses with the board found in both images (3 at least).
+    fix_k3 : bool, optional
+        Keep ``k3 = 0``.
+
+    Returns
+    -------
+    calibration : StereoCalibration
+        With the stereo RMS, the per-pose errors (``left_rms``, ``right_rms``), the board,
+        the number of poses given and the uncertainty of every parameter.
+    skipped : list of str
+        The poses whose board was not found in both images.
+
+    Raises
+    ------
+    BistairError
+        Different numbers of left and right images, images of different sizes or not 2-D,
+        the board found in both images of fewer than ``min_poses`` poses, OpenCV failing, the
+        camera of the right images on the left of the other (images named the wrong way
+        round) or the cameras under 1 mm apart (a board's square not in millimetres).
+
+    Examples
+    --------
+    Blank images show no board (``tests/test_stereo_calibrate.py`` calibrates from rendered
+    board pairs):
+
+    >>> blank = [np.ones((60, 80))] * 3
+    >>> calibrate_stereo_images(blank, blank, Board())
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: board found in both images of 0 of 3 poses, need at least 3
+    """
+    if len(left) != len(right):
+        raise BistairError(f"{len(left)} left and {len(right)} right images: they go in pairs")
+    if min_poses < MIN_POSES:
+        raise BistairError(f"min_poses {min_poses} is too few: a stereo calibration needs at "
+                           f"least {MIN_POSES} board poses")
+    names = list(names) if names is not None else [f"pose-{i:02d}" for i in range(len(left))]
+    sizes = {}
+    for side, images in (("left", left), ("right", right)):
+        for name, img in zip(names, images, strict=True):
+            if np.ndim(img) != 2:
+                raise BistairError(f"{name}: the {side} image must be grey (2-D), got shape "
+                                   f"{np.shape(img)}")
+            h, w = np.shape(img)
+            first = sizes.setdefault(side, (w, h, name))
+            if (w, h) != first[:2]:
+                raise BistairError(f"{name}: the {side} image is {w}x{h}, the {side} image of "
+                                   f"{first[2]} {first[0]}x{first[1]}")
+    obj, lpts, rpts, used, skipped = [], [], [], [], []
+    for name, li, ri in zip(names, left, right, strict=True):
+        a, b = board.detect(li), board.detect(ri)
+        if a is None or b is None:
+            skipped.append(name)
+            continue
+        if board.type != "asymmetric-circles":  # its corners come in one order only
+            a, b = _upright(a), _upright(b)
+        obj.append(board.object_points())
+        lpts.append(a)
+        rpts.append(b)
+        used.append(name)
+    if len(used) < min_poses:
+        raise BistairError(f"board found in both images of {len(used)} of {len(names)} poses, "
+                           f"need at least {min_poses}")
+    pair = calibrate_points(obj, lpts, rpts, sizes["left"][:2], sizes["right"][:2], used,
+                            fix_k3=fix_k3)
+    left_of = on_the_left(pair.R, pair.T)
+    if left_of > 0:
+        raise BistairError(f"the camera of the right images sits {left_of:.1f} mm to the left "
+                           "of the other (the right camera is the one at +x of the left, to "
+                           "the right in its image): are the board images named the wrong way "
+                           "round? Exchange left and right")
+    if pair.baseline < MIN_BASELINE:
+        raise BistairError(f"the cameras come out {pair.baseline:.3g} mm apart: is the "
+                           f"board's square size ({board.spacing:g}) in millimetres?")
+    cal = StereoCalibration.from_pair(pair)
+    return cal.replace(board=board.to_dict(), poses_total=len(names)), skipped
+
+
+def _upright(points: np.ndarray) -> np.ndarray:
+    """Detected board points in the order that starts at the end nearer the image's
+    top-left (the list reversed otherwise: the same grid turned by 180 degrees)."""
+    first, last = points[0], points[-1]
+    return points[::-1].copy() if first.sum() > last.sum() else points

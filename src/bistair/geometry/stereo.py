@@ -12,11 +12,11 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    bilinearly, never between two surfaces (:func:`~.stereo_jit.remap_valid`: four valid
    neighbours whose spread is that of a surface).
 2. Before matching, the kinks of each rectified row are dropped
-   (:func:`~.stereo_jit.drop_kinks`: second differences over four times the measured noise,
+   (:func:`~.match_jit.drop_kinks`: second differences over four times the measured noise,
    the blurred step between two surfaces whose pixels mix both), and with ``smooth`` both
-   maps are smoothed within each surface (:func:`~.stereo_jit.smooth_runs`, which does
+   maps are smoothed within each surface (:func:`~.match_jit.smooth_runs`, which does
    both, and turns a falling coordinate round, in one pass).
-3. Matching (:func:`~.stereo_jit.match_pair`): for each valid left pixel, the right pixel
+3. Matching (:func:`~.match_jit.match_pair`): for each valid left pixel, the right pixel
    of equal projector coordinate on the same rectified row, interpolated between the two
    valid neighbours that bracket it (a line through four samples where it crosses once),
    only where the coordinate rises along the row (up to ``wiggle`` px of noise) without a
@@ -25,7 +25,7 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    other carries nothing along a row); with both projector axes decoded, the other must
    agree too. The same value searched back on the left row must come back within
    ``tolerance`` px of the pixel, and a disparity must be confirmed by the row above or
-   below (:func:`~.stereo_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
+   below (:func:`~.match_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
    with the measured noise (four, three and 5.7 times it, as a position along the row).
    Occlusions and mismatches are NaN, never a guess.
 4. Points (:func:`~.stereo_jit.grid_depth`; :func:`~.stereo_jit.depth_counts` counts the
@@ -33,7 +33,8 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    at its rectified position and is triangulated there, ``Z = -f * tx / d`` (``tx``: the
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
-   on the left camera's own (distorted) image grid.
+   on the left camera's own (distorted) image grid. The resampling and steps 2 to 4 are
+   :func:`~.match.match`.
 5. Checks of the inputs against each other (:mod:`.stereo_checks`): too few matches,
    projector rows that disagree (both axes), points that one projector explains only with
    the cameras exchanged or the right images upside down.
@@ -62,8 +63,15 @@ from ..core.jit import side_by_side
 from ..core.result import AxesResult, DecodeResult, make_result
 from ..errors import BistairError
 from ..spec import BaseSpec
-from .calibration import Calibration, Device
-from .stereo_calibration import StereoCalibration, load_stereo_calibration, short_baseline
+from .calibration import (
+    STEREO,
+    Calibration,
+    Device,
+    StereoCalibration,
+    load_calibration,
+    short_baseline,
+)
+from .match import Matched, match
 from .stereo_checks import (
     MIN_MATCHED,
     MISFIT_SAMPLE,
@@ -73,29 +81,10 @@ from .stereo_checks import (
     projector_misfits,
     same_captures,
 )
-from .stereo_jit import (
-    ALONE,
-    AMBIGUOUS,
-    INCONSISTENT,
-    MATCHED,
-    NOT_MONOTONIC,
-    OTHER_AXIS,
-    UNMATCHED,
-    cloud_points,
-    count_status,
-    depth_counts,
-    grid_points,
-    match_pair,
-    pick_finite,
-    rectified_positions,
-    remap_valid,
-    smooth_runs,
-    supported,
-)
+from .stereo_jit import cloud_points, grid_points, pick_finite, rectified_positions
 from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
-KINK, KINK_REACH = 4.0, 1  # a row's kinks: second differences over 4 noise, dropped +-2 px
 
 
 @dataclass(frozen=True, eq=False)
@@ -296,7 +285,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         confirm it).
     smooth : float, optional
         Gaussian sigma (px) of a smoothing of both cameras' projector coordinates on the
-        rectified grids before matching (:func:`~.stereo_jit.smooth_runs`: never across
+        rectified grids before matching (:func:`~.match_jit.smooth_runs`: never across
         two surfaces; the default, 1 px); 0 matches the decoded values as they are. Smoothing
         trades lateral resolution for depth noise (sigma 1 px: about a third of it).
     offset : float, optional
@@ -348,17 +337,12 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
     rect = rectification or rectify(calibration)
     coords = _coordinates(left, right, calibration, orientation)
     settings = (min_depth, max_depth, tolerance, other_tolerance, gap, wiggle, support, smooth)
-    m = _match(coords, rect, *settings)
+    m = match(coords, rect, *settings)
     mask, matched = m.mask, int(m.per_row.sum())
-    counts = count_status(m.status)
     info: dict[str, Any] = {
         "left_decoded": m.decoded, "matched": matched,
         "matched_fraction": round(float(matched / max(m.decoded, 1)), 6),
-        "unmatched": int(counts[UNMATCHED]), "ambiguous": int(counts[AMBIGUOUS]),
-        "not_monotonic": int(counts[NOT_MONOTONIC]),
-        "inconsistent": int(counts[INCONSISTENT]), "other_axis": int(counts[OTHER_AXIS]),
-        "alone": int(counts[ALONE]),
-        "rectified_matches": int(counts[MATCHED]), "outside_range": int(m.outside),
+        **m.counts, "outside_range": int(m.outside),
         "matched_axis": m.axis,
         "rectified": {"left": list(rect.size_left), "right": list(rect.size_right),
                       "f": rect.f, "cy": rect.cy, "cx_left": rect.cx_left,
@@ -388,72 +372,12 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
                         info)
 
 
-@dataclass
-class _Matched:
-    """What :func:`_match` gives: the matched axis, the disparity and status on the
-    rectified left grid, the depth on the left camera's own grid, where it is found
-    (``mask``, and how many per row), how many points fell outside the depth range, the
-    left pixels decoded on that axis, and the thresholds used (noise, tolerance, wiggle,
-    support: rectified pixels)."""
-
-    axis: str
-    disparity: np.ndarray
-    status: np.ndarray
-    depth: np.ndarray
-    mask: np.ndarray
-    per_row: np.ndarray
-    outside: int
-    decoded: int
-    noise: float
-    tolerance: float
-    wiggle: float
-    support: float
-
-
-def _match(coords: dict[str, tuple[np.ndarray, np.ndarray]], rect: Rectification,
-           min_depth: float, max_depth: float, tolerance: float, other_tolerance: float,
-           gap: int, wiggle: float, support: float, smooth: float) -> _Matched:
-    """Resample both cameras' projector coordinates onto the rectified grids, match them
-    along the rows and triangulate (steps 2-4 of the module docstring)."""
-    spread = {name: _step(pair[0]) for name, pair in coords.items()}
-    on_grid = {name: (remap_valid(lc, *rect.maps_left, spread[name]),
-                      remap_valid(rc, *rect.maps_right, spread[name]))
-               for name, (lc, rc) in coords.items()}
-    axis, slope = _matched_axis(on_grid)
-    # the thresholds grow with the noise: the phase's own (a row's second differences)
-    # as a position along the row (a map and its negation have the same)
-    noise_l, noise_r = (_noise(m) for m in on_grid[axis])
-    noise = max(noise_l, noise_r) / abs(slope)
-    # both maps rising along the rows, without their kinks, smoothed: one pass each
-    src, dst = (smooth_runs(m, smooth, spread[axis], max(KINK * n * math.sqrt(6.0),
-                                                         0.5 * abs(slope)), KINK_REACH,
-                            negate=slope < 0)
-                for m, n in zip(on_grid[axis], (noise_l, noise_r), strict=True))
-    wiggle, tolerance = max(wiggle, 4.0 * noise), max(tolerance, 3.0 * noise)
-    support = max(support, 4.0 * math.sqrt(2.0) * noise)
-    low, high = rect.disparities(min_depth, max_depth)
-    high = min(high, 4.0 * max(rect.size_left))  # farther than any image: same window
-    low = max(low, -4.0 * max(rect.size_left))
-    other = [name for name in on_grid if name != axis]
-    pair = on_grid[other[0]] if other else (None, None)
-    disparity, status = match_pair(src, dst, -high - rect.shift, -low - rect.shift,
-                                   rect.shift, tolerance, gap, wiggle, spread[axis],
-                                   other=pair[0], other_right=pair[1],
-                                   other_tolerance=other_tolerance)
-    disparity, status = supported(disparity, status, support)
-    depth, mask, outside, per_row, decoded = depth_counts(
-        disparity, *rect.positions, coords[axis][0], rect.f, rect.cx_left, rect.cy, rect.tx,
-        rect.R1, min_depth, max_depth)
-    return _Matched(axis, disparity, status, depth, mask, per_row, outside, decoded, noise,
-                    tolerance, wiggle, support)
-
-
 def _misfits(coords: Coords, rect: Rectification, settings: tuple,
-             m: _Matched | None = None) -> tuple[float, float]:
+             m: Matched | None = None) -> tuple[float, float]:
     """The projector misfits (:func:`~.stereo_checks.projector_misfits`) of the match of
     ``coords`` (``m`` if already made) and its share of the decoded left pixels with a
     point."""
-    m = m or _match(coords, rect, *settings)
+    m = m or match(coords, rect, *settings)
     matched = int(m.per_row.sum())
     share = float(matched / max(m.decoded, 1))
     pick = np.linspace(0, matched - 1, min(matched, MISFIT_SAMPLE)).astype(np.int64)
@@ -544,59 +468,6 @@ def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResu
     if both:
         return {"columns": (left.coord_x, right.coord_x), "rows": (left.coord_y, right.coord_y)}
     return {orientation: (left.coord, right.coord)}
-
-
-def _step(coord: np.ndarray) -> float:
-    """The largest spread of 2 x 2 neighbours taken as one surface: four times the median
-    spread of the decode (blocks at every fourth row and column), at least one projector
-    pixel."""
-    h, w = coord.shape
-    c = [coord[dy:h - 1 + dy:4, dx:w - 1 + dx:4] for dy in (0, 1) for dx in (0, 1)]
-    with np.errstate(invalid="ignore"):
-        spread = (np.maximum(np.maximum(c[0], c[1]), np.maximum(c[2], c[3]))
-                  - np.minimum(np.minimum(c[0], c[1]), np.minimum(c[2], c[3])))
-    spread = spread[np.isfinite(spread)]
-    return max(1.0, 4.0 * float(np.median(spread))) if spread.size else 1.0
-
-
-def _matched_axis(on_grid: dict[str, tuple[np.ndarray, np.ndarray]]) -> tuple[str, float]:
-    """The coded axis that changes along the rectified rows, and its change per pixel
-    there (its sign: the way the phase runs)."""
-    slopes = {}
-    for name, (lc, rc) in on_grid.items():
-        slopes[name] = tuple(_row_slope(m) for m in (lc, rc))
-    axis = max(slopes, key=lambda n: abs(slopes[n][0]) if math.isfinite(slopes[n][0]) else -1)
-    sl, sr = slopes[axis]
-    if not (math.isfinite(sl) and math.isfinite(sr)):
-        raise BistairError("the two cameras share too few decoded pixels on their rectified "
-                           "rows to match: is the calibration for these cameras?")
-    if abs(sl) < 0.05:
-        raise BistairError(f"the projector {axis} barely change along the cameras' baseline "
-                           f"({sl:.3f} per rectified pixel): code the projector axis along it "
-                           "(columns for cameras side by side) or both")
-    if sl * sr <= 0:
-        raise BistairError("the projector coordinate runs one way along the rows in the left "
-                           "camera and the other way in the right one: is one image mirrored?")
-    return axis, sl
-
-
-def _noise(values: np.ndarray) -> float:
-    """The noise (standard deviation) of a map along its rows, from second differences of
-    every sixteenth row (a robust spread: 1.4826 MAD / sqrt(6)); 0 without data."""
-    rows = values[::16]
-    second = (rows[:, 2:] - 2 * rows[:, 1:-1] + rows[:, :-2]).ravel()
-    second = second[np.isfinite(second)]
-    if second.size < 10:
-        return 0.0
-    return float(1.4826 * np.median(np.abs(second - np.median(second))) / math.sqrt(6.0))
-
-
-def _row_slope(coord: np.ndarray) -> float:
-    """Median change of a map along its rows (every sixteenth row), NaN without data."""
-    with np.errstate(invalid="ignore"):
-        steps = np.diff(coord[::16], axis=1)
-    steps = steps[np.isfinite(steps)]
-    return float(np.median(steps)) if steps.size >= 10 else math.nan
 
 
 def _grey(result: DecodeResult | AxesResult, offset: float) -> np.ndarray:
@@ -700,7 +571,7 @@ def stereo(left_images: np.ndarray, right_images: np.ndarray, spec: BaseSpec,
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
     if not isinstance(calibration, StereoCalibration):
-        calibration = load_stereo_calibration(calibration)
+        calibration = load_calibration(calibration, STEREO)
     opts = decode_options(spec.method, force, options)
 
     def decoded(side: str, images: np.ndarray) -> DecodeResult | AxesResult:

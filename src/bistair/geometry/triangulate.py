@@ -39,7 +39,7 @@ from ..errors import BistairError
 from ..io.atomic import output_folder
 from ..io.writers import write_depth, write_ply
 from ..spec import BaseSpec
-from .calibration import Calibration, Device, load_calibration
+from .calibration import CAMERA_PROJECTOR, Calibration, Device, load_calibration
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-14)
 
@@ -476,7 +476,7 @@ def reconstruct(result: DecodeResult | AxesResult, calibration: Calibration | st
             raise BistairError("give the captures' spec: this result does not carry the "
                                "spec it was decoded with")
     if not isinstance(calibration, Calibration):
-        calibration = load_calibration(calibration)
+        calibration = load_calibration(calibration, CAMERA_PROJECTOR)
     coded = check_fit(result, calibration, spec, orientation)
     check_depth_range(min_depth, max_depth)
     if not epipolar_tolerance > 0:
