@@ -1,6 +1,22 @@
-"""Checks that a decode's spec fits its captures: where the code's edges fall on the phase.
+"""Checks that a decode's spec fits its captures.
 
-A code (Gray code, stair level, ...) steps at its own edges, which sit at a known wrapped
+:class:`Judge` runs the checks every decode runs, one method per row of the checks guide's
+table (``docs/guide/checks.md``), in the order a decode meets them. Its parts, each usable
+alone:
+
+- refusing: :func:`refuse`, :func:`forcing`, :func:`sample_checks`, :func:`judge_sample`;
+- the frame order: :func:`shift_order_problem`, :func:`exchange_fits`,
+  :func:`rotated_frames`, :func:`swapped_frames`, :func:`fit_residual`;
+- the axis: :func:`axis_rates`, :func:`axis_problem`;
+- the phase convention: :func:`edge_alignment` (an :class:`EdgeCheck`),
+  :func:`convention_problem`;
+- the orders: :func:`wrap_steps`, :func:`jump_problem`, :func:`wilson_low`,
+  :func:`edge_steps`, :func:`edge_jump_problem`, :func:`sparse_problem`;
+- the result: :func:`outside_problem`;
+- for the codecs' own checks: :func:`cell_steps`, :func:`direction_problem`,
+  :func:`stair_misfit`, :func:`stair_sample`.
+
+Where the code's edges fall on the phase: a code (Gray code, stair level, ...) steps at its own edges, which sit at a known wrapped
 phase (0 for most methods: at the phase jumps). Along the coded axis, pairs of neighbouring
 pixels whose code differs show where those edges fall in the capture: around the expected
 phase when the spec is right, half a period off when the phase convention is off by pi
