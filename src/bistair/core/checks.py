@@ -16,12 +16,13 @@ alone:
 - for the codecs' own checks: :func:`cell_steps`, :func:`direction_problem`,
   :func:`stair_misfit`, :func:`stair_sample`.
 
-Where the code's edges fall on the phase: a code (Gray code, stair level, ...) steps at its own edges, which sit at a known wrapped
-phase (0 for most methods: at the phase jumps). Along the coded axis, pairs of neighbouring
-pixels whose code differs show where those edges fall in the capture: around the expected
-phase when the spec is right, half a period off when the phase convention is off by pi
-(``phase_offset``), with the phase rising instead of falling across them when the shifts run
-the other way (``shift_sign``) or the shift frames are in reverse order.
+Where the code's edges fall on the phase: a code (Gray code, stair level, ...) steps at its
+own edges, which sit at a known wrapped phase (0 for most methods: at the phase jumps).
+Along the coded axis, pairs of neighbouring pixels whose code differs show where those edges
+fall in the capture: around the expected phase when the spec is right, half a period off
+when the phase convention is off by pi (``phase_offset``), with the phase rising instead of
+falling across them when the shifts run the other way (``shift_sign``) or the shift frames
+are in reverse order.
 
 Examples
 --------
