@@ -39,25 +39,8 @@ from typing import Any, Literal, get_args, get_origin
 import numpy as np
 
 from ..core.captures import Prepared, check_min_modulation, prepare
-from ..core.checks import (
-    SWAP_LEAST,
-    SWAPPED,
-    EdgeCheck,
-    axis_problem,
-    convention_problem,
-    edge_alignment,
-    edge_jump_problem,
-    edge_steps,
-    exchange_fits,
-    forcing,
-    jump_problem,
-    outside_problem,
-    refuse,
-    rotated_frames,
-    sample_checks,
-    sparse_problem,
-    wrap_steps,
-)
+from ..core.checks import EdgeCheck, Judge, forcing, sample_checks
+from ..core.checks import shift_order_problem as shift_order_problem  # (its old place)
 from ..core.measure import FringeSet, measure
 from ..core.phase import phase_shift_patterns
 from ..core.result import (
@@ -67,7 +50,6 @@ from ..core.result import (
     result_from_orders,
     transpose_own,
 )
-from ..core.sample import Sample
 from ..errors import BistairError
 from ..spec import AXES, BaseSpec, PeriodSpec, fringe_count
 
@@ -331,29 +313,13 @@ class Codec:
         :func:`~bistair.core.checks.refuse`)."""
         min_modulation = options.pop("min_modulation", None)
         prepared, cols = self._columns(images, spec)
-        axis: list[str | None] = [None]
-        seen: dict[str, Any] = {}  # figures the sample's checks judged, for info.json
-
-        def on_sample(sample: Sample) -> None:
-            """The checks of pass 0's sample, before pass 1 (a Gray code alone, with no
-            phase, has no sample: nothing to judge)."""
-            refuse(shift_order_problem(sample, spec, seen=seen))
-            axis[0] = axis_problem(sample, spec.orientation)
-            if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
-                refuse(axis[0])
-
-        with sample_checks(on_sample):
+        judge = Judge(spec, aligned=self.aligned)
+        with sample_checks(judge):  # the frame order and the axis, on pass 0's sample
             fs = self.measure_columns(cols, spec, min_modulation)
-        turned = axis[0]
-
-        def judge(problem: str | None) -> None:
-            """Refuse for ``problem``, naming a turned axis too (the likelier cause)."""
-            refuse(problem if problem is None or turned is None else f"{problem}; {turned}")
-
         code = self.code_columns(cols, spec, fs, min_modulation)
         del cols
         fs = replace(fs, stair=None)  # (the code's maps hold the pair: let go with them)
-        warnings = check_convention(fs, code, spec) + ([turned] if turned else [])
+        judge.convention(fs, code.check, code.edges, code.edge_phase, code.cycle)
         orders = self.order_columns(fs, code, spec, **options)
         # the code's maps let go with it once the orders are made (the words narrowed for the
         # result: int8 for up to 127 fringes), the phase noise and the sample too
@@ -362,35 +328,13 @@ class Codec:
         read_top = int(code.edges.max()) if beyond else -1  # codes past the projector's end
         del code
         fs = replace(fs, sigma=None, sample=None)
-        orders.info.update(seen)
-        if warnings:
-            orders.info["warnings"] = [*orders.info.get("warnings", []), *warnings]
-        if "jump_links" not in orders.info:  # a per-pixel decode: judge its orders here
-            judged = orders.order if orders.read is None else orders.read
-            bad, big, links = wrap_steps(fs.phi, judged, fs.valid)
-            del judged
-            orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
-            judge(jump_problem(bad, links, big=big, big_limit=0.02))
-            if edge_phase and getattr(spec, "steps", 0):  # edges mid-fringe: judged there too
-                judged = orders.order if orders.read is None else orders.read
-                _, jumps, across = edge_steps(fs.phi, judged, fs.valid, edge_phase)
-                del judged
-                orders.info.update(edge_links=across, edge_jumps=jumps)
-                judge(edge_jump_problem(jumps, across))
-            if links >= 200 and bad > 0.02 * links:  # a plain code misread beside its edges
-                where = ("the code reads pixels beside its edges one order off" if
-                         orders.read is None else "the code reads pixels beside its edges "
-                         "one order off (left out where their own evidence shows it)")
-                orders.info["warnings"] = [*orders.info.get("warnings", []), (
-                    f"the orders as read do not step by one across {100 * bad / links:.1f}% "
-                    f"of the phase jumps: {where} (a code whose edges sit on the phase "
-                    "jumps; a complementary or shifted code, a second period or --strategy "
-                    "region avoid it)")]
-        judge(jump_problem(orders.info.get("jump_violations", 0),
-                           orders.info.get("jump_links", 0)))
-        modulated = int(np.count_nonzero(fs.valid))
-        orders.info.setdefault("valid_modulation", modulated)
-        judge(sparse_problem(int(np.count_nonzero(orders.order >= 0)), modulated))
+        orders.info.update(judge.seen)
+        if judge.warnings:
+            orders.info["warnings"] = [*orders.info.get("warnings", []), *judge.warnings]
+        judge.blocks(fs, orders)
+        judge.edges(fs, orders, edge_phase)
+        judge.steps(orders)
+        orders.info.setdefault("valid_modulation", judge.sparse(fs, orders.order))
         orders.read = None  # (judged: let go before the result's arrays are made)
         # pass 2: the orders and the wrapped phase become the result's, written over where
         # nothing else (the result's other arrays, the captures) shares their memory; the
@@ -409,10 +353,7 @@ class Codec:
             result.info["outside_projector"] = (result.info.get("outside_projector", 0)
                                                 + beyond)
         decoded = int(np.count_nonzero(result.mask))
-        other = {"columns": "rows", "rows": "columns"}.get(spec.orientation, "")
-        fits = other and spec.coded_length < top <= spec.other_length
-        judge(outside_problem(decoded, result.info.get("outside_projector", 0),
-                              spec.coded_length, other if fits else ""))
+        judge.outside(result.info, decoded, top)
         result.info["valid_pixels"] = decoded
         result.info.setdefault("full_scale", prepared.full_scale)
         if spec.orientation == "rows":  # (only this function holds the result: turned array
@@ -477,94 +418,6 @@ def most_code(spec: BaseSpec, cycle: int | None = None) -> int:
     return max((1 << fringes.bit_length()) - 1, cycle or 0)
 
 
-def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
-                        seen: dict[str, Any] | None = None) -> str | None:
-    """A one-line reason to refuse when two frames of an N-step set look swapped
-    (:func:`~bistair.core.checks.swapped_frames`), judged on pass 0's sample: its strong
-    pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
-
-    Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
-    or more steps is checked (:func:`~bistair.core.checks.exchange_fits`: an exchange that
-    fits under ``SWAPPED`` of the set's residual); the first, where it starts the method
-    frames, also against the whole sequence one frame over
-    (:func:`~bistair.core.checks.rotated_frames`: a capture started a frame late or early),
-    named when that fits better than any exchange. With four steps an exchange and the
-    exchange of the other two frames fit alike (one of them also reverses the shifts): both
-    are named.
-    With fewer than 500 strong pixels in the sample nothing is said.
-
-    Parameters
-    ----------
-    sample : Sample
-        Pass 0's sample of the captures (``FringeSet.sample``), column layout, its
-        ``values`` the method's frames in method order.
-    spec : BaseSpec
-        The spec whose ``method_frames`` name the frames and whose ``shift_sign`` gives the
-        direction of the shifts.
-    samples : int, default 20000
-        At most how many strong pixels to use.
-    seen : dict, optional
-        Given the first set's figures, where it starts the method frames: ``rotated_fit``
-        (the better reading one frame over, its residual over the set's) and
-        ``exchange_fit`` (the best exchange's, likewise).
-
-    Returns
-    -------
-    str or None
-        The reason naming the frames, or ``None`` when the frames look in order.
-
-    Examples
-    --------
-    >>> from bistair.codecs import encode, make_spec
-    >>> from bistair.core.captures import prepare
-    >>> spec = make_spec("graycode", width=240, height=256, period=30)
-    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
-    >>> shift_order_problem(measure_shifts(cols, spec).sample, spec) is None
-    True
-    >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
-    >>> swapped = prepare(images, spec.frame_count, spec.method)
-    >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
-    'frames shift-0 and shift-1 look swapped (or shift-2 and shift-3'
-    >>> late = prepare(encode(spec)[[1, 2, 3, 4, 5, 6, 0]], spec.frame_count, spec.method)
-    >>> shift_order_problem(measure_shifts(late, spec).sample, spec)[:40]
-    'the frames look one frame late: the last'
-    """
-    names = spec.method_frames()
-    sets: dict[str, list[int]] = {}
-    for i, name in enumerate(names):
-        if "shift-" in name:
-            sets.setdefault(name.rsplit("shift-", 1)[0], []).append(i)
-    r, c = np.nonzero(sample.strong)
-    if r.size < 500:
-        return None
-    step = max(1, -(-r.size // samples))
-    r, c = r[::step], c[::step]
-    values = sample.values[:, r, c].astype(np.float64)
-    for index, members in enumerate(m for m in sets.values() if len(m) >= 4):
-        base, ratio, pairs = exchange_fits(values[members], spec.shift_sign)
-        way, turned = 0, float("inf")
-        if index == 0 and members == list(range(len(members))) and len(names) > len(members):
-            # the first set at the start: also the whole sequence one frame over
-            way, turned = rotated_frames(values, len(members), spec.shift_sign)
-            if seen is not None:
-                seen.update(rotated_fit=round(turned, 3), exchange_fit=round(ratio, 3))
-        if way and turned < ratio:  # no exchange of two frames explains it as well
-            return ("the frames look one frame " + ("late: the last one fits as shift-0 "
-                    "(did the capture start a frame late, or a frame go missing at the "
-                    "start?)" if way > 0 else "early: the phase shifts fit from the second "
-                    "frame on (is there an extra frame at the start?)")
-                    + "; check the frame order")
-        if base > SWAP_LEAST and ratio < SWAPPED:
-            a, b = (names[members[i]] for i in pairs[0])
-            other = [p for p in pairs[1:] if not set(p) & set(pairs[0])]
-            also = ("" if len(members) != 4 or not other else " (or {} and {}: with four "
-                    "steps the two fit alike)".format(*(names[members[i]] for i in other[0])))
-            return (f"frames {a} and {b} look swapped{also}: the phase shifts fit a sinusoid "
-                    f"{1 / max(ratio, 1e-3):.1f} times better exchanged (check the frame "
-                    "order)")
-    return None
-
-
 def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     """Refuse captures whose code steps do not sit where the spec's phase convention puts
     them (:mod:`bistair.core.checks`); returns the warnings worth a line.
@@ -607,20 +460,7 @@ def check_convention(fs: FringeSet, code: CodeMap, spec: BaseSpec) -> list[str]:
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the code steps where ...
     """
-    check = code.check or edge_alignment(fs.phi, code.edges, fs.valid, code.edge_phase,
-                                         code.cycle)
-    pair = tuple(f for f in spec.method_frames() if f.endswith(("-cos", "-sin")))
-    # a reading of the same frames with the code half a period over (a Gray code's)
-    half = getattr(spec, "half_period_reading", lambda: "")()
-    problem = convention_problem(check, spec.phase_offset, spec.shift_sign, code.edge_phase,
-                                 pair, half)
-    if problem is None:
-        return []
-    kind, message = problem
-    if kind == "refuse":
-        refuse(message)
-        return []
-    return [message]
+    return Judge(spec).convention(fs, code.check, code.edges, code.edge_phase, code.cycle)
 
 
 def fringe_index(spec: BaseSpec, period: float | None = None) -> np.ndarray:

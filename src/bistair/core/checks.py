@@ -1,11 +1,28 @@
-"""Checks that a decode's spec fits its captures: where the code's edges fall on the phase.
+"""Checks that a decode's spec fits its captures.
 
-A code (Gray code, stair level, ...) steps at its own edges, which sit at a known wrapped
-phase (0 for most methods: at the phase jumps). Along the coded axis, pairs of neighbouring
-pixels whose code differs show where those edges fall in the capture: around the expected
-phase when the spec is right, half a period off when the phase convention is off by pi
-(``phase_offset``), with the phase rising instead of falling across them when the shifts run
-the other way (``shift_sign``) or the shift frames are in reverse order.
+:class:`Judge` runs the checks every decode runs, one method per row of the checks guide's
+table (``docs/guide/checks.md``), in the order a decode meets them. Its parts, each usable
+alone:
+
+- refusing: :func:`refuse`, :func:`forcing`, :func:`sample_checks`, :func:`judge_sample`;
+- the frame order: :func:`shift_order_problem`, :func:`exchange_fits`,
+  :func:`rotated_frames`, :func:`swapped_frames`, :func:`fit_residual`;
+- the axis: :func:`axis_rates`, :func:`axis_problem`;
+- the phase convention: :func:`edge_alignment` (an :class:`EdgeCheck`),
+  :func:`convention_problem`;
+- the orders: :func:`wrap_steps`, :func:`jump_problem`, :func:`wilson_low`,
+  :func:`edge_steps`, :func:`edge_jump_problem`, :func:`sparse_problem`;
+- the result: :func:`outside_problem`;
+- for the codecs' own checks: :func:`cell_steps`, :func:`direction_problem`,
+  :func:`stair_misfit`, :func:`stair_sample`.
+
+Where the code's edges fall on the phase: a code (Gray code, stair level, ...) steps at its
+own edges, which sit at a known wrapped phase (0 for most methods: at the phase jumps).
+Along the coded axis, pairs of neighbouring pixels whose code differs show where those edges
+fall in the capture: around the expected phase when the spec is right, half a period off
+when the phase convention is off by pi (``phase_offset``), with the phase rising instead of
+falling across them when the shifts run the other way (``shift_sign``) or the shift frames
+are in reverse order.
 
 Examples
 --------
@@ -27,14 +44,19 @@ import contextlib
 from collections.abc import Callable, Iterator
 from contextvars import ContextVar
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
 from ..errors import BistairError
+from ..spec import BaseSpec
 from .checks_jit import level_misfits, step_sums, wrap_step_counts
 from .phase import TWO_PI, residuals, wrap, wrapped_phase
 from .sample import Sample, sample_grid
 from .stair import half_gaps
+
+if TYPE_CHECKING:  # (measure calls judge_sample: no import at run time)
+    from .measure import FringeSet
 
 MIN_EDGES = 50  # code steps needed before the check says anything
 _FORCED: ContextVar[list[str] | None] = ContextVar("bistair_forced", default=None)
@@ -1027,3 +1049,284 @@ def rotated_frames(samples: np.ndarray, steps: int, shift_sign: int = 1,
     if base <= 0.2 or ratio >= limit:
         return 0, ratio
     return (1 if late <= early else -1), ratio
+
+
+def shift_order_problem(sample: Sample, spec: BaseSpec, samples: int = 20000,
+                        seen: dict[str, Any] | None = None) -> str | None:
+    """A one-line reason to refuse when two frames of an N-step set look swapped
+    (:func:`swapped_frames`), judged on pass 0's sample: its strong
+    pixels (at most ``samples`` of them, evenly spaced), every frame's raw values there.
+
+    Every N-step set of the spec's method frames (the frames named ``...shift-n``) with four
+    or more steps is checked (:func:`exchange_fits`: an exchange that
+    fits under ``SWAPPED`` of the set's residual); the first, where it starts the method
+    frames, also against the whole sequence one frame over
+    (:func:`rotated_frames`: a capture started a frame late or early),
+    named when that fits better than any exchange. With four steps an exchange and the
+    exchange of the other two frames fit alike (one of them also reverses the shifts): both
+    are named.
+    With fewer than 500 strong pixels in the sample nothing is said.
+
+    Parameters
+    ----------
+    sample : Sample
+        Pass 0's sample of the captures (``FringeSet.sample``), column layout, its
+        ``values`` the method's frames in method order.
+    spec : BaseSpec
+        The spec whose ``method_frames`` name the frames and whose ``shift_sign`` gives the
+        direction of the shifts.
+    samples : int, default 20000
+        At most how many strong pixels to use.
+    seen : dict, optional
+        Given the first set's figures, where it starts the method frames: ``rotated_fit``
+        (the better reading one frame over, its residual over the set's) and
+        ``exchange_fit`` (the best exchange's, likewise).
+
+    Returns
+    -------
+    str or None
+        The reason naming the frames, or ``None`` when the frames look in order.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=256, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> shift_order_problem(measure_shifts(cols, spec).sample, spec) is None
+    True
+    >>> images = encode(spec)[[1, 0, 2, 3, 4, 5, 6]]  # shift-0 and shift-1 exchanged
+    >>> swapped = prepare(images, spec.frame_count, spec.method)
+    >>> shift_order_problem(measure_shifts(swapped, spec).sample, spec).split(":")[0]
+    'frames shift-0 and shift-1 look swapped (or shift-2 and shift-3'
+    >>> late = prepare(encode(spec)[[1, 2, 3, 4, 5, 6, 0]], spec.frame_count, spec.method)
+    >>> shift_order_problem(measure_shifts(late, spec).sample, spec)[:40]
+    'the frames look one frame late: the last'
+    """
+    names = spec.method_frames()
+    sets: dict[str, list[int]] = {}
+    for i, name in enumerate(names):
+        if "shift-" in name:
+            sets.setdefault(name.rsplit("shift-", 1)[0], []).append(i)
+    r, c = np.nonzero(sample.strong)
+    if r.size < 500:
+        return None
+    step = max(1, -(-r.size // samples))
+    r, c = r[::step], c[::step]
+    values = sample.values[:, r, c].astype(np.float64)
+    for index, members in enumerate(m for m in sets.values() if len(m) >= 4):
+        base, ratio, pairs = exchange_fits(values[members], spec.shift_sign)
+        way, turned = 0, float("inf")
+        if index == 0 and members == list(range(len(members))) and len(names) > len(members):
+            # the first set at the start: also the whole sequence one frame over
+            way, turned = rotated_frames(values, len(members), spec.shift_sign)
+            if seen is not None:
+                seen.update(rotated_fit=round(turned, 3), exchange_fit=round(ratio, 3))
+        if way and turned < ratio:  # no exchange of two frames explains it as well
+            return ("the frames look one frame " + ("late: the last one fits as shift-0 "
+                    "(did the capture start a frame late, or a frame go missing at the "
+                    "start?)" if way > 0 else "early: the phase shifts fit from the second "
+                    "frame on (is there an extra frame at the start?)")
+                    + "; check the frame order")
+        if base > SWAP_LEAST and ratio < SWAPPED:
+            a, b = (names[members[i]] for i in pairs[0])
+            other = [p for p in pairs[1:] if not set(p) & set(pairs[0])]
+            also = ("" if len(members) != 4 or not other else " (or {} and {}: with four "
+                    "steps the two fit alike)".format(*(names[members[i]] for i in other[0])))
+            return (f"frames {a} and {b} look swapped{also}: the phase shifts fit a sinusoid "
+                    f"{1 / max(ratio, 1e-3):.1f} times better exchanged (check the frame "
+                    "order)")
+    return None
+
+
+class Judged(Protocol):
+    """What :class:`Judge` reads of a decode's stage 3 (the codecs' ``Orders``): the fringe
+    order per pixel, its figures, and the orders as its code read them (or ``None``)."""
+
+    order: np.ndarray
+    info: dict[str, Any]
+    read: np.ndarray | None
+
+
+class Judge:
+    """The checks every decode runs, one method per row of the checks guide's table
+    (``docs/guide/checks.md``, keys ``Judge.<method>``), in the order a decode meets them:
+
+    ======================  ========================================================
+    pass 0's sample         :meth:`frames`, :meth:`axis` (the judge is called with it)
+    the code (stage 2)      :meth:`convention`
+    the orders (stage 3)    :meth:`blocks`, :meth:`edges`, :meth:`steps`, :meth:`sparse`
+    the result              :meth:`outside`
+    ======================  ========================================================
+
+    Each refuses through :func:`refuse` (so ``--force`` records it instead); once the axis
+    check has found the phase running the other way, every later refusal names that too
+    (the likelier cause). The codecs' own checks (stair levels, multi-level cells, periods,
+    lv windows, a Gray code alone's direction) stay in their codecs and run inside their
+    stages.
+
+    Parameters
+    ----------
+    spec : BaseSpec
+        The spec of the axis decoded (column layout).
+    aligned : bool
+        The codec needs the coded axis along the image's rows: a turned axis is refused;
+        for the others it is a warning.
+
+    Attributes
+    ----------
+    turned : str or None
+        The axis check's reason, once it has judged.
+    seen : dict
+        Figures the sample's checks judged (``rotated_fit``, ``exchange_fit``), for
+        ``info.json``.
+    warnings : list of str
+        The warnings of the convention and the axis, in that order.
+
+    Examples
+    --------
+    >>> from bistair.codecs import encode, make_spec
+    >>> from bistair.codecs.base import measure_shifts
+    >>> from bistair.core.captures import prepare
+    >>> spec = make_spec("graycode", width=240, height=256, period=30)
+    >>> cols = prepare(encode(spec), spec.frame_count, spec.method)
+    >>> judge = Judge(spec)
+    >>> with sample_checks(judge):  # the frame order and the axis, on pass 0's sample
+    ...     fs = measure_shifts(cols, spec)
+    >>> sorted(judge.seen), judge.turned
+    (['exchange_fit', 'rotated_fit'], None)
+    >>> judge.sparse(fs, np.full(fs.phi.shape, -1))  # nothing read: an empty answer, let by
+    61440
+    >>> late = prepare(encode(spec)[[1, 2, 3, 4, 5, 6, 0]], spec.frame_count, spec.method)
+    >>> with sample_checks(Judge(spec)):
+    ...     fs = measure_shifts(late, spec)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: the captures do not fit the spec: the frames look one frame late...
+    """
+
+    def __init__(self, spec: BaseSpec, aligned: bool = False) -> None:
+        self.spec = spec
+        self.aligned = aligned
+        self.turned: str | None = None
+        self.seen: dict[str, Any] = {}
+        self._convention: list[str] = []
+        self._counted = False  # the orders' steps across the wraps counted here (per pixel)
+
+    @property
+    def warnings(self) -> list[str]:
+        """The convention's warnings, then the axis's (a turned camera, where not refused)."""
+        return [*self._convention, *([self.turned] if self.turned else [])]
+
+    def _refuse(self, problem: str | None) -> None:
+        """Refuse for ``problem``, naming a turned axis too (the likelier cause)."""
+        refuse(problem if problem is None or self.turned is None
+               else f"{problem}; {self.turned}")
+
+    def __call__(self, sample: Sample) -> None:
+        """Judge pass 0's sample (:func:`sample_checks` hands it over before any full pass):
+        :meth:`frames`, then :meth:`axis`."""
+        self.frames(sample)
+        self.axis(sample)
+
+    # -- pass 0's sample ---------------------------------------------------------------------
+    def frames(self, sample: Sample) -> None:
+        """The shift frames in their order: none of a set exchanged, the sequence not one
+        frame over (:func:`shift_order_problem`)."""
+        refuse(shift_order_problem(sample, self.spec, seen=self.seen))
+
+    def axis(self, sample: Sample) -> None:
+        """The phase runs along the coded axis (:func:`axis_problem`): refused for an
+        aligned codec, else a warning."""
+        self.turned = axis_problem(sample, self.spec.orientation)
+        if self.aligned:  # a per-pixel code decodes a turned camera's images: a warning
+            refuse(self.turned)
+
+    # -- the code (stage 2) ------------------------------------------------------------------
+    def convention(self, fs: FringeSet, check: EdgeCheck | None, edges: np.ndarray,
+                   edge_phase: float = 0.0, cycle: int | None = None) -> list[str]:
+        """The code steps where the spec's phase convention puts them
+        (:func:`convention_problem`: ``shift_sign``, ``phase_offset``): refused when the
+        phase falls where the code grows or the steps sit over pi/3 off, a warning from
+        0.25 rad. ``check``, a codec's own (multi-frequency's), else the code's ``edges``
+        aligned on the wrapped phase (at ``edge_phase``, every ``cycle`` values). Returns
+        the warning, if any (also kept in :attr:`warnings`)."""
+        check = check or edge_alignment(fs.phi, edges, fs.valid, edge_phase, cycle)
+        spec = self.spec
+        pair = tuple(f for f in spec.method_frames() if f.endswith(("-cos", "-sin")))
+        # a reading of the same frames with the code half a period over (a Gray code's)
+        half = getattr(spec, "half_period_reading", lambda: "")()
+        problem = convention_problem(check, spec.phase_offset, spec.shift_sign, edge_phase,
+                                     pair, half)
+        if problem is None:
+            return []
+        kind, message = problem
+        if kind == "refuse":
+            refuse(message)
+            return []
+        self._convention.append(message)
+        return [message]
+
+    # -- the orders (stage 3) ----------------------------------------------------------------
+    def blocks(self, fs: FringeSet, orders: Judged) -> None:
+        """A per-pixel decode's orders (as read) across the clean wraps
+        (:func:`wrap_steps`, counted here into ``jump_violations``, ``jump_links``,
+        ``block_jumps``; a region decoder counts its own): refused for whole-block jumps
+        at over 2% of them, or steps not by one at over 10% (:func:`jump_problem`)."""
+        if "jump_links" in orders.info:
+            return
+        self._counted = True
+        judged = orders.order if orders.read is None else orders.read
+        bad, big, links = wrap_steps(fs.phi, judged, fs.valid)
+        orders.info.update(jump_violations=bad, jump_links=links, block_jumps=big)
+        self._refuse(jump_problem(bad, links, big=big, big_limit=0.02))
+
+    def edges(self, fs: FringeSet, orders: Judged, edge_phase: float) -> None:
+        """A per-pixel decode of a code whose edges sit mid-fringe (``edge_phase``, a
+        shifted Gray code's): its orders as read hold across those edges
+        (:func:`edge_steps` into ``edge_links``, ``edge_jumps``; :func:`edge_jump_problem`,
+        2%)."""
+        if not (self._counted and edge_phase and getattr(self.spec, "steps", 0)):
+            return
+        judged = orders.order if orders.read is None else orders.read
+        _, jumps, across = edge_steps(fs.phi, judged, fs.valid, edge_phase)
+        orders.info.update(edge_links=across, edge_jumps=jumps)
+        self._refuse(edge_jump_problem(jumps, across))
+
+    def steps(self, orders: Judged) -> None:
+        """The orders step by one across every wrap of the phase (:func:`jump_problem`:
+        over 10% refused); a per-pixel decode whose orders as read miss at over 2% of 200
+        or more is warned (a plain code misread beside its edges)."""
+        info = orders.info
+        bad, links = info.get("jump_violations", 0), info.get("jump_links", 0)
+        if self._counted and links >= 200 and bad > 0.02 * links:
+            where = ("the code reads pixels beside its edges one order off" if
+                     orders.read is None else "the code reads pixels beside its edges "
+                     "one order off (left out where their own evidence shows it)")
+            info["warnings"] = [*info.get("warnings", []), (
+                f"the orders as read do not step by one across {100 * bad / links:.1f}% "
+                f"of the phase jumps: {where} (a code whose edges sit on the phase "
+                "jumps; a complementary or shifted code, a second period or --strategy "
+                "region avoid it)")]
+        self._refuse(jump_problem(bad, links))
+
+    def sparse(self, fs: FringeSet, order: np.ndarray) -> int:
+        """The code read on more than a few of the modulated pixels
+        (:func:`sparse_problem`: some but under 1%); returns the modulated pixels'
+        count."""
+        modulated = int(np.count_nonzero(fs.valid))
+        self._refuse(sparse_problem(int(np.count_nonzero(order >= 0)), modulated))
+        return modulated
+
+    # -- the result --------------------------------------------------------------------------
+    def outside(self, info: dict[str, Any], decoded: int, top: int) -> None:
+        """The coordinates inside the projector (:func:`outside_problem`: over 10% of the
+        decoded pixels, and 100, beyond the coded length); the other orientation named
+        where ``top``, the highest coordinate the codes read, fits along the projector's
+        other axis."""
+        spec = self.spec
+        other = {"columns": "rows", "rows": "columns"}.get(spec.orientation, "")
+        fits = other and spec.coded_length < top <= spec.other_length
+        self._refuse(outside_problem(decoded, info.get("outside_projector", 0),
+                                     spec.coded_length, other if fits else ""))
