@@ -224,8 +224,8 @@ def dispatcher(func: Callable) -> Any:
 
     Examples
     --------
-    >>> from bistair.core.phase_jit import _arctan2
-    >>> type(dispatcher(_arctan2)).__name__
+    >>> from bistair.core.phase_jit import arctan2_flat
+    >>> type(dispatcher(arctan2_flat)).__name__
     'CPUDispatcher'
     """
     fn = func.py_func
@@ -273,8 +273,8 @@ def load_cached(func: Callable, signatures: list[tuple]) -> int:
 
     Examples
     --------
-    >>> from bistair.core.phase_jit import _arctan2
-    >>> load_cached(_arctan2, []) == 0
+    >>> from bistair.core.phase_jit import arctan2_flat
+    >>> load_cached(arctan2_flat, []) == 0
     True
     """
     compiled = dispatcher(func)
@@ -370,7 +370,7 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
 
 def _compile_helpers(module: dict[str, Any], numba: Any) -> None:
     """On a module's first kernel: its ``prange`` made numba's and its helpers (marked with
-    :func:`_numba_inline` or :func:`_numba_called`) compiled, once; a helper imported from
+    :func:`inline` or :func:`called`) compiled, once; a helper imported from
     another module is compiled after that module's own helpers, which it may call."""
     if module.get("prange") is not range:
         return
@@ -657,28 +657,59 @@ TWO_PI32 = np.float32(2.0 * math.pi)
 PI32 = np.float32(math.pi)
 
 
-def _numba_inline(fn: Callable) -> Callable:
-    """Mark a helper that the kernels call: compiled into them with ``numba.njit``."""
+def inline(fn: Callable) -> Callable:
+    """Mark a helper that the kernels call: compiled into them with ``numba.njit``.
+
+    Parameters
+    ----------
+    fn : callable
+        A plain function of numbers or arrays, in a ``*_jit.py`` module.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself, marked: the first kernel of a module that holds it (or imports it)
+        compiles it, inlined (``inline="always"``).
+
+    Examples
+    --------
+    >>> @inline
+    ... def twice(x):
+    ...     return 2 * x
+    >>> twice(3), twice._inline
+    (6, 'always')
+    """
     fn._inline = "always"  # type: ignore[attr-defined]
     return fn
 
 
-def _numba_called(fn: Callable) -> Callable:
+def called(fn: Callable) -> Callable:
     """Mark a helper that the kernels call: compiled with ``numba.njit`` on its own (not
-    inlined: numba's parallel loops miscompile some inlined bodies that write arrays)."""
+    inlined: numba's parallel loops miscompile some inlined bodies that write arrays).
+
+    Parameters
+    ----------
+    fn : callable
+        A plain function of numbers or arrays, in a ``*_jit.py`` module.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself, marked (``inline="never"``).
+
+    Examples
+    --------
+    >>> @called
+    ... def fill(out, value):
+    ...     out[:] = value
+    >>> fill._inline
+    'never'
+    """
     fn._inline = "never"  # type: ignore[attr-defined]
     return fn
 
 
-@_numba_inline
-def _wrapped(raw: np.float32) -> np.float32:
-    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it, for ``|raw| < 2pi``."""
-    d = raw + PI32
-    if d >= TWO_PI32:
-        d = d - TWO_PI32
-    elif d < 0:
-        d = d + TWO_PI32
-    return d - PI32
+_numba_inline = inline  # the old name, for geometry/'s twins until they import inline
 
 
 def chunk_count(n: int) -> int:
@@ -703,18 +734,49 @@ def chunk_count(n: int) -> int:
     return max(1, min(64, n // 4096))
 
 
-@_numba_inline
-def _fmax(a: float, b: float) -> float:
-    """``np.maximum`` of two floats (NaN from either)."""
+@inline
+def fmax(a: float, b: float) -> float:
+    """``np.maximum`` of two floats (NaN from either), for the kernels.
+
+    Parameters
+    ----------
+    a, b : float
+        Two numbers.
+
+    Returns
+    -------
+    float
+        The larger; NaN where either is NaN.
+
+    Examples
+    --------
+    >>> fmax(1.0, 2.0), fmax(float("nan"), 2.0)
+    (2.0, nan)
+    """
     if a != a or b != b:
         return a if a != a else b
     return a if a >= b else b
 
 
+@inline
+def fmin(a: float, b: float) -> float:
+    """``np.minimum`` of two floats (NaN from either), for the kernels.
 
-@_numba_inline
-def _fmin(a: float, b: float) -> float:
-    """``np.minimum`` of two floats (NaN from either)."""
+    Parameters
+    ----------
+    a, b : float
+        Two numbers.
+
+    Returns
+    -------
+    float
+        The smaller; NaN where either is NaN.
+
+    Examples
+    --------
+    >>> fmin(1.0, 2.0), fmin(1.0, float("nan"))
+    (1.0, nan)
+    """
     if a != a or b != b:
         return a if a != a else b
     return a if a <= b else b

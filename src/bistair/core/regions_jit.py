@@ -44,7 +44,7 @@ import math
 
 import numpy as np
 
-from .jit import PI32, TWO_PI32, _numba_called, _numba_inline, kernel
+from .jit import PI32, TWO_PI32, called, inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -57,7 +57,7 @@ HALF = 3  # gradients in a period-jump window (as the decode uses it; fixed at c
 NO_CUTS = np.zeros((0, 0), np.bool_)  # no codec cuts, no second mask
 
 
-@_numba_called
+@called
 def _median_bits(vals: np.ndarray, hist: np.ndarray) -> np.float32:
     """The median of ``vals`` (float32 in ``[+0, 4)``, at least one: their bit patterns
     sort as the values do) as :func:`numpy.median` gives it (the middle value, or the
@@ -173,7 +173,7 @@ def cut_medians(phi: np.ndarray, valid: np.ndarray) -> tuple[np.ndarray, np.ndar
     return meds, counts, True
 
 
-@_numba_inline
+@inline
 def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np.float32,
           qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
           half: np.float32) -> bool:
@@ -199,7 +199,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
     return step > rel * size
 
 
-@_numba_inline
+@inline
 def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
            rel: np.float32) -> bool:
     """Not clearly below ``rel`` of the larger gradient: :func:`_jump`'s first test, which
@@ -209,7 +209,7 @@ def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
                 * np.float32(0.9999))
 
 
-@_numba_inline
+@inline
 def _loud(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
           noise_p: np.float32, noise_q: np.float32, inv_p: np.float32,
           inv_q: np.float32) -> bool:
@@ -224,7 +224,7 @@ def _loud(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
     return not (d2 < square * np.float32(0.999)) or square < np.float32(1e-30)
 
 
-@_numba_inline
+@inline
 def _inverse_root(count: np.float32, inv3: np.float32, inv4: np.float32, inv5: np.float32,
                   inv6: np.float32) -> np.float32:
     """``1/sqrt(count)`` for a window count of 3 to 6, chosen by selects (for a vector
@@ -232,17 +232,18 @@ def _inverse_root(count: np.float32, inv3: np.float32, inv4: np.float32, inv5: n
     return inv3 if count == 3 else (inv4 if count == 4 else (inv5 if count == 5 else inv6))
 
 
-@_numba_inline
+@inline
 def _wrap_sel(raw: np.float32) -> np.float32:
-    """:func:`bistair.core.jit._wrapped` as two selects (the same value for every input,
-    NaN and infinities included: after the first step ``d`` is never below 0)."""
+    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it for ``|raw| < 2pi``, as
+    two selects (the same value as two branches for every input, NaN and infinities
+    included: after the first step ``d`` is never below 0)."""
     d = raw + PI32
     d = d - TWO_PI32 if d >= TWO_PI32 else d
     d = d + TWO_PI32 if d < np.float32(0.0) else d
     return d - PI32
 
 
-@_numba_inline
+@inline
 def _gradients(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below: bool,
                g: np.ndarray) -> None:
     """A row's wrapped gradients and their counts, for :func:`_windows`: ``g[0]``, ``g[1]``
@@ -277,7 +278,7 @@ def _gradients(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, bel
             ny[x + 3] = zero
 
 
-@_numba_inline
+@inline
 def _windows(g: np.ndarray, s: np.ndarray, twice: bool, around: np.ndarray,
              ahead: np.ndarray, ahead_too: bool, around2: np.ndarray, ahead2: np.ndarray,
              ahead2_too: bool) -> None:
@@ -336,7 +337,7 @@ def _windows(g: np.ndarray, s: np.ndarray, twice: bool, around: np.ndarray,
         _counts(g[r, 2], g[r, 3], a[2], b[2], too)
 
 
-@_numba_inline
+@inline
 def _means(s: np.ndarray, n: np.ndarray, around: np.ndarray, ahead: np.ndarray,
            ahead_too: bool) -> None:
     """A row's window means of one gradient (:func:`_windows`): ``around[x] = (s[x+6] -
@@ -355,7 +356,7 @@ def _means(s: np.ndarray, n: np.ndarray, around: np.ndarray, ahead: np.ndarray,
             around[x] = np.divide(s[x + 6] - s[x], max(c, one))
 
 
-@_numba_inline
+@inline
 def _counts(nx: np.ndarray, ny: np.ndarray, around: np.ndarray, ahead: np.ndarray,
             ahead_too: bool) -> None:
     """A row's window counts (:func:`_windows`): the smaller of the two gradients'."""
@@ -370,7 +371,7 @@ def _counts(nx: np.ndarray, ny: np.ndarray, around: np.ndarray, ahead: np.ndarra
             ahead[x] = min(cx, cy)
 
 
-@_numba_inline
+@inline
 def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32, pos: bool,
                 st: np.ndarray, raw: np.ndarray, back: np.ndarray) -> None:
     """The states of a row's horizontal links, ``st[x+1]`` for the link between ``x`` and
@@ -420,7 +421,7 @@ def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32,
                 st[k + 1] = 4
 
 
-@_numba_called
+@called
 def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, sign: int,
                relative: float, cut_v: np.ndarray, cut_h: np.ndarray, cuts: bool, y0: int,
                y1: int, out: np.ndarray) -> None:
@@ -854,7 +855,7 @@ def cut_links(bits: np.ndarray, cut_v: np.ndarray, cut_h: np.ndarray) -> np.ndar
     return out
 
 
-@_numba_inline
+@inline
 def _find(parent: np.ndarray, a: np.int32) -> np.int32:
     """The root of ``a`` (paths halved on the way)."""
     while parent[a] != a:
@@ -863,7 +864,7 @@ def _find(parent: np.ndarray, a: np.int32) -> np.int32:
     return a
 
 
-@_numba_inline
+@inline
 def _union(parent: np.ndarray, a: np.int32, b: np.int32) -> None:
     """Join the trees of ``a`` and ``b`` under the smaller root: a root is always its
     tree's smallest id (``parent[i] <= i``)."""
@@ -875,7 +876,7 @@ def _union(parent: np.ndarray, a: np.int32, b: np.int32) -> None:
         parent[a] = b
 
 
-@_numba_called
+@called
 def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: int, y1: int,
                 base: int, labels: np.ndarray, parent: np.ndarray, size: np.ndarray,
                 bright: np.ndarray, dropped: np.ndarray) -> tuple[int, int]:
@@ -930,7 +931,7 @@ def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: in
     return nxt - base, listed
 
 
-@_numba_called
+@called
 def _reattach(labels: np.ndarray, bits: np.ndarray, ty: np.ndarray, tx: np.ndarray,
               roots: np.ndarray, size: np.ndarray, bright: np.ndarray, strong: np.ndarray,
               count_strong: bool, passes: int) -> None:
@@ -1087,7 +1088,7 @@ def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: i
     return labels, parent, n, region_size, region_bright
 
 
-@_numba_called
+@called
 def _relabel_rows(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, y0: int,
                   y1: int) -> None:
     """:func:`relabel` of rows ``y0 .. y1-1`` (a run of one label looked up once)."""

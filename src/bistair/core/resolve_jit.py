@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .jit import _numba_inline, kernel
+from .jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -94,7 +94,7 @@ def dense_tile(bad: np.ndarray, decided: np.ndarray, share: float, block: int) -
 
 
 
-@_numba_inline
+@inline
 def _reflect(i: int, n: int) -> int:
     """Index ``i`` reflected into ``0..n-1`` (d c b a | a b c d | d c b a), for
     ``-n <= i < 2n``."""
@@ -212,7 +212,7 @@ def label_orders(labels: np.ndarray, region_order: np.ndarray, valid: np.ndarray
     return order, outside
 
 
-@_numba_inline
+@inline
 def _clip(x: float, lo: float, hi: float) -> float:
     """``np.clip`` of one float: NaN stays NaN."""
     if x != x:

@@ -21,7 +21,7 @@ import math
 import numpy as np
 
 from .jit import PI32, kernel, kernel_frames
-from .phase_jit import _angle, _hypot32
+from .phase_jit import angle32, hypot32
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -125,8 +125,8 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
         for x in range(w):
             a = np.float32(raw[first, y, x]) * s32 - avg[y, x]
             b = np.float32(raw[first + 1, y, x]) * s32 - avg[y, x]
-            theta[y, x] = _angle(b, a)
-            mod[y, x] = _hypot32(a, b)
+            theta[y, x] = angle32(b, a)
+            mod[y, x] = hypot32(a, b)
     return theta, mod
 
 
