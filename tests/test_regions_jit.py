@@ -26,16 +26,9 @@ from bistair.core.regions import (
     fringe_regions,
     period_jumps,
 )
-from bistair.core.regions_jit import (
-    NO_CUTS,
-    TILE,
-    cut_links,
-    cut_medians,
-    label_kept,
-    link_bits,
-    relink,
-    valid_changes,
-)
+from bistair.core.regions_cuts_jit import cut_links, cut_medians
+from bistair.core.regions_jit import NO_CUTS, TILE, link_bits, relink, valid_changes
+from bistair.core.regions_labels_jit import label_kept
 from bistair.io.read import read_with_spec
 from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.presets import preset_spec

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from .jit import TWO_PI32, inline, chunk_count, kernel
+from .jit import TWO_PI32, chunk_count, inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 # atan(u) = u + u*s*P(s), s = u*u, on |u| <= tan(pi/8): a minimax fit (Lawson's iteration on

@@ -25,19 +25,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import (
-    NO_CUTS,
-    TILE,
-    band_links,
-    cut_links,
-    cut_medians,
-    label_kept,
-    link_bits,
-    relabel,
-    relink,
-    valid_changes,
-    wrap_links,
-)
+from .regions_cuts_jit import band_links, cut_links, cut_medians
+from .regions_jit import NO_CUTS, TILE, link_bits, relink, valid_changes
+from .regions_labels_jit import label_kept, relabel, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
 
@@ -178,7 +168,7 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     The gradient is the hypotenuse of the median absolute wrapped neighbour differences
     along the rows and down the columns, on every fourth row and column. A float32 phase
     has its medians taken in one compiled pass
-    (:func:`~bistair.core.regions_jit.cut_medians`): the same threshold, bit for bit, as
+    (:func:`~bistair.core.regions_cuts_jit.cut_medians`): the same threshold, bit for bit, as
     :func:`cut_reference`.
 
     Parameters
@@ -216,7 +206,7 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 def cut_reference(phi: np.ndarray, valid: np.ndarray) -> float:
     """NumPy reference of :func:`default_cut` (of its compiled medians,
-    :func:`~bistair.core.regions_jit.cut_medians`): three times the hypotenuse of the
+    :func:`~bistair.core.regions_cuts_jit.cut_medians`): three times the hypotenuse of the
     median wrapped neighbour differences on every fourth row and column, in [0.6, 2.2].
 
     Parameters
@@ -292,7 +282,7 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
     labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
     pixels labelled and the dropped ones reattached, with per-region counts
-    (:func:`~bistair.core.regions_jit.label_kept`).
+    (:func:`~bistair.core.regions_labels_jit.label_kept`).
 
     With ``share``, the links are handed on in ``Labelling.links`` (:class:`Links`) for
     the next labelling of the same ``phi`` and ``phase_noise`` (the same arrays): given
@@ -300,9 +290,9 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     weak mask, then its regions on the valid pixels with its own cuts), that labelling
     takes them over, makes again only the rows that read a row whose validity changed
     (:func:`~bistair.core.regions_jit.relink`; where those are at most three quarters of
-    the rows) and adds its cuts (:func:`~bistair.core.regions_jit.cut_links`), where its
+    the rows) and adds its cuts (:func:`~bistair.core.regions_cuts_jit.cut_links`), where its
     direction is the first one's and no link's step lies between the two cut thresholds
-    (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
+    (:func:`~bistair.core.regions_cuts_jit.band_links`). The same links, bit for bit, as its
     own pass; they are taken over once (a later labelling given them makes its own).
 
     Parameters
@@ -470,7 +460,7 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
 def kept_regions(lab: Labelling, min_size: int = MIN_REGION) -> tuple[np.ndarray, int]:
     """The final number of each region of :func:`label_fringes`: regions of at least
     ``min_size`` pixels numbered ``1..n`` in their order, the others 0 (what
-    :func:`fringe_regions` writes through :func:`~bistair.core.regions_jit.relabel`).
+    :func:`fringe_regions` writes through :func:`~bistair.core.regions_labels_jit.relabel`).
 
     Parameters
     ----------

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ...core.jit import fmax, fmin, called, inline, kernel
+from ...core.jit import called, fmax, fmin, inline, kernel
 from ...core.memory import row_bands
 from ...core.regions_jit import TILE
 
@@ -376,7 +376,7 @@ def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
 def _relabel_count(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, n_labels: int,
                    y0: int, y1: int, count: np.ndarray) -> None:
     """Rows ``y0 .. y1-1``: the final labels ``remap[roots[labels]]`` written in place (as
-    :func:`bistair.core.regions_jit.relabel` writes them, a run of one label looked up
+    :func:`bistair.core.regions_labels_jit.relabel` writes them, a run of one label looked up
     once) and each row's distinct final labels (> 0) counted into ``count[y + 1]``."""
     w = labels.shape[1]
     stamp = np.zeros(n_labels + 1, np.int32)  # the row (+ 1) a label was last counted in
@@ -454,7 +454,7 @@ def relabel_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, phi: 
                  mod: np.ndarray, n_labels: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The final labels of a band of rows written in place
-    (:func:`bistair.core.regions_jit.relabel`, the hook its docstring describes) and, in
+    (:func:`bistair.core.regions_labels_jit.relabel`, the hook its docstring describes) and, in
     the same visit of each tile of rows, the five values of
     :func:`bistair.codecs.bidirectional.profiles.stair_values` summed per (label, row):
     ``(start (R+1,), entry (K,), count (K,), acc (5, K))``, row ``y``'s labels in order of
@@ -464,7 +464,7 @@ def relabel_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, phi: 
     Parameters
     ----------
     labels : (R, W) int32 array
-        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        Provisional labels (:func:`bistair.core.regions_labels_jit.label_kept`), changed in
         place to the final ones.
     roots : int32 array
         The region of each provisional label.
@@ -526,7 +526,7 @@ def relabel_stair_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
     Parameters
     ----------
     labels : (H, W) int32 array
-        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        Provisional labels (:func:`bistair.core.regions_labels_jit.label_kept`), changed in
         place to the final ones.
     roots : int32 array
         The region of each provisional label.
