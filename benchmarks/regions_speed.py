@@ -7,8 +7,8 @@ The inputs are the decode's own: one default (bidirectional) decode of
 pass is timed: the passes of bistair 02b6580 (``tests/support/regions_before.py``, compiled
 with the same numba options) and their replacements in ``bistair.core.regions_jit`` and
 ``regions_labels_jit``, the two labellings whole (``fringe_regions``, ``coherent_pixels``)
-before and after, and the floor (``cv2.subtract`` x2, ``cv2.phase``, ``cv2.magnitude``). One kernel thread and
-process CPU time by default (``time.process_time``, ``set_threads(1)``,
+before and after, and the floor (``cv2.subtract`` x2, ``cv2.phase``, ``cv2.magnitude``).
+One kernel thread and process CPU time by default (``time.process_time``, ``set_threads(1)``,
 ``cv2.setNumThreads(1)``: what a loaded machine still measures well), or ``--wall`` on
 every core; the minimum over the rounds is printed, in ms and ns a pixel.
 
