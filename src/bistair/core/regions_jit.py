@@ -52,7 +52,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
           qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
           half: np.float32) -> bool:
     """Whether two mean gradients differ by more than ``rel`` of the larger and four times
-    their noise (float32, as :func:`bistair.core.regions.period_jumps` computes it)."""
+    their noise (float32, as ``tests/support/reference.py:period_jumps`` computes it)."""
     if pn < half or qn < half:
         return False
     dx, dy = px - qx, py - qy
@@ -462,7 +462,7 @@ def link_bits(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float,
 
     A link between two valid pixels is cut at a wrap (``|difference| > pi``: its high-phase
     end is dropped), at a step above ``cut``, where the fringes' spacing or slant jumps
-    (:func:`bistair.core.regions.period_jumps`, windows of 3 gradients, ``relative``), at a
+    (``tests/support/reference.py:period_jumps``, windows of 3 gradients, ``relative``), at a
     cut the codec gives (``cut_v``, ``cut_h`` with ``cuts``) and, along the rows, in a run
     of links against the phase's direction ``sign`` whose fall exceeds
     ``max(0.15, 4 sigma)`` (``sigma``: ``sqrt(2)`` times the larger phase noise of a link's

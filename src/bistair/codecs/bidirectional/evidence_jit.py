@@ -179,7 +179,8 @@ def _quantize(theta: float, levels: int) -> int:
 
 @inline
 def _level_misfit(theta: float, level: int, levels: int) -> float:
-    """:func:`bistair.core.stair.level_misfit` of one phase."""
+    """The squared distance of a phase from a stair level, in half steps (its NumPy
+    reference: ``tests/support/reference.py:level_misfit``)."""
     two_pi = 2.0 * math.pi
     phase = -math.pi + math.pi / levels + two_pi * level / levels
     d = (theta - phase + math.pi) % two_pi
