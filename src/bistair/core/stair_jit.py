@@ -136,8 +136,9 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
 def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray]:
     """The stair phase (``tests/support/reference.py:stair_phase``) of frames ``first``
-    (cosine) and ``first + 1`` (sine) of a raw capture stack (each value times ``scale`` its fraction of full scale),
-    read, centred on ``avg`` and turned into a phase and a modulation in one pass.
+    (cosine) and ``first + 1`` (sine) of a raw capture stack (each value times ``scale``
+    its fraction of full scale), read, centred on ``avg`` and turned into a phase and a
+    modulation in one pass.
 
     Parameters
     ----------

@@ -277,8 +277,9 @@ def _vote(labels: np.ndarray, offsets: np.ndarray, start: np.ndarray, length: np
 
 def run_label_modes(labels: np.ndarray, runs: ColumnRuns, value: np.ndarray, n_labels: int,
                     n_values: int, chunks: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """The most frequent value per label (``tests/support/reference.py:mode_by_label``) of ``labels`` and of the image whose
-    pixels take their run's ``value`` (-1 outside every run), without making that image.
+    """The most frequent value per label (``tests/support/reference.py:mode_by_label``) of
+    ``labels`` and of the image whose pixels take their run's ``value`` (-1 outside every
+    run), without making that image.
 
     Parameters
     ----------
