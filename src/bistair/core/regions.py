@@ -313,8 +313,9 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
 
     Links are cut at wraps, at steps above ``cut``, where the fringe period jumps
     (``tests/support/reference.py:period_jumps``) and, along the rows, where the phase runs
-    backwards (against :func:`fringe_direction`) by more than noise explains (``phase_noise``: per-pixel phase
-    noise in radians, 0.02 when not given): that is where one surface meets another.
+    backwards (against :func:`fringe_direction`) by more than noise explains
+    (``phase_noise``: per-pixel phase noise in radians, 0.02 when not given): that is where
+    one surface meets another.
     ``boundaries`` adds links to cut that a codec found itself (vertical links (H-1, W),
     horizontal links (H, W-1)). A link cut at a wrap drops its high-phase pixel, any
     other cut both; the pixels kept are labelled (4-connected), then the dropped ones join
