@@ -2,9 +2,10 @@
 several passes share.
 
 The compiled passes of a concept module ``X.py`` live beside it in ``X_jit.py``
-(:mod:`.phase_jit`, :mod:`.measure_jit`, :mod:`.stair_jit`, :mod:`.regions_jit`,
-:mod:`.resolve_jit`, :mod:`.checks_jit`, :mod:`.result_jit`); a pass that one codec alone
-uses lives beside that codec. Every pass is plain Python over arrays, marked with
+(:mod:`.phase_jit`, :mod:`.measure_jit`, :mod:`.stair_jit`, :mod:`.regions_jit` and its
+parts, :mod:`.resolve_jit`, :mod:`.parts_jit`, :mod:`.checks_jit`, :mod:`.result_jit`); a
+pass that one codec alone uses lives beside that codec. Callers import the concept module,
+not its twin (``tests/test_architecture.py``). Every pass is plain Python over arrays, marked with
 :func:`kernel` and compiled with numba on its first call; numba itself is imported only
 then, so importing bistair or starting the command line does not pay for it. Passes that
 loop over image rows or chunks run them on every core (``prange``); :func:`set_threads`
