@@ -75,7 +75,7 @@ def copied(runs: Runs) -> Runs:
 
 def cases(frames: np.ndarray, spec) -> dict:
     from bistair.codecs.bidirectional.profiles_jit import label_stair_sums, relabel_stair_sums
-    from bistair.core.regions_jit import relabel
+    from bistair.core.regions_labels_jit import relabel
 
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
     from support.labelspace_before import drop_transitions  # the oracle, in tests/support

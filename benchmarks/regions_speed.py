@@ -5,10 +5,10 @@ The inputs are the decode's own: one default (bidirectional) decode of
 ``decode_speed.py``'s scene is run with ``coherent_pixels`` and the codec's
 ``fringe_regions`` watched, and their arguments kept. Then, in interleaved rounds, each
 pass is timed: the passes of bistair 02b6580 (``tests/support/regions_before.py``, compiled
-with the same numba options) and their replacements in ``bistair.core.regions_jit``, the
-two labellings whole (``fringe_regions``, ``coherent_pixels``) before and after, and the
-floor (``cv2.subtract`` x2, ``cv2.phase``, ``cv2.magnitude``). One kernel thread and
-process CPU time by default (``time.process_time``, ``set_threads(1)``,
+with the same numba options) and their replacements in ``bistair.core.regions_jit`` and
+``regions_labels_jit``, the two labellings whole (``fringe_regions``, ``coherent_pixels``)
+before and after, and the floor (``cv2.subtract`` x2, ``cv2.phase``, ``cv2.magnitude``).
+One kernel thread and process CPU time by default (``time.process_time``, ``set_threads(1)``,
 ``cv2.setNumThreads(1)``: what a loaded machine still measures well), or ``--wall`` on
 every core; the minimum over the rounds is printed, in ms and ns a pixel.
 
@@ -82,6 +82,7 @@ def cases(frames: np.ndarray, spec) -> dict:
     from support import regions_before as old  # the oracle, in tests/support
 
     from bistair.core import regions_jit as new
+    from bistair.core import regions_labels_jit as labels
 
     (c_args, c_kw), (f_args, f_kw) = decode_inputs(frames, spec)
     phi, weak, strong, sigma = c_args
@@ -98,7 +99,7 @@ def cases(frames: np.ndarray, spec) -> dict:
                                            ltype=cv2.CV_32S)
     labels_old, n_old = old.regions_before(fphi, fvalid, cut, 20, noise, edges, sign)
     bits = new.link_bits(fphi, fvalid, noise, cut, sign, 0.3, edges[0], edges[1], True)
-    lab, roots, n, size, lit = new.label_kept(bits, new.NO_CUTS, False, new.TILE, 3)
+    lab, roots, n, size, lit = labels.label_kept(bits, new.NO_CUTS, False, new.TILE, 3)
     remap = np.arange(n + 1, dtype=np.int32)
     c_lab, c_n = old.regions_before(phi, weak, None, 1, sigma)
     coh = regions.label_fringes(phi, weak, phase_noise=sigma, strong=strong)
@@ -115,11 +116,11 @@ def cases(frames: np.ndarray, spec) -> dict:
         "old cv2.connectedComponents": lambda: cv2.connectedComponents(
             keep.view(np.uint8), connectivity=4, ltype=cv2.CV_32S),
         "old reattach": lambda: old.reattach(lab_cc.copy(), fvalid, keep, vert, horiz, 3),
-        "new label_kept (+ reattach)": lambda: new.label_kept(bits, new.NO_CUTS, False,
+        "new label_kept (+ reattach)": lambda: labels.label_kept(bits, new.NO_CUTS, False,
                                                               new.TILE, 3),
         "old drop_small": lambda: old.drop_small(labels_old.copy(), n_old, 20),
         "copy of the labels": lambda: lab.copy(),
-        "new relabel (+ the copy)": lambda: new.relabel(lab.copy(), roots, remap),
+        "new relabel (+ the copy)": lambda: labels.relabel(lab.copy(), roots, remap),
         "old keep_coherent": lambda: old.keep_coherent(c_lab, weak, strong, c_n, 10, 100, 20),
         "new keep_coherent": lambda: keep_coherent(coh.labels, coh.roots, coh.size,
                                                    coh.strong, strong, 10, 100, 20),

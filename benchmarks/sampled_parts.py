@@ -50,7 +50,7 @@ from robustness import DEFAULT, HARD
 import bistair
 from bistair.core import resolve
 from bistair.core.parts import split_disagreeing
-from bistair.core.resolve_jit import dense_tile, pixel_orders, window_seeds
+from bistair.core.parts_jit import dense_tile, pixel_orders, window_seeds
 from bistair.evaluation.metrics import score
 from bistair.sim import Imaging, expose, preset, preset_spec, trace
 

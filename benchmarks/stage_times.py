@@ -42,7 +42,7 @@ PATTERNS: tuple[tuple[str, tuple[str, ...]], ...] = (
         "bistair.codecs.bidirectional:thin_band_doubt",
         "bistair.codecs.bidirectional:level_offset", "bistair.codecs.bidirectional.response*:*",
         "bistair.core.split:*", "bistair.core.parts*:*",
-        "bistair.core.resolve:resolve_regions", "bistair.core.resolve:mode_by_label",
+        "bistair.core.resolve:resolve_regions",
         "bistair.core.resolve:jump_violations", "bistair.core.resolve:drop_contradicted",
         "bistair.core.resolve:settle", "bistair.core.resolve:unanchored",
         "bistair.core.resolve:code_evidence", "bistair.core.resolve_jit:label_*",

@@ -12,7 +12,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import bistair
-from bistair.core.stair import stair_phase
 
 spec = bistair.make_spec("bidirectional", width=480, height=90, period=20, partitions=4,
                          stairs=6, group_rows=30, local_rows=20)
@@ -30,7 +29,7 @@ plt.show()
 # The stair phase of the pair (Eq. 19 of the paper) along a local row and a partition row:
 # the local stair steps every fringe, the partition stair every six.
 avg = patterns[:4].mean(axis=0)
-theta, _ = stair_phase(patterns[4], patterns[5], avg)
+theta = np.arctan2(patterns[5] - avg, patterns[4] - avg)
 x = np.arange(spec.width)
 fig, ax = plt.subplots(figsize=(10, 3), layout="constrained")
 ax.plot(x, theta[5], label="local row (k mod S)")

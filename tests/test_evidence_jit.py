@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from support.reference import level_misfit
 
 from bistair.codecs import make_spec
 from bistair.codecs.bidirectional.bands import (
@@ -18,7 +19,7 @@ from bistair.codecs.bidirectional.evidence import (
     band_splits,
     region_evidence,
 )
-from bistair.core.stair import level_misfit, quantize
+from bistair.core.stair import quantize
 from bistair.sim.warp import WarpScene, render_warp
 
 RNG = np.random.default_rng(5)

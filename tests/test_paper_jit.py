@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy import ndimage
+from support.reference import mode_by_label
 
 from bistair.codecs import make_spec
 from bistair.codecs.base import measure_shifts
@@ -23,7 +24,6 @@ from bistair.codecs.bidirectional.paper_jit import (
 from bistair.core.captures import prepare
 from bistair.core.jit import set_threads
 from bistair.core.regions import fringe_regions
-from bistair.core.resolve import mode_by_label
 from bistair.core.stair import quantize
 from bistair.sim.warp import WarpScene, render_warp
 

@@ -2,10 +2,11 @@
 
 import numpy as np
 import pytest
+from support.reference import stair_phase
 
 from bistair.core.phase import TWO_PI, phase_shift_patterns, residuals, wrapped_phase
 from bistair.core.regions import fill_orders, fringe_regions, region_links
-from bistair.core.stair import quantize, stair_level_phase, stair_pair, stair_phase
+from bistair.core.stair import quantize, stair_level_phase, stair_pair
 
 
 @pytest.mark.parametrize("steps", [3, 4, 5, 8, 12])

@@ -2,7 +2,7 @@
 they replaced gave (tests/support/regions_before.py, bistair 02b6580: period_jump_links +
 fringe_links for the links, cv2.connectedComponents + reattach + drop_small for the regions,
 keep_coherent for the coherent dim pixels), and their period jumps what the NumPy reference
-bistair.core.regions.period_jumps gives: on random fields and masks (hypothesis), on renders
+support.reference.period_jumps gives: on random fields and masks (hypothesis), on renders
 decoded by several codecs at several noise levels, and on every real capture in
 ../shared/data that a decode labels."""
 
@@ -16,26 +16,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from support import regions_before as before
 from support.real_parts import parts
+from support.reference import period_jumps
 
 import bistair
 from bistair.core.jit import set_threads
 from bistair.core.measure import coherent_pixels
-from bistair.core.regions import (
-    cut_reference,
-    default_cut,
-    fringe_regions,
-    period_jumps,
-)
-from bistair.core.regions_jit import (
-    NO_CUTS,
-    TILE,
-    cut_links,
-    cut_medians,
-    label_kept,
-    link_bits,
-    relink,
-    valid_changes,
-)
+from bistair.core.regions import cut_reference, default_cut, fringe_regions
+from bistair.core.regions_cuts_jit import cut_links, cut_medians
+from bistair.core.regions_jit import NO_CUTS, TILE, link_bits, relink, valid_changes
+from bistair.core.regions_labels_jit import label_kept
 from bistair.io.read import read_with_spec
 from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.presets import preset_spec

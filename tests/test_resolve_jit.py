@@ -1,4 +1,5 @@
-"""The order resolution's compiled passes (bistair.core.resolve_jit) give exactly what the
+"""The order resolution's compiled passes (bistair.core.resolve_jit, and those of its parts:
+bistair.core.parts_jit) give exactly what the
 NumPy code they replaced gave: dense patches of wrong steps, each region's order on its
 pixels, messages between regions, votes per region and code, and the in-place fills and
 splits."""
@@ -8,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import ndimage
 
-from bistair.core.resolve_jit import dense_tile, window_seeds
+from bistair.core.parts_jit import dense_tile, window_seeds
 
 
 def _dense_before(bad, decided, share, block=8):
@@ -40,7 +41,7 @@ def test_disagreeing_windows():
 
 
 def test_pixel_orders():
-    from bistair.core.resolve_jit import pixel_orders
+    from bistair.core.parts_jit import pixel_orders
 
     rng = np.random.default_rng(10)
     labels = rng.integers(0, 6, (30, 40)).astype(np.int32)

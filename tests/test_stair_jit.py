@@ -7,16 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from support.arrays import angle_np, same
+from support.reference import relinearize, stair_phase
 
 from bistair.core.captures import ScaledStack
-from bistair.core.stair import (
-    level_readings,
-    level_table,
-    quantize,
-    relinearize,
-    stair_level_phase,
-    stair_phase,
-)
+from bistair.core.stair import level_readings, level_table, quantize, stair_level_phase
 from bistair.core.stair_jit import pair_phase, quantize32, relinearize32
 
 RNG = np.random.default_rng(7)

@@ -50,7 +50,7 @@ def octant_np(y: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def angle_np(y: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``bistair.core.phase_jit._angle`` in NumPy float32 (see :func:`octant_np`)."""
+    """``bistair.core.phase_jit.angle32`` in NumPy float32 (see :func:`octant_np`)."""
     from bistair.core import phase_jit as pj
 
     m, t = octant_np(y, x)
@@ -60,7 +60,7 @@ def angle_np(y: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def phase_np(y: np.ndarray, x: np.ndarray, offset: float = 0.0) -> np.ndarray:
-    """``bistair.core.phase_jit._phase`` in NumPy float32 (see :func:`octant_np`)."""
+    """``bistair.core.phase_jit.phase32`` in NumPy float32 (see :func:`octant_np`)."""
     from bistair.core import phase_jit as pj
 
     f = np.float32

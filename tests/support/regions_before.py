@@ -33,7 +33,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
           qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
           half: np.float32) -> bool:
     """Whether two mean gradients differ by more than ``rel`` of the larger and four times
-    their noise (float32, as :func:`bistair.core.regions.period_jumps` computes it)."""
+    their noise (float32, as :func:`support.reference.period_jumps` computes it)."""
     if pn < half or qn < half:
         return False
     dx, dy = px - qx, py - qy
@@ -125,7 +125,7 @@ def _gradient_windows(phi: np.ndarray, valid: np.ndarray, y: int, half: int,
 def period_jump_links(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, half: int,
                       relative: float) -> tuple[np.ndarray, np.ndarray]:
     """The links across which the fringes' spacing or slant jumps (see
-    :func:`bistair.core.regions.period_jumps`): ``(vertical (H-1, W), horizontal (H, W-1))``.
+    :func:`support.reference.period_jumps`): ``(vertical (H-1, W), horizontal (H, W-1))``.
 
     Gradients are wrapped phase differences along the row (``x``) and down the column
     (``y``), averaged over windows of columns: ``[x-half, x+half)`` around a pixel (for the

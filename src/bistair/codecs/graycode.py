@@ -391,7 +391,7 @@ def code_columns(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     (dtype('int32'), [0, 1, 2, 3, 4, 5, 6, 7], 0.0, 0)
     """
     if spec.steps == 0:
-        return code_alone(prepared, spec, fs, min_modulation)
+        return code_alone(prepared, fs, spec.code_bits, bool(spec.inverse), spec.fringes)
     if spec.code_levels != 2:
         return levels_code(prepared, spec, fs)
     n = spec.steps
@@ -708,7 +708,8 @@ def measure_columns(prepared: Prepared, spec: GrayCodeSpec,
     0
     """
     if spec.steps == 0:
-        return measure_alone(prepared, spec, min_modulation)
+        return measure_alone(prepared, spec.code_bits, bool(spec.inverse), spec.period,
+                             min_modulation)
     return measure_shifts(prepared, spec, min_modulation)
 
 

@@ -5,7 +5,8 @@ Frames ``gray-0 .. gray-(B-1)``, most significant bit first, each followed by it
 ``gray-i-inv`` when the spec has ``inverse``, then ``white`` and ``black`` with ``white``
 (OpenCV's order; any order through ``frames``). The cell of projector column ``x`` is
 ``floor(x / period)``: ``period`` is the cell width (1 by default: one projector pixel, as
-OpenCV's code).
+OpenCV's code). The stages take the spec's numbers (bits, inverse, cell width, cells),
+not the spec: :mod:`.graycode`, the codec, calls them.
 
 A bit is read against its inverse where the spec has them (robust to albedo and ambient
 light, as OpenCV), else against the mid-level of the white and black frames. A bit is
@@ -38,7 +39,6 @@ Examples
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -48,9 +48,6 @@ from ..core.jit import kernel_frames
 from ..core.measure import FringeSet, along_fringe_noise
 from .base import CodeMap
 from .graycode_jit import alone_cells, alone_levels
-
-if TYPE_CHECKING:
-    from .graycode import GrayCodeSpec
 
 CLEAR = 3.0  # a bit is clear at this many noise sigmas of its difference
 MIN_CLEAR = 0.005  # and by at least this fraction of full scale (noiseless captures)
@@ -122,7 +119,7 @@ def alone_noise(prepared: Prepared, bits: int, inverse: bool) -> float:
     return float(np.median(diffs) / (0.6745 * 2.0))
 
 
-def measure_alone(prepared: Prepared, spec: GrayCodeSpec,
+def measure_alone(prepared: Prepared, bits: int, inverse: bool, period: float,
                   min_modulation: float | None = None) -> FringeSet:
     """Stage 1 of a Gray code alone: contrast, validity and noise (no phase to measure).
 
@@ -131,8 +128,12 @@ def measure_alone(prepared: Prepared, spec: GrayCodeSpec,
     prepared : Prepared
         The code frames in method order, column layout, with the white and black frames
         beside them where the spec has them.
-    spec : GrayCodeSpec
-        The spec of one coded axis (``steps`` 0).
+    bits : int
+        Code bits (the spec's ``code_bits``).
+    inverse : bool
+        The frames hold each bit's inverse after it.
+    period : float
+        The cell width in projector pixels.
     min_modulation : float, optional
         The contrast (half the bright-dark difference, fraction of full scale) a decoded
         pixel needs; from the noise when not given.
@@ -155,24 +156,24 @@ def measure_alone(prepared: Prepared, spec: GrayCodeSpec,
     >>> from bistair.codecs import encode, make_spec
     >>> from bistair.core.captures import prepare
     >>> spec = make_spec("graycode", width=64, height=16, steps=0, inverse=1)
-    >>> fs = measure_alone(prepare(encode(spec), spec.frame_count, "graycode"), spec)
+    >>> cols = prepare(encode(spec), spec.frame_count, "graycode")
+    >>> fs = measure_alone(cols, spec.code_bits, True, spec.period)
     >>> bool(fs.valid.all()), float(fs.mod.max()), float(fs.phi.max()), fs.steps
     (True, 0.5, 0.0, 0)
     """
-    bits = spec.code_bits
-    noise = alone_noise(prepared, bits, bool(spec.inverse))
+    noise = alone_noise(prepared, bits, inverse)
     threshold = modulation_threshold(noise, min_modulation)
-    avg, mod = alone_levels(kernel_frames(prepared.raw)[0], bits, bool(spec.inverse),
+    avg, mod = alone_levels(kernel_frames(prepared.raw)[0], bits, inverse,
                             float(prepared.scale), _frame(prepared.white),
                             _frame(prepared.black))
     valid = mod >= np.float32(threshold)
     check_decodable(valid, prepared.clipped, min_modulation, mod)
-    phi = np.full(valid.shape, np.float32(cell_phase(spec.period)), np.float32)
+    phi = np.full(valid.shape, np.float32(cell_phase(period)), np.float32)
     return FringeSet(phi, avg, mod, valid, noise, 0, threshold)
 
 
-def code_alone(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
-               min_modulation: float | None = None) -> CodeMap:
+def code_alone(prepared: Prepared, fs: FringeSet, bits: int, inverse: bool, cells: int
+               ) -> CodeMap:
     """Stage 2 of a Gray code alone: each pixel's cell where every bit is clear (-1
     elsewhere).
 
@@ -184,12 +185,15 @@ def code_alone(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     ----------
     prepared : Prepared
         The code frames in method order, column layout.
-    spec : GrayCodeSpec
-        The spec of one coded axis (``steps`` 0).
     fs : FringeSet
         Stage 1 (:func:`measure_alone`): the valid pixels, the mid-level and the noise.
-    min_modulation : float, optional
-        Not used (stage 1 applied it).
+    bits : int
+        Code bits (the spec's ``code_bits``).
+    inverse : bool
+        The frames hold each bit's inverse after it.
+    cells : int
+        The projector's cells across the coded axis (the spec's ``fringes``): a cell from
+        there on is past the projector.
 
     Returns
     -------
@@ -205,17 +209,18 @@ def code_alone(prepared: Prepared, spec: GrayCodeSpec, fs: FringeSet,
     >>> spec = make_spec("graycode", width=40, height=8, steps=0, period=10, white=1)
     >>> cols = prepare(encode(spec), spec.frame_count, "graycode", select=range(2),
     ...                white=2, black=3)
-    >>> code = code_alone(cols, spec, measure_alone(cols, spec))
+    >>> fs = measure_alone(cols, spec.code_bits, False, spec.period)
+    >>> code = code_alone(cols, fs, spec.code_bits, False, spec.fringes)
     >>> code.code[0, ::5].tolist(), code.beyond
     ([0, 0, 1, 1, 2, 2, 3, 3], 0)
     """
     # a bit's difference: pattern - inverse (noise sqrt(2) sigma) or pattern - mid-level
     # (noise sqrt(1.5) sigma)
-    clear = max(CLEAR * fs.noise * (math.sqrt(2.0) if spec.inverse else math.sqrt(1.5)),
+    clear = max(CLEAR * fs.noise * (math.sqrt(2.0) if inverse else math.sqrt(1.5)),
                 MIN_CLEAR)
-    cell = alone_cells(kernel_frames(prepared.raw)[0], spec.code_bits, bool(spec.inverse),
+    cell = alone_cells(kernel_frames(prepared.raw)[0], bits, inverse,
                        float(prepared.scale), fs.avg, fs.valid, float(clear))
-    far = cell >= spec.fringes
+    far = cell >= cells
     beyond = int(np.count_nonzero(far))
     cell[far] = -1
     return CodeMap(cell, {}, check=EdgeCheck(0, 0.0, 0.0, 0, 0.0), beyond=beyond)

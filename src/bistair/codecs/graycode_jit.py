@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_called, _numba_inline, kernel, kernel_frames
+from ..core.jit import called, inline, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -84,7 +84,7 @@ def code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndar
 
 
 
-@_numba_inline
+@inline
 def _binary(g: np.int32) -> np.int32:
     """Gray code to binary: the XOR of all the right shifts of ``g``."""
     shift = 1
@@ -232,7 +232,7 @@ HALF32 = np.float32(math.pi)
 THREE32 = np.float32(1.5 * math.pi)
 
 
-@_numba_inline
+@inline
 def _order_of(g: np.int64, p: np.float32, mode: int, fringes: int
               ) -> tuple[np.int64, np.int64]:
     """The order the code word ``g`` gives at wrapped phase ``p`` (the rule of ``mode``)
@@ -251,7 +251,7 @@ def _order_of(g: np.int64, p: np.float32, mode: int, fringes: int
     return e, e
 
 
-@_numba_called
+@called
 def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, fringes: int,
           inverse: bool, noise_d: float, phase_noise: float, z: float, share: float,
           reach: float, target: np.int64, alone: bool) -> bool:
@@ -354,7 +354,7 @@ def _fits(d: np.ndarray, g: np.int64, p: np.float32, mod: float, mode: int, frin
     return True
 
 
-@_numba_inline
+@inline
 def _edge_distance(u: float, b: int, mode: int, fringes: int) -> float:
     """How far, in code cells, place ``u`` lies from the nearest edge of bit ``b`` (LSB 0):
     the Gray code's bit ``b`` steps at the odd multiples of ``2**b``; the cyclic code's
@@ -369,7 +369,7 @@ def _edge_distance(u: float, b: int, mode: int, fringes: int) -> float:
     return dist
 
 
-@_numba_inline
+@inline
 def _edge_margin(d: np.ndarray, level: np.int64, c_pos: float, c_neg: float) -> float:
     """The margin, as a share of the pixel's contrast, of the bit whose edge lies between
     code cells ``level - 1`` and ``level`` (-1 if the code has no such bit)."""

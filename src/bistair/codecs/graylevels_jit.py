@@ -21,12 +21,12 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel, kernel_frames
+from ..core.jit import inline, kernel, kernel_frames
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
 
-@_numba_inline
+@inline
 def _level(raw: np.ndarray, frame: int, y: int, x: int, s32: np.float32, avg: np.ndarray,
            mod: np.ndarray, valid: np.ndarray, phi: np.ndarray, reach: int,
            tol: np.float32) -> tuple[np.float32, int]:

@@ -35,8 +35,7 @@ from ..core.measure import FringeSet
 from ..core.memory import row_bands
 from ..core.regions import RegionLinks, core_weight, fringe_regions, region_links
 from ..core.resolve import code_evidence, orders_from_regions
-from ..core.stair import stair_level_phase, stair_pair
-from ..core.stair_jit import pair_phase, quantize32
+from ..core.stair import read_stairs, stair_level_phase, stair_pair
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
@@ -583,9 +582,8 @@ def code_columns(prepared: Prepared, spec: LvSpec, fs: FringeSet,
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the code phases sit ...
     """
-    theta = (fs.stair if fs.stair is not None else
-             pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg))[0]
-    codes = quantize32(theta, spec.levels, fs.valid)
+    theta, _, codes = read_stairs(prepared, spec.steps, spec.levels, fs.avg, fs.valid,
+                                  fs.stair)
     if stair_misfit(*stair_sample(fs.sample, theta, fs.valid),
                     stair_level_phase(np.arange(spec.levels), spec.levels)) > 0.7:
         refuse("the code phases sit halfway between the code's levels: are code-cos and "

@@ -43,8 +43,7 @@ from ..core.measure import FringeSet
 from ..core.phase import shifts_of, wrapped_phase
 from ..core.regions import core_weight, fringe_regions
 from ..core.resolve import code_evidence, orders_from_regions
-from ..core.stair import stair_level_phase, stair_pair
-from ..core.stair_jit import pair_phase, quantize32
+from ..core.stair import read_stairs, stair_level_phase, stair_levels, stair_pair
 from ..errors import BistairError
 from ..spec import PeriodSpec, field, format_period
 from .base import Codec, CodeMap, Orders, along_columns, fringe_index, shift_patterns
@@ -152,11 +151,11 @@ def code_columns(prepared: Prepared, spec: PhaseCodingSpec, fs: FringeSet,
     ([0, 1, 2, 3, 4, 5, 6, 7], ['code_phase'])
     """
     if spec.form == "pair":
-        theta = (fs.stair if fs.stair is not None else
-                 pair_phase(prepared.raw, spec.steps, prepared.scale, fs.avg))[0]
+        theta, _, codes = read_stairs(prepared, spec.steps, spec.levels, fs.avg, fs.valid,
+                                      fs.stair)
     else:
         theta = wrapped_phase(prepared.frames[spec.steps:], spec.shift_sign)[0]
-    codes = quantize32(theta, spec.levels, fs.valid)
+        codes = stair_levels(theta, spec.levels, fs.valid)
     return CodeMap(codes, {"code_phase": theta})
 
 

@@ -2,9 +2,10 @@
 several passes share.
 
 The compiled passes of a concept module ``X.py`` live beside it in ``X_jit.py``
-(:mod:`.phase_jit`, :mod:`.measure_jit`, :mod:`.stair_jit`, :mod:`.regions_jit`,
-:mod:`.resolve_jit`, :mod:`.checks_jit`, :mod:`.result_jit`); a pass that one codec alone
-uses lives beside that codec. Every pass is plain Python over arrays, marked with
+(:mod:`.phase_jit`, :mod:`.measure_jit`, :mod:`.stair_jit`, :mod:`.regions_jit` and its
+parts, :mod:`.resolve_jit`, :mod:`.parts_jit`, :mod:`.checks_jit`, :mod:`.result_jit`); a
+pass that one codec alone uses lives beside that codec. Callers import the concept module,
+not its twin (``tests/test_architecture.py``). Every pass is plain Python over arrays, marked with
 :func:`kernel` and compiled with numba on its first call; numba itself is imported only
 then, so importing bistair or starting the command line does not pay for it. Passes that
 loop over image rows or chunks run them on every core (``prange``); :func:`set_threads`
@@ -224,8 +225,8 @@ def dispatcher(func: Callable) -> Any:
 
     Examples
     --------
-    >>> from bistair.core.phase_jit import _arctan2
-    >>> type(dispatcher(_arctan2)).__name__
+    >>> from bistair.core.phase_jit import arctan2_flat
+    >>> type(dispatcher(arctan2_flat)).__name__
     'CPUDispatcher'
     """
     fn = func.py_func
@@ -273,8 +274,8 @@ def load_cached(func: Callable, signatures: list[tuple]) -> int:
 
     Examples
     --------
-    >>> from bistair.core.phase_jit import _arctan2
-    >>> load_cached(_arctan2, []) == 0
+    >>> from bistair.core.phase_jit import arctan2_flat
+    >>> load_cached(arctan2_flat, []) == 0
     True
     """
     compiled = dispatcher(func)
@@ -370,7 +371,7 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
 
 def _compile_helpers(module: dict[str, Any], numba: Any) -> None:
     """On a module's first kernel: its ``prange`` made numba's and its helpers (marked with
-    :func:`_numba_inline` or :func:`_numba_called`) compiled, once; a helper imported from
+    :func:`inline` or :func:`called`) compiled, once; a helper imported from
     another module is compiled after that module's own helpers, which it may call."""
     if module.get("prange") is not range:
         return
@@ -657,28 +658,59 @@ TWO_PI32 = np.float32(2.0 * math.pi)
 PI32 = np.float32(math.pi)
 
 
-def _numba_inline(fn: Callable) -> Callable:
-    """Mark a helper that the kernels call: compiled into them with ``numba.njit``."""
+def inline(fn: Callable) -> Callable:
+    """Mark a helper that the kernels call: compiled into them with ``numba.njit``.
+
+    Parameters
+    ----------
+    fn : callable
+        A plain function of numbers or arrays, in a ``*_jit.py`` module.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself, marked: the first kernel of a module that holds it (or imports it)
+        compiles it, inlined (``inline="always"``).
+
+    Examples
+    --------
+    >>> @inline
+    ... def twice(x):
+    ...     return 2 * x
+    >>> twice(3), twice._inline
+    (6, 'always')
+    """
     fn._inline = "always"  # type: ignore[attr-defined]
     return fn
 
 
-def _numba_called(fn: Callable) -> Callable:
+def called(fn: Callable) -> Callable:
     """Mark a helper that the kernels call: compiled with ``numba.njit`` on its own (not
-    inlined: numba's parallel loops miscompile some inlined bodies that write arrays)."""
+    inlined: numba's parallel loops miscompile some inlined bodies that write arrays).
+
+    Parameters
+    ----------
+    fn : callable
+        A plain function of numbers or arrays, in a ``*_jit.py`` module.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself, marked (``inline="never"``).
+
+    Examples
+    --------
+    >>> @called
+    ... def fill(out, value):
+    ...     out[:] = value
+    >>> fill._inline
+    'never'
+    """
     fn._inline = "never"  # type: ignore[attr-defined]
     return fn
 
 
-@_numba_inline
-def _wrapped(raw: np.float32) -> np.float32:
-    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it, for ``|raw| < 2pi``."""
-    d = raw + PI32
-    if d >= TWO_PI32:
-        d = d - TWO_PI32
-    elif d < 0:
-        d = d + TWO_PI32
-    return d - PI32
+_numba_inline = inline  # the old name, for geometry/'s twins until they import inline
 
 
 def chunk_count(n: int) -> int:
@@ -703,18 +735,49 @@ def chunk_count(n: int) -> int:
     return max(1, min(64, n // 4096))
 
 
-@_numba_inline
-def _fmax(a: float, b: float) -> float:
-    """``np.maximum`` of two floats (NaN from either)."""
+@inline
+def fmax(a: float, b: float) -> float:
+    """``np.maximum`` of two floats (NaN from either), for the kernels.
+
+    Parameters
+    ----------
+    a, b : float
+        Two numbers.
+
+    Returns
+    -------
+    float
+        The larger; NaN where either is NaN.
+
+    Examples
+    --------
+    >>> fmax(1.0, 2.0), fmax(float("nan"), 2.0)
+    (2.0, nan)
+    """
     if a != a or b != b:
         return a if a != a else b
     return a if a >= b else b
 
 
+@inline
+def fmin(a: float, b: float) -> float:
+    """``np.minimum`` of two floats (NaN from either), for the kernels.
 
-@_numba_inline
-def _fmin(a: float, b: float) -> float:
-    """``np.minimum`` of two floats (NaN from either)."""
+    Parameters
+    ----------
+    a, b : float
+        Two numbers.
+
+    Returns
+    -------
+    float
+        The smaller; NaN where either is NaN.
+
+    Examples
+    --------
+    >>> fmin(1.0, 2.0), fmin(1.0, float("nan"))
+    (1.0, nan)
+    """
     if a != a or b != b:
         return a if a != a else b
     return a if a <= b else b

@@ -24,8 +24,7 @@ import numpy as np
 from .captures import Prepared, ScaledStack, check_decodable, modulation_threshold
 from .checks import judge_sample
 from .measure_jit import fit_residual_energy, front_end, keep_coherent, phase_noise
-from .phase import shifts_of
-from .phase_jit import offset_parts, shift_weights
+from .phase import nstep_weights, shifts_of
 from .regions import MIN_REGION, Links, label_fringes
 from .sample import Sample, chi2_median, clip_level, kernel_view, set_noise, take_sample
 
@@ -252,7 +251,7 @@ def measure(prepared: Prepared, start: int, steps: int, min_modulation: float | 
     raw, first, cos_frame = kernel_view(prepared, start, steps, pair)
     phi, mod, avg, valid, strong, sigma, theta, stair_mod, weak = front_end(  # pass 1
         raw, first, int(steps), cos_frame, float(prepared.scale),
-        *shift_weights(steps, shift_sign), *offset_parts(phase_offset), clip_level(prepared),
+        *nstep_weights(steps, shift_sign, phase_offset), clip_level(prepared),
         float(lowest), float(threshold), np.float32(noise / np.sqrt(steps / 2.0)),
         prepared.white if contrast else none, prepared.black if contrast else none, contrast)
     if not maps:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import chunk_count, kernel, kernel_frames
-from .phase_jit import _angle, _hypot32, _phase, _quarter_sums, _quarter_turns
+from .phase_jit import angle32, hypot32, phase32, quarter_sums, quarter_turns
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -234,7 +234,7 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
     pass over tiles of rows on every core, each frame read once.
 
     Per pixel: the N-step sums (:func:`~bistair.core.phase_jit._set_sums`), the wrapped
-    phase less the phase offset in ``[0, 2*pi)`` (:func:`~bistair.core.phase_jit._phase`,
+    phase less the phase offset in ``[0, 2*pi)`` (:func:`~bistair.core.phase_jit.phase32`,
     the float32 arctangent of :func:`~bistair.core.phase_jit.arctan2_32`), the modulation
     ``2/N * hypot`` and the average (float32); whether a frame of the set or of the pair
     reaches ``full`` (clipped); valid (modulation at least ``lowest``, not saturated:
@@ -303,7 +303,7 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
     sat32 = np.float32(1.02)
     need32 = np.float32(2.0 * lowest)
     floor32 = np.float32(1e-6)
-    quarter = _quarter_turns(sin_w, cos_w)
+    quarter = quarter_turns(sin_w, cos_w)
     phi = np.empty((h, w), np.float32)
     mod = np.empty((h, w), np.float32)
     avg = np.empty((h, w), np.float32)
@@ -336,9 +336,9 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
                     v2 = r2[x]
                     v3 = r3[x]
                     top[x] = max(max(v0, v1), max(v2, v3))
-                    num, den, av = _quarter_sums(v0, v1, v2, v3, s32, sin_w, cos_w)
-                    p[x] = _phase(num, den, off_hi, off_lo)
-                    m[x] = _hypot32(num, den) * np.float32(0.5)
+                    num, den, av = quarter_sums(v0, v1, v2, v3, s32, sin_w, cos_w)
+                    p[x] = phase32(num, den, off_hi, off_lo)
+                    m[x] = hypot32(num, den) * np.float32(0.5)
                     a[x] = av
             else:  # frame by frame along the row, in frame order: the loops vectorise
                 n32 = np.float32(steps)
@@ -363,8 +363,8 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
                 for x in range(w):
                     num = -s[x]
                     a[x] = a[x] / n32
-                    p[x] = _phase(num, c[x], off_hi, off_lo)
-                    m[x] = _hypot32(num, c[x]) * mod_scale
+                    p[x] = phase32(num, c[x], off_hi, off_lo)
+                    m[x] = hypot32(num, c[x]) * mod_scale
             if pair >= 0:
                 cos_row = raw[pair, y]
                 sin_row = raw[pair + 1, y]
@@ -374,8 +374,8 @@ def front_end(raw: np.ndarray, start: int, steps: int, pair: int, scale: float,
                     top[x] = max(top[x], max(cos_row[x], sin_row[x]))
                     cc = np.float32(cos_row[x]) * s32 - a[x]
                     ss = np.float32(sin_row[x]) * s32 - a[x]
-                    th[x] = _angle(ss, cc)
-                    sm[x] = _hypot32(cc, ss)
+                    th[x] = angle32(ss, cc)
+                    sm[x] = hypot32(cc, ss)
             ok_row = valid[y]
             st_row = strong[y]
             sg = sigma[y]

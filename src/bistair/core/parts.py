@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from .resolve_jit import dense_tile, pixel_orders, window_seeds
+from .parts_jit import dense_tile, pixel_orders, window_seeds
 
 Agreement = Callable[[np.ndarray], np.ndarray]
 

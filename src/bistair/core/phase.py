@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .phase_jit import phase_of_sums32, wrap_angles
+from .phase_jit import offset_parts, phase_of_sums32, shift_weights, wrap_angles
 
 TWO_PI = 2.0 * np.pi
 
@@ -251,3 +251,37 @@ def order_from_reference(phi: np.ndarray, reference: np.ndarray) -> np.ndarray:
     [2.0, 1.0]
     """
     return np.rint((np.asarray(reference) - phi) * (1.0 / TWO_PI))
+
+
+def nstep_weights(steps: int, shift_sign: int = 1, phase_offset: float = 0.0
+                  ) -> tuple[np.ndarray, np.ndarray, np.float32, np.float32]:
+    """The constants of an N-step set's phase as the compiled passes take them (pass 0,
+    :func:`bistair.core.sample_jit.sample_pixels`, and pass 1,
+    :func:`bistair.core.measure_jit.front_end`): each frame's sine and cosine weight
+    (:func:`bistair.core.phase_jit.shift_weights`) and the phase offset in two exact parts
+    (:func:`bistair.core.phase_jit.offset_parts`).
+
+    Parameters
+    ----------
+    steps : int
+        Number of frames ``N``.
+    shift_sign : int
+        +1 or -1: the rig's direction of the phase shift.
+    phase_offset : float
+        The rig's phase offset in radians.
+
+    Returns
+    -------
+    sin_w, cos_w : (N,) float32 array
+        The weights of the N-step sums.
+    off_hi, off_lo : numpy.float32
+        The phase offset's parts.
+
+    Examples
+    --------
+    >>> sin_w, cos_w, hi, lo = nstep_weights(4, -1, np.pi / 2)
+    >>> sin_w.tolist(), cos_w.tolist(), float(hi + lo)
+    ([0.0, -1.0, 0.0, 1.0], [1.0, 0.0, -1.0, 0.0], 1.5707963705062866)
+    """
+    return (*shift_weights(steps, shift_sign), *offset_parts(phase_offset))
+

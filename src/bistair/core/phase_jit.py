@@ -2,7 +2,7 @@
 arctangent every phase of a decode comes from, the phase and modulation of N-step sums, and
 the wrap of angles.
 
-**The arctangent** (:func:`_octant`, :func:`_angle`, :func:`_phase`; :func:`arctan2_32` on
+**The arctangent** (:func:`_octant`, :func:`angle32`, :func:`phase32`; :func:`arctan2_32` on
 arrays) is a float32 minimax polynomial after reduction to ``|u| <= tan(pi/8)``, written
 with selects (its loops vectorise) in a fixed order of operations and compiled without
 fastmath (numba's default here: no reassociation, no fused multiply-add; the decode's
@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from .jit import TWO_PI32, _numba_inline, chunk_count, kernel
+from .jit import TWO_PI32, chunk_count, inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 # atan(u) = u + u*s*P(s), s = u*u, on |u| <= tan(pi/8): a minimax fit (Lawson's iteration on
@@ -45,10 +45,10 @@ _PI4_HI = np.float32(round(math.pi / 4 / _QUANTUM) * _QUANTUM)
 _PI4_LO = np.float32(math.pi / 4 - float(_PI4_HI))
 _TWO_PI_HI = np.float32(8.0 * float(_PI4_HI))
 _TWO_PI_LO = np.float32(2.0 * math.pi - float(_TWO_PI_HI))
-ATAN_ERROR = 3.2e-7  # the largest error of _phase and _angle (radians), measured: see arctan2_32
+ATAN_ERROR = 3.2e-7  # the largest error of phase32 and angle32 (radians), measured: see arctan2_32
 
 
-@_numba_inline
+@inline
 def _octant(y: np.float32, x: np.float32) -> tuple[np.float32, np.float32]:
     """``(m, t)`` with ``atan2(y, x) = m*pi/4 + t`` for ``y >= 0`` (``m`` a whole number 0-4
     as float32, ``|t| <= pi/8``); the caller mirrors it for ``y < 0``. Float32, branch-free
@@ -75,10 +75,27 @@ def _octant(y: np.float32, x: np.float32) -> tuple[np.float32, np.float32]:
     return m, t
 
 
-@_numba_inline
-def _angle(y: np.float32, x: np.float32) -> np.float32:
+@inline
+def angle32(y: np.float32, x: np.float32) -> np.float32:
     """``arctan2(y, x)`` in ``[-pi, pi]`` of finite float32 values, float32 (see
-    :func:`arctan2_32`; ``atan2(-0.0, x < 0)`` is ``pi`` here)."""
+    :func:`arctan2_32`; ``atan2(-0.0, x < 0)`` is ``pi`` here): the angle the kernels of
+    the stair pair and of the stair's noise use.
+
+    Parameters
+    ----------
+    y, x : numpy.float32
+        The sine and cosine parts.
+
+    Returns
+    -------
+    numpy.float32
+        The angle in radians.
+
+    Examples
+    --------
+    >>> float(angle32(np.float32(1.0), np.float32(-1.0)))  # 3*pi/4 in float32
+    2.356194496154785
+    """
     m, t = _octant(y, x)
     below = y < np.float32(0.0)
     m = -m if below else m
@@ -86,12 +103,30 @@ def _angle(y: np.float32, x: np.float32) -> np.float32:
     return m * _PI4_HI + (m * _PI4_LO + t)  # m * _PI4_HI is exact
 
 
-@_numba_inline
-def _phase(y: np.float32, x: np.float32, off_hi: np.float32, off_lo: np.float32
+@inline
+def phase32(y: np.float32, x: np.float32, off_hi: np.float32, off_lo: np.float32
            ) -> np.float32:
     """The phase of ``(x, y)`` less a phase offset (``off_hi + off_lo``,
     :func:`offset_parts`), in ``[0, 2*pi)``, float32, one rounding at the end (see
-    :func:`arctan2_32`)."""
+    :func:`arctan2_32`): the wrapped phase of every pass that measures one.
+
+    Parameters
+    ----------
+    y, x : numpy.float32
+        The sine and cosine sums.
+    off_hi, off_lo : numpy.float32
+        The phase offset in two parts (:func:`offset_parts`).
+
+    Returns
+    -------
+    numpy.float32
+        The phase in ``[0, 2*pi)``.
+
+    Examples
+    --------
+    >>> float(phase32(np.float32(-1.0), np.float32(0.0), *offset_parts(0.0)))  # 3*pi/2
+    4.71238899230957
+    """
     m, t = _octant(y, x)
     below = y < np.float32(0.0)
     m = np.float32(8.0) - m if below else m  # 2*pi - angle
@@ -110,30 +145,83 @@ def _phase(y: np.float32, x: np.float32, off_hi: np.float32, off_lo: np.float32
     return r if (r >= np.float32(0.0) and r < TWO_PI32) else np.float32(0.0)
 
 
-@_numba_inline
-def _hypot32(a: np.float32, b: np.float32) -> np.float32:
+@inline
+def hypot32(a: np.float32, b: np.float32) -> np.float32:
     """``hypot(a, b)`` of float32 values in float32: the square root of ``a*a + b*b``
     (correctly rounded; values of a capture neither overflow nor matter where they
-    underflow)."""
+    underflow).
+
+    Parameters
+    ----------
+    a, b : numpy.float32
+        Two sums.
+
+    Returns
+    -------
+    numpy.float32
+        The length of ``(a, b)``.
+
+    Examples
+    --------
+    >>> float(hypot32(np.float32(3.0), np.float32(4.0)))
+    5.0
+    """
     return np.sqrt(a * a + b * b)
 
 
-@_numba_inline
-def _quarter_turns(sin_w: np.ndarray, cos_w: np.ndarray) -> bool:
+@inline
+def quarter_turns(sin_w: np.ndarray, cos_w: np.ndarray) -> bool:
     """Four shifts a quarter turn apart (:func:`shift_weights` of N = 4): weights 0 where
-    :func:`_quarter_sums` leaves them out."""
+    :func:`quarter_sums` leaves them out.
+
+    Parameters
+    ----------
+    sin_w, cos_w : (N,) float32 array
+        The weights of :func:`shift_weights`.
+
+    Returns
+    -------
+    bool
+        :func:`quarter_sums` gives their sums.
+
+    Examples
+    --------
+    >>> bool(quarter_turns(*shift_weights(4))), bool(quarter_turns(*shift_weights(3)))
+    (True, False)
+    """
     return (sin_w.size == 4 and sin_w[0] == 0 and sin_w[2] == 0 and cos_w[1] == 0
             and cos_w[3] == 0)
 
 
-@_numba_inline
-def _quarter_sums(v0: Any, v1: Any, v2: Any, v3: Any, scale: np.float32,
+@inline
+def quarter_sums(v0: Any, v1: Any, v2: Any, v3: Any, scale: np.float32,
                   sin_w: np.ndarray, cos_w: np.ndarray
                   ) -> tuple[np.float32, np.float32, np.float32]:
     """``(num, den, avg)`` of a pixel's four quarter-turn frames (raw values times
     ``scale``): ``-(s1*f1 + s3*f3)``, ``c0*f0 + c2*f2`` and the mean, float32; what the
     frame-by-frame sums over all four weights give (the others are 0), in fewer
-    operations."""
+    operations.
+
+    Parameters
+    ----------
+    v0, v1, v2, v3 : number
+        The pixel's raw values in the four frames.
+    scale : numpy.float32
+        Raw value to intensity.
+    sin_w, cos_w : (4,) float32 array
+        The weights (:func:`quarter_turns` of them is true).
+
+    Returns
+    -------
+    tuple of numpy.float32
+        ``(num, den, avg)``.
+
+    Examples
+    --------
+    >>> s = quarter_sums(2, 3, 0, 1, np.float32(1.0), *shift_weights(4))
+    >>> [float(v) for v in s]
+    [-2.0, 2.0, 1.5]
+    """
     f0 = np.float32(v0) * scale
     f1 = np.float32(v1) * scale
     f2 = np.float32(v2) * scale
@@ -226,15 +314,32 @@ def arctan2_32(y: np.ndarray, x: np.ndarray) -> np.ndarray:
     [0.0, 0.785398, -2.356194, 3.141593]
     """
     yf = np.ascontiguousarray(y, np.float32).reshape(-1)
-    out = _arctan2(yf, np.ascontiguousarray(x, np.float32).reshape(-1))
+    out = arctan2_flat(yf, np.ascontiguousarray(x, np.float32).reshape(-1))
     return out.reshape(np.shape(y))
 
 
 @kernel(parallel=True)
-def _arctan2(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+def arctan2_flat(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The pass of :func:`arctan2_32`: :func:`angle32` of each pair, over flat arrays.
+
+    Parameters
+    ----------
+    y, x : (n,) float32 array
+        Contiguous, the same size.
+
+    Returns
+    -------
+    (n,) float32 array
+        The angles in radians.
+
+    Examples
+    --------
+    >>> arctan2_flat(np.float32([0.0, 1.0]), np.float32([1.0, 0.0])).tolist()
+    [0.0, 1.5707963705062866]
+    """
     out = np.empty(y.size, np.float32)
     for i in prange(y.size):  # (one flat loop: numba vectorises it)
-        out[i] = _angle(y[i], x[i])
+        out[i] = angle32(y[i], x[i])
     return out
 
 
@@ -248,8 +353,8 @@ def _phase_of_sums(num: np.ndarray, den: np.ndarray, off_hi: np.float32, off_lo:
         for i in range(c * n // chunks, (c + 1) * n // chunks):
             a = num[i]
             b = den[i]
-            phi[i] = _phase(a, b, off_hi, off_lo)
-            mod[i] = _hypot32(a, b) * scale
+            phi[i] = phase32(a, b, off_hi, off_lo)
+            mod[i] = hypot32(a, b) * scale
     return phi, mod
 
 

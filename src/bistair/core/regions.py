@@ -25,106 +25,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from .phase import TWO_PI, order_from_reference, wrap
-from .regions_jit import (
-    NO_CUTS,
-    TILE,
-    band_links,
-    cut_links,
-    cut_medians,
-    label_kept,
-    link_bits,
-    relabel,
-    relink,
-    valid_changes,
-    wrap_links,
-)
+from .regions_cuts_jit import band_links, cut_links, cut_medians
+from .regions_jit import NO_CUTS, TILE, link_bits, relink, valid_changes
+from .regions_labels_jit import label_kept, relabel, wrap_links
 
 MIN_REGION = 20  # pixels: smaller fringe regions are noise islands, never votes
-
-
-def period_jumps(phi: np.ndarray, valid: np.ndarray, sigma: np.ndarray | float,
-                 relative: float = 0.3, half: int = 3) -> tuple[np.ndarray, np.ndarray]:
-    """NumPy reference of the period jumps that :func:`~bistair.core.regions_jit.link_bits`
-    cuts (with ``half`` 3, as a decode runs it): the links across which the fringes'
-    spacing or slant jumps (vertical links (H-1, W), horizontal links (H, W-1)) to cut.
-
-    Where one surface hides another the wrapped phase may happen to run on across the edge,
-    but its gradient (the fringe period and slant in the image) jumps. Both gradient
-    components are averaged over windows of ``half`` pixels along the row on each side of a
-    horizontal link, or around the two ends of a vertical link; a link is cut where the
-    averages differ by more than ``relative`` of the larger gradient and by more than four
-    times their noise (``sigma``: per-pixel phase noise, radians). Only links between two
-    valid pixels are cut (no other link joins a region).
-
-    Parameters
-    ----------
-    phi : (H, W) float array
-        Wrapped phase in ``[0, 2*pi)``.
-    valid : (H, W) bool array
-        Pixels whose phase counts.
-    sigma : (H, W) float array or float
-        Per-pixel phase noise in radians.
-    relative : float
-        Share of the larger mean gradient by which the two must differ.
-    half : int
-        Window length in pixels (each window also needs ``half`` valid gradients).
-
-    Returns
-    -------
-    vert : (H-1, W) bool array
-        Links between each pixel and the one below it to cut.
-    horiz : (H, W-1) bool array
-        Links between each pixel and the one to its right to cut.
-
-    Examples
-    --------
-    >>> x = np.arange(40.0)
-    >>> phi = np.tile(np.where(x < 20, 0.2 * x, 0.6 * x) % (2 * np.pi), (6, 1))
-    >>> vert, horiz = period_jumps(phi, np.ones(phi.shape, bool), 0.01)
-    >>> np.flatnonzero(horiz[0]).tolist(), bool(vert.any())
-    ([16, 17, 18, 19, 21, 22], False)
-    """
-    h, w = phi.shape
-    noise = np.broadcast_to(np.asarray(sigma, np.float32), (h, w))
-
-    def wrapped(a: np.ndarray, b: np.ndarray, ok: np.ndarray) -> np.ndarray:
-        return (((b - a + np.pi) % TWO_PI) - np.pi).astype(np.float32) * ok
-
-    ok_x = (valid[:, 1:] & valid[:, :-1]).astype(np.float32)
-    gx = np.zeros((h, w), np.float32)
-    nx = np.zeros((h, w), np.float32)
-    gx[:, :-1] = wrapped(phi[:, :-1], phi[:, 1:], ok_x)
-    nx[:, :-1] = ok_x
-    ok_y = (valid[1:] & valid[:-1]).astype(np.float32)
-    gy = np.zeros((h, w), np.float32)
-    ny = np.zeros((h, w), np.float32)
-    gy[:-1] = wrapped(phi[:-1], phi[1:], ok_y)
-    ny[:-1] = ok_y
-    sums = [np.pad(np.cumsum(a, axis=1), ((0, 0), (1, 0))) for a in (gx, nx, gy, ny)]
-
-    def window(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Mean gradients and the samples behind them over columns [lo, hi)."""
-        lo, hi = np.clip(lo, 0, w), np.clip(hi, 0, w)
-        sx, cx, sy, cy = (c[:, hi] - c[:, lo] for c in sums)
-        return sx / np.maximum(cx, 1), sy / np.maximum(cy, 1), np.minimum(cx, cy)
-
-    def cut(a: tuple, b: tuple, noise_a: np.ndarray, noise_b: np.ndarray) -> np.ndarray:
-        (ax, ay, na), (bx, by, nb) = a, b
-        step = np.hypot(ax - bx, ay - by)
-        size = np.maximum(np.hypot(ax, ay), np.hypot(bx, by))
-        spread = 2.0 * np.maximum(noise_a / np.sqrt(np.maximum(na, 1)),
-                                  noise_b / np.sqrt(np.maximum(nb, 1)))
-        return ((step > relative * size) & (step > 4.0 * spread)
-                & (na >= half) & (nb >= half))
-
-    x = np.arange(w)
-    around = window(x - half, x + half)  # gradients around each pixel
-    vert = cut(tuple(v[:-1] for v in around), tuple(v[1:] for v in around),
-               noise[:-1], noise[1:]) & (ok_y > 0)
-    xl = np.arange(w - 1)
-    left, right = window(xl - half, xl), window(xl + 1, xl + 1 + half)
-    horiz = cut(left, right, noise[:, :-1], noise[:, 1:]) & (ok_x > 0)
-    return vert, horiz
 
 
 def fringe_direction(phi: np.ndarray, valid: np.ndarray) -> int:
@@ -178,7 +83,7 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
     The gradient is the hypotenuse of the median absolute wrapped neighbour differences
     along the rows and down the columns, on every fourth row and column. A float32 phase
     has its medians taken in one compiled pass
-    (:func:`~bistair.core.regions_jit.cut_medians`): the same threshold, bit for bit, as
+    (:func:`~bistair.core.regions_cuts_jit.cut_medians`): the same threshold, bit for bit, as
     :func:`cut_reference`.
 
     Parameters
@@ -216,7 +121,7 @@ def default_cut(phi: np.ndarray, valid: np.ndarray) -> float:
 
 def cut_reference(phi: np.ndarray, valid: np.ndarray) -> float:
     """NumPy reference of :func:`default_cut` (of its compiled medians,
-    :func:`~bistair.core.regions_jit.cut_medians`): three times the hypotenuse of the
+    :func:`~bistair.core.regions_cuts_jit.cut_medians`): three times the hypotenuse of the
     median wrapped neighbour differences on every fourth row and column, in [0.6, 2.2].
 
     Parameters
@@ -292,7 +197,7 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     """The fringe regions of :func:`fringe_regions` before small ones are dropped and the
     labels numbered: the links (:func:`~bistair.core.regions_jit.link_bits`), then the kept
     pixels labelled and the dropped ones reattached, with per-region counts
-    (:func:`~bistair.core.regions_jit.label_kept`).
+    (:func:`~bistair.core.regions_labels_jit.label_kept`).
 
     With ``share``, the links are handed on in ``Labelling.links`` (:class:`Links`) for
     the next labelling of the same ``phi`` and ``phase_noise`` (the same arrays): given
@@ -300,9 +205,9 @@ def label_fringes(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     weak mask, then its regions on the valid pixels with its own cuts), that labelling
     takes them over, makes again only the rows that read a row whose validity changed
     (:func:`~bistair.core.regions_jit.relink`; where those are at most three quarters of
-    the rows) and adds its cuts (:func:`~bistair.core.regions_jit.cut_links`), where its
+    the rows) and adds its cuts (:func:`~bistair.core.regions_cuts_jit.cut_links`), where its
     direction is the first one's and no link's step lies between the two cut thresholds
-    (:func:`~bistair.core.regions_jit.band_links`). The same links, bit for bit, as its
+    (:func:`~bistair.core.regions_cuts_jit.band_links`). The same links, bit for bit, as its
     own pass; they are taken over once (a later labelling given them makes its own).
 
     Parameters
@@ -407,9 +312,10 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
     """Label fringe regions of ``phi`` (wrapped, in ``[0, 2*pi)``) over the ``valid`` mask.
 
     Links are cut at wraps, at steps above ``cut``, where the fringe period jumps
-    (:func:`period_jumps`) and, along the rows, where the phase runs backwards (against
-    :func:`fringe_direction`) by more than noise explains (``phase_noise``: per-pixel phase
-    noise in radians, 0.02 when not given): that is where one surface meets another.
+    (``tests/support/reference.py:period_jumps``) and, along the rows, where the phase runs
+    backwards (against :func:`fringe_direction`) by more than noise explains
+    (``phase_noise``: per-pixel phase noise in radians, 0.02 when not given): that is where
+    one surface meets another.
     ``boundaries`` adds links to cut that a codec found itself (vertical links (H-1, W),
     horizontal links (H, W-1)). A link cut at a wrap drops its high-phase pixel, any
     other cut both; the pixels kept are labelled (4-connected), then the dropped ones join
@@ -470,7 +376,7 @@ def fringe_regions(phi: np.ndarray, valid: np.ndarray, cut: float | None = None,
 def kept_regions(lab: Labelling, min_size: int = MIN_REGION) -> tuple[np.ndarray, int]:
     """The final number of each region of :func:`label_fringes`: regions of at least
     ``min_size`` pixels numbered ``1..n`` in their order, the others 0 (what
-    :func:`fringe_regions` writes through :func:`~bistair.core.regions_jit.relabel`).
+    :func:`fringe_regions` writes through :func:`~bistair.core.regions_labels_jit.relabel`).
 
     Parameters
     ----------

@@ -1,8 +1,8 @@
-"""Compiled passes of the fringe regions (:mod:`bistair.core.regions`): the links between
-neighbouring pixels (wraps, phase steps, backward runs, fringe period jumps, a codec's own
-cuts) in one pass over row tiles, the kept pixels labelled by union-find over row tiles
-(with per-region counts gathered in the same scan), dropped pixels reattached, the final
-numbering, and the wraps between regions.
+"""Compiled passes of the fringe regions (:mod:`bistair.core.regions`), their first half:
+the links between neighbouring pixels (wraps, phase steps, backward runs, fringe period
+jumps, a codec's own cuts) in one pass over row tiles, and the medians of the cut. The
+labelling of the kept pixels, the final numbering and the wraps between regions are the
+second half, :mod:`.regions_labels_jit`.
 
 A decode runs them in this order (:func:`bistair.core.regions.label_fringes`):
 
@@ -10,18 +10,12 @@ A decode runs them in this order (:func:`bistair.core.regions.label_fringes`):
    where a labelling takes over the links of an earlier one of the same phase, the
    rows that read a row whose validity changed made again, :func:`valid_changes` and
    :func:`relink`, and the codec's cuts added, :func:`cut_links`);
-2. :func:`label_kept`: provisional labels of the kept pixels (4-connected), their regions
-   numbered ``1..n`` in raster order of each region's first pixel (as
-   ``cv2.connectedComponents(kept, connectivity=4)`` numbers them), the valid pixels not
-   kept reattached to a region they link to, pixels and pixels of a second mask counted
-   per region;
-3. :func:`relabel`: the final labels, written row by row in raster order (the hook for
-   sums per (region, row): see its docstring).
+2. :func:`~.regions_labels_jit.label_kept`, then 3. :func:`~.regions_labels_jit.relabel`.
 
-Each gives exactly what the passes it replaced gave (``period_jump_links``,
-``fringe_links``, ``cv2.connectedComponents``, ``reattach`` and ``drop_small`` of bistair
-0.x, kept in ``tests/support/regions_before.py`` as the tests' oracle;
-:func:`bistair.core.regions.period_jumps` is the NumPy reference of the period jumps).
+Each gives exactly what the passes it replaced gave (``period_jump_links`` and
+``fringe_links`` of bistair 0.x, kept in ``tests/support/regions_before.py`` as the tests'
+oracle; ``tests/support/reference.py:period_jumps`` is the NumPy reference of the period
+jumps).
 
 Examples
 --------
@@ -33,18 +27,14 @@ Examples
 ...                  NO_CUTS, NO_CUTS, False)
 >>> (bits[0, 28:32] & KEPT).tolist()  # the wrap between columns 29 and 30: 29 dropped
 [4, 0, 4, 4]
->>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, TILE, 3)
->>> n, size.tolist()  # column 29 reattached
-(2, [0, 120, 120])
 """
-
 from __future__ import annotations
 
 import math
 
 import numpy as np
 
-from .jit import PI32, TWO_PI32, _numba_called, _numba_inline, kernel
+from .jit import PI32, TWO_PI32, called, inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -57,128 +47,12 @@ HALF = 3  # gradients in a period-jump window (as the decode uses it; fixed at c
 NO_CUTS = np.zeros((0, 0), np.bool_)  # no codec cuts, no second mask
 
 
-@_numba_called
-def _median_bits(vals: np.ndarray, hist: np.ndarray) -> np.float32:
-    """The median of ``vals`` (float32 in ``[+0, 4)``, at least one: their bit patterns
-    sort as the values do) as :func:`numpy.median` gives it (the middle value, or the
-    float32 mean of the two middle values): the values counted by their top 16 bits
-    (``hist``: zeros, one bin each, left as found), then the middle ranks selected
-    among those of the middle bins. (Compiled on its own: inlined twice into
-    :func:`cut_medians` it ran six times slower.)"""
-    n = vals.shape[0]
-    bins = hist.shape[0]
-    bits = vals.view(np.uint32)
-    for i in range(n):
-        hist[bits[i] >> 16] += 1
-    lo_k = (n - 1) // 2  # the two middle ranks (the same for an odd count)
-    hi_k = n // 2
-    seen = 0
-    below = 0  # values in the bins under the lower middle rank's
-    lo_bin = bins
-    hi_bin = bins - 1
-    for b in range(bins):
-        c = hist[b]
-        if lo_bin == bins and seen + c > lo_k:
-            lo_bin = b
-            below = seen
-        if seen + c > hi_k:
-            hi_bin = b
-            break
-        seen += c
-    mid = np.empty(seen + hist[hi_bin] - below, np.float32)
-    m = 0
-    for i in range(n):
-        b = bits[i] >> 16
-        if lo_bin <= b <= hi_bin:
-            mid[m] = vals[i]
-            m += 1
-    for i in range(n):
-        hist[bits[i] >> 16] = 0
-    k = lo_k - below
-    mid = np.partition(mid, k)  # (a selection: ties are equal bits)
-    a = mid[k]
-    return a if hi_k == lo_k else (a + mid[k + 1:].min()) / np.float32(2.0)
-
-
-@kernel()
-def cut_medians(phi: np.ndarray, valid: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
-    """The two medians of :func:`bistair.core.regions.default_cut`, bit for bit: of the
-    absolute wrapped differences ``min(g, 2pi - g)`` (float32) between valid neighbours
-    on every fourth row and column, along the rows (pixel ``(4i, 4j)`` and the one to
-    its right) and down the columns (``(4i, 4j)`` and the one below), without NumPy's
-    strided copies and sorts.
-
-    Parameters
-    ----------
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    valid : (H, W) bool array
-        Pixels whose phase counts.
-
-    Returns
-    -------
-    meds : (2,) float32 array
-        The medians along the rows and down the columns (0 where there is no pair).
-    counts : (2,) int64 array
-        The pairs behind each.
-    ok : bool
-        False where a difference is NaN or not below 4 (``meds`` then not to be read:
-        NumPy's own median decides).
-
-    Examples
-    --------
-    >>> phi = np.tile(np.float32(2 * np.pi) * np.arange(40, dtype=np.float32) / 10
-    ...               % np.float32(2 * np.pi), (8, 1))
-    >>> meds, counts, ok = cut_medians(phi, np.ones(phi.shape, bool))
-    >>> [round(float(m), 4) for m in meds], counts.tolist(), ok
-    ([0.6283, 0.0], [20, 20], True)
-    """
-    h, w = phi.shape
-    two_pi = TWO_PI32
-    rows = (h + 3) // 4
-    cols = (w + 3) // 4
-    vals = np.empty((2, rows * cols + 1), np.float32)  # (+1: the last write not kept)
-    counts = np.zeros(2, np.int64)
-    nx = 0
-    ny = 0
-    for y in range(0, h, 4):  # each value written, kept where its pair is valid (no
-        p = phi[y]  # branch on the validity: half of them would be mispredicted)
-        v = valid[y].view(np.uint8)
-        for x in range(0, w - 1, 4):
-            g = abs(p[x + 1] - p[x])
-            t = two_pi - g
-            vals[0, nx] = t if t < g else g  # (NaN kept)
-            nx += v[x] & v[x + 1]
-        if y + 1 < h:
-            q = phi[y + 1]
-            u = valid[y + 1].view(np.uint8)
-            for x in range(0, w, 4):
-                g = abs(q[x] - p[x])
-                t = two_pi - g
-                vals[1, ny] = t if t < g else g
-                ny += v[x] & u[x]
-    counts[0] = nx
-    counts[1] = ny
-    meds = np.zeros(2, np.float32)
-    for r in range(2):  # negative, NaN or 4 and more: not for the bit patterns' order
-        bits = vals[r, :counts[r]].view(np.uint32)
-        for i in range(bits.shape[0]):
-            if bits[i] >= np.uint32(0x40800000):
-                return meds, counts, False
-    hist = np.zeros(0x4080, np.int32)  # (the top 16 bits of 4.0)
-    if nx > 0:
-        meds[0] = _median_bits(vals[0, :nx], hist)
-    if ny > 0:
-        meds[1] = _median_bits(vals[1, :ny], hist)
-    return meds, counts, True
-
-
-@_numba_inline
+@inline
 def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np.float32,
           qn: np.float32, noise_p: np.float32, noise_q: np.float32, rel: np.float32,
           half: np.float32) -> bool:
     """Whether two mean gradients differ by more than ``rel`` of the larger and four times
-    their noise (float32, as :func:`bistair.core.regions.period_jumps` computes it)."""
+    their noise (float32, as ``tests/support/reference.py:period_jumps`` computes it)."""
     if pn < half or qn < half:
         return False
     dx, dy = px - qx, py - qy
@@ -199,7 +73,7 @@ def _jump(px: np.float32, py: np.float32, pn: np.float32, qx: np.float32, qy: np
     return step > rel * size
 
 
-@_numba_inline
+@inline
 def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
            rel: np.float32) -> bool:
     """Not clearly below ``rel`` of the larger gradient: :func:`_jump`'s first test, which
@@ -209,7 +83,7 @@ def _steep(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
                 * np.float32(0.9999))
 
 
-@_numba_inline
+@inline
 def _loud(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
           noise_p: np.float32, noise_q: np.float32, inv_p: np.float32,
           inv_q: np.float32) -> bool:
@@ -224,7 +98,7 @@ def _loud(px: np.float32, py: np.float32, qx: np.float32, qy: np.float32,
     return not (d2 < square * np.float32(0.999)) or square < np.float32(1e-30)
 
 
-@_numba_inline
+@inline
 def _inverse_root(count: np.float32, inv3: np.float32, inv4: np.float32, inv5: np.float32,
                   inv6: np.float32) -> np.float32:
     """``1/sqrt(count)`` for a window count of 3 to 6, chosen by selects (for a vector
@@ -232,17 +106,18 @@ def _inverse_root(count: np.float32, inv3: np.float32, inv4: np.float32, inv5: n
     return inv3 if count == 3 else (inv4 if count == 4 else (inv5 if count == 5 else inv6))
 
 
-@_numba_inline
+@inline
 def _wrap_sel(raw: np.float32) -> np.float32:
-    """:func:`bistair.core.jit._wrapped` as two selects (the same value for every input,
-    NaN and infinities included: after the first step ``d`` is never below 0)."""
+    """``((raw + pi) % 2pi) - pi`` in float32, as NumPy computes it for ``|raw| < 2pi``, as
+    two selects (the same value as two branches for every input, NaN and infinities
+    included: after the first step ``d`` is never below 0)."""
     d = raw + PI32
     d = d - TWO_PI32 if d >= TWO_PI32 else d
     d = d + TWO_PI32 if d < np.float32(0.0) else d
     return d - PI32
 
 
-@_numba_inline
+@inline
 def _gradients(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, below: bool,
                g: np.ndarray) -> None:
     """A row's wrapped gradients and their counts, for :func:`_windows`: ``g[0]``, ``g[1]``
@@ -277,7 +152,7 @@ def _gradients(p: np.ndarray, v: np.ndarray, pb: np.ndarray, vb: np.ndarray, bel
             ny[x + 3] = zero
 
 
-@_numba_inline
+@inline
 def _windows(g: np.ndarray, s: np.ndarray, twice: bool, around: np.ndarray,
              ahead: np.ndarray, ahead_too: bool, around2: np.ndarray, ahead2: np.ndarray,
              ahead2_too: bool) -> None:
@@ -336,7 +211,7 @@ def _windows(g: np.ndarray, s: np.ndarray, twice: bool, around: np.ndarray,
         _counts(g[r, 2], g[r, 3], a[2], b[2], too)
 
 
-@_numba_inline
+@inline
 def _means(s: np.ndarray, n: np.ndarray, around: np.ndarray, ahead: np.ndarray,
            ahead_too: bool) -> None:
     """A row's window means of one gradient (:func:`_windows`): ``around[x] = (s[x+6] -
@@ -355,7 +230,7 @@ def _means(s: np.ndarray, n: np.ndarray, around: np.ndarray, ahead: np.ndarray,
             around[x] = np.divide(s[x + 6] - s[x], max(c, one))
 
 
-@_numba_inline
+@inline
 def _counts(nx: np.ndarray, ny: np.ndarray, around: np.ndarray, ahead: np.ndarray,
             ahead_too: bool) -> None:
     """A row's window counts (:func:`_windows`): the smaller of the two gradients'."""
@@ -370,7 +245,7 @@ def _counts(nx: np.ndarray, ny: np.ndarray, around: np.ndarray, ahead: np.ndarra
             ahead[x] = min(cx, cy)
 
 
-@_numba_inline
+@inline
 def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32, pos: bool,
                 st: np.ndarray, raw: np.ndarray, back: np.ndarray) -> None:
     """The states of a row's horizontal links, ``st[x+1]`` for the link between ``x`` and
@@ -420,7 +295,7 @@ def _row_states(p: np.ndarray, v: np.ndarray, nz: np.ndarray, cut32: np.float32,
                 st[k + 1] = 4
 
 
-@_numba_called
+@called
 def _link_rows(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, sign: int,
                relative: float, cut_v: np.ndarray, cut_h: np.ndarray, cuts: bool, y0: int,
                y1: int, out: np.ndarray) -> None:
@@ -587,7 +462,7 @@ def link_bits(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float,
 
     A link between two valid pixels is cut at a wrap (``|difference| > pi``: its high-phase
     end is dropped), at a step above ``cut``, where the fringes' spacing or slant jumps
-    (:func:`bistair.core.regions.period_jumps`, windows of 3 gradients, ``relative``), at a
+    (``tests/support/reference.py:period_jumps``, windows of 3 gradients, ``relative``), at a
     cut the codec gives (``cut_v``, ``cut_h`` with ``cuts``) and, along the rows, in a run
     of links against the phase's direction ``sign`` whose fall exceeds
     ``max(0.15, 4 sigma)`` (``sigma``: ``sqrt(2)`` times the larger phase noise of a link's
@@ -677,54 +552,6 @@ def valid_changes(bits: np.ndarray, valid: np.ndarray) -> np.ndarray:
 
 
 @kernel(parallel=True)
-def band_links(phi: np.ndarray, valid: np.ndarray, low: float, high: float) -> int:
-    """The links between two valid neighbours whose phase step lies in ``(low, high]``
-    (float32, as :func:`link_bits` compares a step with its cut): where none does, a cut
-    threshold of ``low`` and one of ``high`` make the same links.
-
-    Parameters
-    ----------
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    valid : (H, W) bool array
-        Pixels to link.
-    low, high : float
-        The two thresholds (compared in float32).
-
-    Returns
-    -------
-    int
-        Links, along the rows and down the columns.
-
-    Examples
-    --------
-    >>> phi = np.float32([[0.0, 1.0, 1.5], [0.0, 0.2, 3.0]])
-    >>> band_links(phi, np.ones(phi.shape, bool), 0.9, 1.0)  # the step of 1.0 only
-    1
-    """
-    h, w = phi.shape
-    lo = np.float32(low)
-    hi = np.float32(high)
-    valid8 = valid.view(np.uint8)
-    count = np.zeros(h, np.int64)
-    for y in prange(h):
-        p = phi[y]
-        v = valid8[y]
-        c = 0
-        for x in range(w - 1):
-            a = abs(p[x + 1] - p[x])
-            c += (v[x] & v[x + 1]) & ((a > lo) & (a <= hi))
-        if y + 1 < h:
-            q = phi[y + 1]
-            u = valid8[y + 1]
-            for x in range(w):
-                a = abs(q[x] - p[x])
-                c += (v[x] & u[x]) & ((a > lo) & (a <= hi))
-        count[y] = c
-    return int(count.sum())
-
-
-@kernel(parallel=True)
 def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, sign: int,
            relative: float, bits: np.ndarray, changed: np.ndarray) -> int:
     """:func:`link_bits` (without a codec's cuts) of a ``valid`` mask, in place of the bytes
@@ -786,416 +613,5 @@ def relink(phi: np.ndarray, valid: np.ndarray, noise: np.ndarray, cut: float, si
         _link_rows(phi, valid8, noise, cut, sign, relative, none, none, False, starts[i],
                    ends[i], bits)
     return made
-
-
-@kernel(parallel=True)
-def cut_links(bits: np.ndarray, cut_v: np.ndarray, cut_h: np.ndarray) -> np.ndarray:
-    """A codec's cuts added to :func:`link_bits`' bytes made without them: a link that
-    connects and is cut connects no more and drops both its pixels. The same bytes, bit
-    for bit, as :func:`link_bits` with the cuts (a codec's cut acts only on a link that
-    would connect: a wrap, a step, a backward run or a period jump cuts it anyway, and
-    the backward runs are found before the codec's cuts).
-
-    Parameters
-    ----------
-    bits : (H, W) uint8 array
-        :func:`link_bits` without cuts.
-    cut_v, cut_h : (H-1, W) and (H, W-1) bool arrays
-        Vertical and horizontal links the codec cuts.
-
-    Returns
-    -------
-    (H, W) uint8 array
-        The bytes with the cuts.
-
-    Examples
-    --------
-    >>> bits = np.full((2, 3), LINK_RIGHT | LINK_DOWN | KEPT | VALID, np.uint8)
-    >>> bits[:, 2] &= ~np.uint8(LINK_RIGHT)
-    >>> bits[1] &= ~np.uint8(LINK_DOWN)
-    >>> cut_links(bits, np.zeros((1, 3), bool),
-    ...           np.array([[False, True], [False, False]])).tolist()
-    [[15, 10, 10], [13, 13, 12]]
-    """
-    h, w = bits.shape
-    out = np.empty((h, w), np.uint8)
-    cv = cut_v.view(np.uint8)
-    ch = cut_h.view(np.uint8)
-    right = np.uint8(LINK_RIGHT)
-    down = np.uint8(LINK_DOWN)
-    every = np.uint8(255)
-    no_right = np.uint8(255 - LINK_RIGHT - KEPT)  # masks: the bits a cut leaves
-    no_down = np.uint8(255 - LINK_DOWN - KEPT)
-    no_kept = np.uint8(255 - KEPT)
-    for t in prange((h + TILE - 1) // TILE):
-        for y in range(t * TILE, min(t * TILE + TILE, h)):
-            b = bits[y]
-            o = out[y]
-            c = ch[y]
-            for x in range(w):  # a link cut where it connects: selects, a vector loop
-                o[x] = b[x]
-            for x in range(w - 1):
-                cr = (c[x] != 0) & ((b[x] & right) != 0)
-                o[x] &= no_right if cr else every
-            for x in range(1, w):
-                cl = (c[x - 1] != 0) & ((b[x - 1] & right) != 0)
-                o[x] &= no_kept if cl else every
-            if y < h - 1:
-                d = cv[y]
-                for x in range(w):
-                    cd = (d[x] != 0) & ((b[x] & down) != 0)
-                    o[x] &= no_down if cd else every
-            if y > 0:
-                u = cv[y - 1]
-                a = bits[y - 1]
-                for x in range(w):
-                    cu = (u[x] != 0) & ((a[x] & down) != 0)
-                    o[x] &= no_kept if cu else every
-    return out
-
-
-@_numba_inline
-def _find(parent: np.ndarray, a: np.int32) -> np.int32:
-    """The root of ``a`` (paths halved on the way)."""
-    while parent[a] != a:
-        parent[a] = parent[parent[a]]
-        a = parent[a]
-    return a
-
-
-@_numba_inline
-def _union(parent: np.ndarray, a: np.int32, b: np.int32) -> None:
-    """Join the trees of ``a`` and ``b`` under the smaller root: a root is always its
-    tree's smallest id (``parent[i] <= i``)."""
-    a = _find(parent, a)
-    b = _find(parent, b)
-    if a < b:
-        parent[b] = a
-    elif b < a:
-        parent[a] = b
-
-
-@_numba_called
-def _label_rows(bits: np.ndarray, strong: np.ndarray, count_strong: bool, y0: int, y1: int,
-                base: int, labels: np.ndarray, parent: np.ndarray, size: np.ndarray,
-                bright: np.ndarray, dropped: np.ndarray) -> tuple[int, int]:
-    """Label the kept pixels of rows ``y0 .. y1-1`` by runs along the rows (a run takes the
-    label of the pixel above its first pixel, or a new id from ``base``; the labels above
-    the rest of the run are joined to it), counting each id's pixels (``size``) and
-    ``strong`` pixels (``bright``, with ``count_strong``), and list the valid pixels not
-    kept (``dropped``: ``(y - y0) * W + x``, in raster order). Returns the ids made and the
-    pixels listed. The rows above ``y0`` are not looked at."""
-    w = bits.shape[1]
-    nxt = base
-    listed = 0
-    for y in range(y0, y1):
-        b = bits[y]
-        lab = labels[y]
-        for x in range(w):
-            lab[x] = 0
-        up = labels[y - 1] if y > y0 else lab  # (the zeros of this row: no label above)
-        s = strong[y] if count_strong else b  # (uint8 rows)
-        row = (y - y0) * w
-        x = 0
-        while x < w:
-            if not b[x] & KEPT:
-                if b[x] & VALID:
-                    dropped[listed] = row + x
-                    listed += 1
-                x += 1
-                continue
-            start = x
-            last = up[x]
-            if last != 0:
-                cur = last
-            else:
-                cur = np.int32(nxt)
-                parent[nxt] = nxt
-                size[nxt] = 0
-                bright[nxt] = 0
-                nxt += 1
-            lit = 0
-            while x < w and b[x] & KEPT:
-                u = up[x]
-                if u != last:
-                    if u != 0 and u != cur:
-                        _union(parent, cur, u)
-                    last = u
-                lab[x] = cur
-                if count_strong:
-                    lit += s[x] != 0
-                x += 1
-            size[cur] += x - start
-            bright[cur] += lit
-    return nxt - base, listed
-
-
-@_numba_called
-def _reattach(labels: np.ndarray, bits: np.ndarray, ty: np.ndarray, tx: np.ndarray,
-              roots: np.ndarray, size: np.ndarray, bright: np.ndarray, strong: np.ndarray,
-              count_strong: bool, passes: int) -> None:
-    """Give the pixels ``(ty, tx)`` (valid, not kept, label 0) the label of a neighbour
-    they are linked to (below, above, right, left: the first labelled one), ``passes``
-    times; each pass reads the labels the previous one left. A pixel takes its
-    neighbour's label as it is (a provisional id, or 0), so the regions ``roots[labels]``
-    are those of the same reattachment on final labels; the counts per region follow."""
-    n = ty.shape[0]
-    got = np.zeros(n, np.int32)
-    for _ in range(passes):
-        if n == 0:
-            break
-        for i in range(n):
-            y = ty[i]
-            x = tx[i]
-            g = np.int32(0)
-            if bits[y, x] & LINK_DOWN:
-                g = labels[y + 1, x]
-            if g == 0 and y > 0 and bits[y - 1, x] & LINK_DOWN:
-                g = labels[y - 1, x]
-            if g == 0 and bits[y, x] & LINK_RIGHT:
-                g = labels[y, x + 1]
-            if g == 0 and x > 0 and bits[y, x - 1] & LINK_RIGHT:
-                g = labels[y, x - 1]
-            got[i] = g
-        m = 0
-        for i in range(n):
-            g = got[i]
-            labels[ty[i], tx[i]] = g
-            if g == 0:
-                ty[m] = ty[i]
-                tx[m] = tx[i]
-                m += 1
-            else:
-                r = roots[g]
-                size[r] += 1
-                if count_strong:
-                    bright[r] += strong[ty[i], tx[i]] != 0
-        n = m
-
-
-@kernel(parallel=True)
-def label_kept(bits: np.ndarray, strong: np.ndarray, count_strong: bool, tile: int,
-               passes: int) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:
-    """The fringe regions of :func:`link_bits`' bytes, before their final numbering:
-    4-connected regions of the ``KEPT`` pixels, numbered ``1..n`` in raster order of each
-    region's first pixel (the numbering of ``cv2.connectedComponents(kept,
-    connectivity=4)``), then the valid pixels that were not kept given the label of a
-    neighbour they still link to (below, above, right, left: the first labelled one,
-    ``passes`` rounds, each reading the labels the last one left); per region its pixels
-    and, with ``count_strong``, its ``strong`` pixels, gathered in the same scan.
-
-    Tiles of ``tile`` rows are labelled on every core (union-find by runs along the rows,
-    the ids of tile ``t`` from ``t * cap + 1``, ``cap`` the most runs a tile can hold),
-    joined across their boundary rows, then the roots (each tree's smallest id: the id of
-    its region's first pixel) numbered in id order. The final labels are
-    ``roots[labels]`` (:func:`relabel`).
-
-    Parameters
-    ----------
-    bits : (H, W) uint8 array
-        :func:`link_bits`.
-    strong : (H, W) bool array
-        A second mask whose pixels are counted per region (read only with
-        ``count_strong``; else any array, e.g. ``NO_CUTS``).
-    count_strong : bool
-        Count ``strong``.
-    tile : int
-        Rows a task labels (the result does not depend on it).
-    passes : int
-        Rounds of reattachment (0: none).
-
-    Returns
-    -------
-    labels : (H, W) int32 array
-        Provisional ids, 0 outside the regions.
-    roots : (ids,) int32 array
-        The region of each id (defined at the ids in use and at 0, which is 0).
-    n : int
-        Number of regions.
-    size : (n+1,) int64 array
-        Pixels per region (``size[0]`` 0).
-    bright : (n+1,) int64 array
-        ``strong`` pixels per region (zeros without ``count_strong``).
-
-    Examples
-    --------
-    >>> bits = np.uint8([[4, 4, 0, 4], [8, 4, 0, 4], [4, 0, 4, 4]])
-    >>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, 1, 0)
-    >>> n, roots[labels].tolist(), size.tolist()
-    (3, [[1, 1, 0, 2], [0, 1, 0, 2], [3, 0, 2, 2]], [0, 3, 4, 1])
-    >>> bits[1, 0] |= LINK_RIGHT  # the valid pixel not kept links to its right
-    >>> labels, roots, n, size, _ = label_kept(bits, NO_CUTS, False, 1, 3)
-    >>> roots[labels].tolist()[1], size.tolist()
-    ([1, 1, 0, 2], [0, 4, 4, 1])
-    """
-    h, w = bits.shape
-    tiles = (h + tile - 1) // tile
-    cap = tile * ((w + 1) // 2)  # runs of kept pixels a tile can hold: ids it may make
-    labels = np.empty((h, w), np.int32)
-    parent = np.empty(tiles * cap + 1, np.int32)  # these three touched only where used
-    size = np.empty(tiles * cap + 1, np.int32)
-    bright = np.empty(tiles * cap + 1, np.int32)
-    dropped = np.empty(tiles * tile * w, np.int32)
-    made = np.zeros(tiles, np.int64)
-    listed = np.zeros(tiles, np.int64)
-    strong8 = strong.view(np.uint8)
-    for t in prange(tiles):
-        made[t], listed[t] = _label_rows(bits, strong8, count_strong, t * tile,
-                                         min(t * tile + tile, h), t * cap + 1, labels,
-                                         parent, size, bright, dropped[t * tile * w:])
-    for t in range(1, tiles):  # join the tiles across their boundary rows
-        below = labels[t * tile]
-        above = labels[t * tile - 1]
-        last_a = np.int32(0)
-        last_b = np.int32(0)
-        for x in range(w):
-            a = above[x]
-            b = below[x]
-            if a != 0 and b != 0 and (a != last_a or b != last_b):
-                _union(parent, a, b)
-                last_a = a
-                last_b = b
-    # number the roots in id order; ``parent[i] < i`` is numbered before ``i``: the tree
-    # of ``i`` is its region (``parent`` becomes ``roots`` in place)
-    n = 0
-    parent[0] = 0
-    for t in range(tiles):
-        for i in range(t * cap + 1, t * cap + 1 + made[t]):
-            if parent[i] == i:
-                n += 1
-                parent[i] = n
-            else:
-                parent[i] = parent[parent[i]]
-    region_size = np.zeros(n + 1, np.int64)
-    region_bright = np.zeros(n + 1, np.int64)
-    for t in range(tiles):
-        for i in range(t * cap + 1, t * cap + 1 + made[t]):
-            r = parent[i]
-            region_size[r] += size[i]
-            region_bright[r] += bright[i]
-    if passes > 0:
-        ty = np.empty(listed.sum(), np.int64)
-        tx = np.empty(listed.sum(), np.int64)
-        k = 0
-        for t in range(tiles):
-            for i in range(t * tile * w, t * tile * w + listed[t]):
-                ty[k] = t * tile + dropped[i] // w
-                tx[k] = dropped[i] % w
-                k += 1
-        _reattach(labels, bits, ty, tx, parent, region_size, region_bright, strong8,
-                  count_strong, passes)
-    return labels, parent, n, region_size, region_bright
-
-
-@_numba_called
-def _relabel_rows(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, y0: int,
-                  y1: int) -> None:
-    """:func:`relabel` of rows ``y0 .. y1-1`` (a run of one label looked up once)."""
-    for y in range(y0, y1):
-        row = labels[y]
-        last = np.int32(0)
-        final = np.int32(0)
-        for x in range(row.shape[0]):
-            lab = row[x]
-            if lab != last:
-                last = lab
-                final = remap[roots[lab]]
-            row[x] = final
-
-
-@kernel(parallel=True)
-def relabel(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray) -> None:
-    """The final labels in place: ``remap[roots[labels]]`` (``remap``: the number each
-    region keeps, 0 for one dropped), row by row on every core.
-
-    **The hook for sums per (region, row)** (bidirectional's stair sums are gathered
-    there: :func:`bistair.codecs.bidirectional.profiles_jit.relabel_sums`, which writes
-    the final labels as this does, tile by tile): this is the last pass over the labels, and
-    it visits each row's pixels in raster order with their final label. A kernel that
-    wants per-(label, row) sums of other per-pixel values runs its own loop over tiles of
-    rows, calls :func:`_relabel_rows` for the tile, then adds its values pixel by pixel
-    into one slot per (label, row) while the rows are in cache: the same float64 sums, bit
-    for bit, as a scan of the final labels (pixels added in raster order), and no scan of
-    its own. The entries per row are known from the rows' runs of one label.
-
-    Parameters
-    ----------
-    labels : (H, W) int32 array
-        Labels (0: none; ``roots[0]`` and ``remap[0]`` are 0), changed in place.
-    roots : int32 array
-        The region of each label (:func:`label_kept`).
-    remap : (n+1,) int32 array
-        The final number of each region.
-
-    Examples
-    --------
-    >>> labels = np.int32([[5, 5, 0, 7]])
-    >>> roots = np.zeros(8, np.int32)
-    >>> roots[5], roots[7] = 1, 2
-    >>> relabel(labels, roots, np.int32([0, 0, 1]))  # region 1 dropped
-    >>> labels.tolist()
-    [[0, 0, 0, 1]]
-    """
-    h = labels.shape[0]
-    for t in prange((h + TILE - 1) // TILE):
-        _relabel_rows(labels, roots, remap, t * TILE, min(t * TILE + TILE, h))
-
-
-@kernel()
-def wrap_links(phi: np.ndarray, labels: np.ndarray, sign: int
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Neighbour pairs of different regions across a phase wrap, walking down the columns
-    and along the rows (a wrap along a row against the phase's direction ``sign`` is left
-    out): ``(src, dst, step)``, step +1 where the phase falls from ``src`` to ``dst``.
-
-    Parameters
-    ----------
-    phi : (H, W) float32 array
-        Wrapped phase in ``[0, 2*pi)``.
-    labels : (H, W) int32 array
-        Region labels, 0 outside any.
-    sign : int
-        +1 or -1, the phase's direction along the rows.
-
-    Returns
-    -------
-    src, dst : int64 arrays
-        Labels of the first and second pixel of each pair (one entry per pixel pair).
-    step : int64 array
-        +1 where the phase falls across the wrap (from near 2*pi to near 0), else -1.
-
-    Examples
-    --------
-    >>> phi = np.float32([[5.0, 6.0, 0.5, 1.5]])
-    >>> labels = np.int32([[1, 1, 2, 2]])
-    >>> [a.tolist() for a in wrap_links(phi, labels, 1)]
-    [[1], [2], [1]]
-    >>> [a.tolist() for a in wrap_links(phi, labels, -1)]  # against the phase's direction
-    [[], [], []]
-    """
-    h, w = phi.shape
-    src = []
-    dst = []
-    step = []
-    for y in range(h):
-        for x in range(w):
-            la = labels[y, x]
-            if la <= 0:
-                continue
-            if y + 1 < h:
-                lb = labels[y + 1, x]
-                if lb > 0 and lb != la and abs(phi[y + 1, x] - phi[y, x]) > PI32:
-                    src.append(la)
-                    dst.append(lb)
-                    step.append(1 if phi[y, x] > phi[y + 1, x] else -1)
-            if x + 1 < w:
-                lb = labels[y, x + 1]
-                if lb > 0 and lb != la and abs(phi[y, x + 1] - phi[y, x]) > PI32:
-                    st = 1 if phi[y, x] > phi[y, x + 1] else -1
-                    if st == sign:
-                        src.append(la)
-                        dst.append(lb)
-                        step.append(st)
-    return (np.array(src, np.int64), np.array(dst, np.int64), np.array(step, np.int64))
 
 

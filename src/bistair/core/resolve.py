@@ -1,18 +1,24 @@
 """Fringe-order resolution shared by the codecs.
 
-* :func:`mode_by_label`: the most frequent value per label (the paper's per-fringe mode).
+* :func:`orders_from_regions`: the region decoders' entry: fringe orders per pixel from
+  fringe regions and each region's evidence for every order (a codec's own,
+  e.g. :func:`code_evidence`: the votes of its pixels' codes);
 * :func:`resolve_regions`: pick one order per fringe region from its own evidence and the
-  rule that orders step by exactly one across each wrap (max-sum message passing).
+  rule that orders step by exactly one across each wrap (max-sum message passing);
 * :func:`jump_violations`: how many wrap links break that rule.
 
 Examples
 --------
 >>> import numpy as np
->>> labels = np.array([1, 1, 1, 2, 2, 0])
->>> values = np.array([4, 4, 5, 7, 7, 9])
->>> mode, support = mode_by_label(labels, values, n_labels=2, n_values=10)
->>> mode.tolist(), support.tolist()
-([-1, 4, 7], [0, 2, 2])
+>>> from bistair.core.regions import fringe_regions
+>>> x = np.arange(60.0) + 0.5
+>>> phi = np.tile((2 * np.pi * x / 30) % (2 * np.pi), (8, 1)).astype(np.float32)
+>>> ok = np.ones(phi.shape, bool)
+>>> code = np.tile((x // 30).astype(np.int64), (8, 1))
+>>> def evidence_of(labels, n):
+...     return labels, n, code_evidence(labels, n, code, 2)
+>>> orders_from_regions(phi, ok, fringe_regions(phi, ok)[0], evidence_of)[0, ::15].tolist()
+[0, 0, 1, 1]
 """
 
 from __future__ import annotations
@@ -31,58 +37,6 @@ from .resolve_jit import (
     pass_messages,
 )
 from .split import adopt_demanded, contradicted_regions, split_contradicted
-
-
-def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_values: int,
-                  weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`~bistair.codecs.bidirectional.paper_jit.run_label_modes`,
-    which a decode runs: the most frequent value (0..n_values-1) per label 1..n_labels; label
-    0 and values < 0 ignored.
-
-    Returns ``(mode, support)`` indexed by label (index 0 unused, mode -1 where no vote).
-
-    Parameters
-    ----------
-    labels : int array
-        Region label per pixel (0: none), any shape.
-    values : int array
-        Value per pixel, same shape; negative values abstain.
-    n_labels : int
-        Highest label.
-    n_values : int
-        Values run 0 .. n_values-1.
-    weights : float array, optional
-        Vote weight per pixel, same shape (1 each when not given).
-
-    Returns
-    -------
-    mode : (n_labels + 1,) int64 array
-        The most supported value per label (the smallest of ties), -1 where no vote.
-    support : (n_labels + 1,) array
-        Its vote count (or summed weight): int64 without ``weights``, float64 with them.
-
-    Examples
-    --------
-    >>> labels = np.array([1, 1, 1, 2, 2, 0])
-    >>> values = np.array([4, 4, 5, 7, -1, 9])
-    >>> mode, support = mode_by_label(labels, values, n_labels=2, n_values=10)
-    >>> mode.tolist(), support.tolist()
-    ([-1, 4, 7], [0, 2, 1])
-    >>> weights = np.array([0.1, 0.1, 1.0, 1.0, 1.0, 1.0])
-    >>> mode_by_label(labels, values, 2, 10, weights)[0].tolist()
-    [-1, 5, 7]
-    """
-    labels = np.asarray(labels).ravel()
-    values = np.asarray(values).ravel()
-    sel = (labels > 0) & (values >= 0)
-    w = None if weights is None else np.asarray(weights, np.float64).ravel()[sel]
-    key = labels[sel].astype(np.int64) * n_values + values[sel]
-    counts = np.bincount(key, weights=w, minlength=(n_labels + 1) * n_values)
-    counts = counts.reshape(n_labels + 1, n_values)
-    mode = counts.argmax(axis=1)
-    support = counts.max(axis=1)
-    mode[support <= 0] = -1
-    return mode.astype(np.int64), support
 
 
 def resolve_regions(evidence: np.ndarray, links: RegionLinks, link_weight: float = 0.5,

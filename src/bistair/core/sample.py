@@ -55,8 +55,7 @@ from scipy import special
 
 from .captures import Prepared
 from .jit import kernel_frames
-from .phase import shifts_of
-from .phase_jit import offset_parts, shift_weights
+from .phase import nstep_weights, shifts_of
 from .sample_jit import masked_median, residual_energy, sample_pixels, second_differences
 
 ROW_STEP = 16  # a run of three adjacent rows every ROW_STEP rows
@@ -256,7 +255,7 @@ def take_sample(prepared: Prepared, start: int, steps: int, pair: int | None,
     rows, cols = sample_grid(*raw.shape[1:])
     values, phi, mod, avg, clipped, theta, stair_mod = sample_pixels(
         raw, first, int(steps), cos_frame, float(prepared.scale),
-        *shift_weights(steps, shift_sign), *offset_parts(phase_offset), clip_level(prepared),
+        *nstep_weights(steps, shift_sign, phase_offset), clip_level(prepared),
         rows, cols)
     if raw is not prepared.raw:  # (frames converted for the kernel: the captures' own)
         values = prepared.raw[:, rows][:, :, cols]

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import kernel
-from .phase_jit import _angle, _hypot32, _phase, _quarter_sums, _quarter_turns
+from .phase_jit import angle32, hypot32, phase32, quarter_sums, quarter_turns
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -224,7 +224,7 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
     n32 = np.float32(steps)
     zero = np.float32(0.0)
     full32 = np.float32(full)
-    quarter = _quarter_turns(sin_w, cos_w)
+    quarter = quarter_turns(sin_w, cos_w)
     values = np.empty((frames, nr, nc), raw.dtype)
     phi = np.empty((nr, nc), np.float32)
     mod = np.empty((nr, nc), np.float32)
@@ -250,9 +250,9 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
             r3 = values[start + 3, i]
             for j in range(nc):
                 top[j] = max(max(r0[j], r1[j]), max(r2[j], r3[j]))
-                num, den, av = _quarter_sums(r0[j], r1[j], r2[j], r3[j], s32, sin_w, cos_w)
-                p[j] = _phase(num, den, off_hi, off_lo)
-                m[j] = _hypot32(num, den) * np.float32(0.5)
+                num, den, av = quarter_sums(r0[j], r1[j], r2[j], r3[j], s32, sin_w, cos_w)
+                p[j] = phase32(num, den, off_hi, off_lo)
+                m[j] = hypot32(num, den) * np.float32(0.5)
                 a[j] = av
         else:
             s = np.empty(nc, np.float32)
@@ -278,8 +278,8 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
             for j in range(nc):
                 num = -s[j]
                 a[j] = a[j] / n32
-                p[j] = _phase(num, c[j], off_hi, off_lo)
-                m[j] = _hypot32(num, c[j]) * mod_scale
+                p[j] = phase32(num, c[j], off_hi, off_lo)
+                m[j] = hypot32(num, c[j]) * mod_scale
         if pair >= 0:
             cos_row = values[pair, i]
             sin_row = values[pair + 1, i]
@@ -289,8 +289,8 @@ def sample_pixels(raw: np.ndarray, start: int, steps: int, pair: int, scale: flo
                 top[j] = max(top[j], max(cos_row[j], sin_row[j]))
                 cc = np.float32(cos_row[j]) * s32 - a[j]
                 ss = np.float32(sin_row[j]) * s32 - a[j]
-                th[j] = _angle(ss, cc)
-                sm[j] = _hypot32(cc, ss)
+                th[j] = angle32(ss, cc)
+                sm[j] = hypot32(cc, ss)
         cl = clipped[i]
         for j in range(nc):
             cl[j] = np.float32(top[j]) >= full32

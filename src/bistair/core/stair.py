@@ -1,5 +1,10 @@
 """Stair phases: levels, the cos/sin coded pair, the decoded stair phase and its quantisation.
 
+The decode's path: :func:`read_stairs` (the pair's phase, modulation and levels),
+:func:`stair_levels` (the levels of a phase read otherwise) and :func:`relinearize_levels`
+(the phase through a level table, and its levels); their compiled passes are in
+:mod:`.stair_jit`. :func:`quantize` is the same quantisation in NumPy.
+
 A stair of ``levels`` steps uses the phases ``-pi + pi/levels + 2*pi*j/levels`` (Eq. 13-14),
 so level ``j`` is the centre of the bin ``[-pi + 2*pi*j/levels, -pi + 2*pi*(j+1)/levels)``.
 The top level sits next to the wrap at ``+-pi``; quantisation is taken modulo ``levels`` so
@@ -21,8 +26,9 @@ import math
 
 import numpy as np
 
+from . import stair_jit
+from .captures import Prepared
 from .phase import TWO_PI, wrap
-from .phase_jit import arctan2_32
 
 
 def stair_level_phase(level: np.ndarray | int, levels: int) -> np.ndarray | float:
@@ -83,42 +89,6 @@ def stair_pair(theta: np.ndarray, offset: float = 0.5, amplitude: float = 0.5) -
     return np.stack([offset + amplitude * np.cos(theta), offset + amplitude * np.sin(theta)])
 
 
-def stair_phase(cos_frame: np.ndarray, sin_frame: np.ndarray,
-                avg: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """NumPy reference of :func:`~bistair.core.stair_jit.pair_phase`, which a decode runs:
-    the decoded stair phase in ``[-pi, pi)`` and its modulation (Eq. 19).
-
-    ``avg`` is the average intensity of the fringe frames (Eq. 9).
-
-    Parameters
-    ----------
-    cos_frame, sin_frame : ndarray
-        The captured cosine and sine stair frames, shape (H, W) (any shape, any dtype), as
-        fractions of full scale.
-    avg : ndarray
-        Average intensity ``A`` of the fringe frames, broadcastable to the frames.
-
-    Returns
-    -------
-    theta : ndarray
-        Float32 stair phase in radians (:func:`~bistair.core.phase_jit.arctan2_32` of the frames
-        minus ``avg``).
-    modulation : ndarray
-        Float32 length of that (cos, sin) vector (``sqrt(c*c + s*s)`` in float32), same
-        shape.
-
-    Examples
-    --------
-    >>> c, s = stair_pair(stair_level_phase(np.arange(4), 4))
-    >>> theta, mod = stair_phase(c, s, np.full(4, 0.5))
-    >>> theta.astype(float).round(4).tolist(), mod.astype(float).round(3).tolist()
-    ([-2.3562, -0.7854, 0.7854, 2.3562], [0.5, 0.5, 0.5, 0.5])
-    """
-    c = np.asarray(cos_frame, dtype=np.float32) - np.asarray(avg, np.float32)
-    s = np.asarray(sin_frame, dtype=np.float32) - np.asarray(avg, np.float32)
-    return arctan2_32(s, c), np.sqrt(c * c + s * s)
-
-
 def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
     """Stair level index of the phase ``theta`` (Eq. 20), modulo ``levels``; int32 (an int
     for a float phase).
@@ -149,35 +119,6 @@ def quantize(theta: np.ndarray | float, levels: int) -> np.ndarray | int:
     scale = (levels / TWO_PI) if theta.dtype != np.float32 else np.float32(levels / TWO_PI)
     scaled = (theta + (np.pi if theta.dtype != np.float32 else np.float32(np.pi))) * scale
     return np.floor(scaled).astype(np.int32) % np.int32(levels)
-
-
-def level_misfit(theta: float, level: int, levels: int) -> float:
-    """NumPy reference of the band evidence's compiled ``_level_misfit``, which a decode runs:
-    the squared distance of a phase from a stair level, in half steps (0 on the level, 1 at
-    the border of its quantisation bin).
-
-    Parameters
-    ----------
-    theta : float
-        Stair phase in radians.
-    level : int
-        Stair level index, 0 .. levels-1.
-    levels : int
-        Number of steps of the stair.
-
-    Returns
-    -------
-    float
-        ``(d / (pi/levels))**2`` with ``d`` the wrapped difference between ``theta`` and the
-        level's phase (:func:`stair_level_phase`).
-
-    Examples
-    --------
-    >>> level_misfit(float(stair_level_phase(2, 6)), 2, 6), round(level_misfit(0.0, 2, 6), 9)
-    (0.0, 1.0)
-    """
-    d = (theta - stair_level_phase(level, levels) + math.pi) % TWO_PI
-    return ((d - math.pi) / (math.pi / levels)) ** 2
 
 
 def half_gaps(levels: np.ndarray) -> np.ndarray:
@@ -218,7 +159,7 @@ def level_readings(levels: np.ndarray, exponent: float, offset: float = 0.5,
 
     The pair ``(offset + amplitude*cos(theta)) ** exponent``, ``(offset + amplitude *
     sin(theta)) ** exponent``, read against the fringes' average (the mean of ``(offset +
-    amplitude*cos(psi)) ** exponent`` over a period), as :func:`stair_phase` reads it. Ambient
+    amplitude*cos(psi)) ** exponent`` over a period), as :func:`read_stairs` reads it. Ambient
     light, albedo and gain cancel; a linear response (``exponent`` 1) reads every level
     where the patterns put it.
 
@@ -369,30 +310,112 @@ def level_table(readings: np.ndarray, levels: np.ndarray, bins: int = 8192) -> n
     return wrap(np.interp(grid, x, y)).astype(np.float32)
 
 
-def relinearize(theta: np.ndarray, table: np.ndarray) -> np.ndarray:
-    """NumPy reference of :func:`~bistair.core.stair_jit.relinearize32`, which a decode runs:
-    stair phases through a :func:`level_table` (float32 arithmetic, as the kernel's).
+def read_stairs(prepared: Prepared, first: int, levels: int, avg: np.ndarray,
+                valid: np.ndarray, pair: tuple[np.ndarray, np.ndarray] | None = None
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The stair pair's phase, modulation and level per pixel: the pair that pass 1 read
+    (``pair``: :attr:`bistair.core.measure.FringeSet.stair`) or, where it read none, frames
+    ``first`` (cosine) and ``first + 1`` (sine) read now, centred on ``avg``
+    (:func:`bistair.core.stair_jit.pair_phase`), and its level (:func:`stair_levels`).
 
     Parameters
     ----------
-    theta : ndarray
-        Stair phases in radians in [-pi, pi], any shape.
-    table : (bins,) float32 array
-        From :func:`level_table`.
+    prepared : Prepared
+        The capture stack.
+    first : int
+        Index of the cosine frame in ``prepared.raw``; the sine frame follows it.
+    levels : int
+        Number of steps of the stair.
+    avg : (H, W) float32 array
+        The fringes' average intensity ``A``.
+    valid : (H, W) bool array
+        Pixels whose level is read.
+    pair : tuple of two (H, W) float32 arrays, optional
+        The phase and modulation already read (then the frames are not read again).
 
     Returns
     -------
-    float32 ndarray
-        The mapped phases, ``theta``'s shape.
+    theta : (H, W) float32 array
+        The stair phase in radians, in ``[-pi, pi]``.
+    modulation : (H, W) float32 array
+        The length of the pair's vector.
+    level : (H, W) int32 array
+        The level of ``theta`` (as :func:`quantize`), -1 where not valid.
+
+    Examples
+    --------
+    >>> from bistair.core.captures import Prepared
+    >>> c, s = stair_pair(stair_level_phase(np.arange(4), 4))
+    >>> raw = np.round(np.stack([c, s])[:, None] * 255).astype(np.uint8)
+    >>> prepared = Prepared(raw, 255.0)
+    >>> theta, mod, level = read_stairs(prepared, 0, 4, np.full((1, 4), 0.5, np.float32),
+    ...                                 np.array([[True, True, True, False]]))
+    >>> level.tolist(), theta.astype(float).round(2).tolist()
+    ([[0, 1, 2, -1]], [[-2.36, -0.79, 0.79, 2.36]])
+    """
+    theta, mod = pair if pair is not None else stair_jit.pair_phase(
+        prepared.raw, first, prepared.scale, avg)
+    return theta, mod, stair_levels(theta, levels, valid)
+
+
+def stair_levels(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
+    """The level of each pixel's stair phase, -1 where not valid: :func:`quantize` in one
+    pass (:func:`bistair.core.stair_jit.quantize32`, the same levels bit for bit).
+
+    Parameters
+    ----------
+    theta : (H, W) float32 array
+        Stair phase in radians.
+    levels : int
+        Number of steps of the stair.
+    valid : (H, W) bool array
+        Pixels to quantise.
+
+    Returns
+    -------
+    (H, W) int32 array
+        Level indices, -1 where not valid.
+
+    Examples
+    --------
+    >>> theta = stair_level_phase(np.arange(6), 6).astype(np.float32)[None]
+    >>> stair_levels(theta, 6, theta > -2).tolist()
+    [[-1, 1, 2, 3, 4, 5]]
+    """
+    return stair_jit.quantize32(theta, levels, valid)
+
+
+def relinearize_levels(theta: np.ndarray, table: np.ndarray, levels: int, valid: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The stair phase through a :func:`level_table` and its levels in one pass
+    (:func:`bistair.core.stair_jit.relinearize32`).
+
+    Parameters
+    ----------
+    theta : (H, W) float32 array
+        Stair phase in radians.
+    table : (bins,) float32 array
+        From :func:`level_table`.
+    levels : int
+        Number of steps of the stair.
+    valid : (H, W) bool array
+        Pixels to quantise.
+
+    Returns
+    -------
+    mapped : (H, W) float32 array
+        The phase through the table.
+    level : (H, W) int32 array
+        Its level (as :func:`stair_levels`), -1 where not valid.
 
     Examples
     --------
     >>> levels = stair_level_phase(np.arange(6), 6)
     >>> readings = level_readings(levels, 2.2)
-    >>> mapped = relinearize(readings.astype(np.float32), level_table(readings, levels))
-    >>> bool(np.allclose(mapped, levels, atol=1e-3))
-    True
+    >>> theta = readings.astype(np.float32)[None]
+    >>> mapped, level = relinearize_levels(theta, level_table(readings, levels), 6,
+    ...                                    np.ones(theta.shape, bool))
+    >>> level.tolist(), bool(np.allclose(mapped, levels, atol=1e-3))
+    ([[0, 1, 2, 3, 4, 5]], True)
     """
-    step = np.float32(table.size / TWO_PI)
-    index = ((np.asarray(theta, dtype=np.float32) + np.float32(np.pi)) * step).astype(np.int64)
-    return table[np.clip(index, 0, table.size - 1)]
+    return stair_jit.relinearize32(theta, table, levels, valid)

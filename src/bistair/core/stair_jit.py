@@ -1,8 +1,10 @@
 """Compiled passes of the stair phase (:mod:`bistair.core.stair`), which the stair codecs
 share: the stair pair's phase and modulation in one pass, and its quantisation to levels.
 
-:func:`bistair.core.stair.stair_phase` and :func:`bistair.core.stair.quantize` are the
-NumPy references; these give the same, bit for bit (the arctangent is
+The codecs call them through their face, :mod:`bistair.core.stair` (``read_stairs``,
+``stair_levels``, ``relinearize_levels``). :func:`bistair.core.stair.quantize` and, in the
+tests, ``tests/support/reference.py`` (``stair_phase``, ``relinearize``) are the NumPy
+references; these give the same, bit for bit (the arctangent is
 :func:`bistair.core.phase_jit.arctan2_32`'s). A decode reads the pair in the phase stage's
 own pass (:func:`bistair.core.measure_jit.front_end`, the same arithmetic):
 :func:`pair_phase` serves a set measured without it.
@@ -21,7 +23,7 @@ import math
 import numpy as np
 
 from .jit import PI32, kernel, kernel_frames
-from .phase_jit import _angle, _hypot32
+from .phase_jit import angle32, hypot32
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -67,7 +69,7 @@ def quantize32(theta: np.ndarray, levels: int, valid: np.ndarray) -> np.ndarray:
 @kernel(parallel=True)
 def relinearize32(theta: np.ndarray, table: np.ndarray, levels: int, valid: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray]:
-    """The stair phase through a level table (:func:`bistair.core.stair.relinearize`, bit for
+    """The stair phase through a level table (``tests/support/reference.py:relinearize``, bit for
     bit) and its :func:`quantize32` levels, in one pass.
 
     Parameters
@@ -125,17 +127,18 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
         for x in range(w):
             a = np.float32(raw[first, y, x]) * s32 - avg[y, x]
             b = np.float32(raw[first + 1, y, x]) * s32 - avg[y, x]
-            theta[y, x] = _angle(b, a)
-            mod[y, x] = _hypot32(a, b)
+            theta[y, x] = angle32(b, a)
+            mod[y, x] = hypot32(a, b)
     return theta, mod
 
 
 
 def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~bistair.core.stair.stair_phase` of frames ``first`` (cosine) and ``first + 1``
-    (sine) of a raw capture stack (each value times ``scale`` its fraction of full scale),
-    read, centred on ``avg`` and turned into a phase and a modulation in one pass.
+    """The stair phase (``tests/support/reference.py:stair_phase``) of frames ``first``
+    (cosine) and ``first + 1`` (sine) of a raw capture stack (each value times ``scale``
+    its fraction of full scale), read, centred on ``avg`` and turned into a phase and a
+    modulation in one pass.
 
     Parameters
     ----------

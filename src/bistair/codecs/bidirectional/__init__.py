@@ -55,8 +55,13 @@ from ...core.regions import (
     label_fringes,
 )
 from ...core.resolve import orders_from_regions
-from ...core.stair import fit_level_response, level_readings, stair_level_phase, stair_pair
-from ...core.stair_jit import pair_phase, quantize32
+from ...core.stair import (
+    fit_level_response,
+    level_readings,
+    read_stairs,
+    stair_level_phase,
+    stair_pair,
+)
 from ...errors import BistairError
 from ...spec import PeriodSpec, field, format_period
 from ..base import Codec, CodeMap, Orders, fringe_index, shift_patterns
@@ -86,8 +91,7 @@ from .response import (
     level_offsets,
     linear_stair,
 )
-from .stairs import stair_edges, stair_fit
-from .stairs_jit import stair_agreement, stair_noise
+from .stairs import stair_agreement, stair_edges, stair_fit, stair_noise
 
 
 @dataclasses.dataclass(frozen=True, kw_only=True)
@@ -234,9 +238,8 @@ def code_columns(prepared: Prepared, spec: BidirectionalSpec, fs: FringeSet,
     ...
     bistair.errors.BistairError: the captures do not fit the spec: the stair phases sit ...
     """
-    theta, stair_mod = fs.stair if fs.stair is not None else pair_phase(
-        prepared.raw, spec.steps, prepared.scale, fs.avg)
-    ks = quantize32(theta, spec.stairs, fs.valid)
+    theta, stair_mod, ks = read_stairs(prepared, spec.steps, spec.stairs, fs.avg, fs.valid,
+                                       fs.stair)
     if _misfit(*stair_sample(fs.sample, theta, fs.valid), spec) > MISFIT:
         refuse("the stair phases sit halfway between the levels of the code: are stair-cos "
                "and stair-sin swapped (or partitions and stairs wrong)?")

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from ...core.jit import _numba_called, _numba_inline, kernel
+from ...core.jit import called, inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -75,11 +75,11 @@ def band_sums(region: np.ndarray, level: np.ndarray, theta: np.ndarray, weight: 
     c = np.zeros(m, np.float64)
     s = np.zeros(m, np.float64)
     w = np.zeros(m, np.float64)
-    ring = _level_ring(levels)
+    ring = level_ring(levels)
     for i in range(n):
         core[i] = level[i] >= 0.7 * q[i]
         if core[i]:
-            u = _nearest_level(theta[i], levels, ring)
+            u = one_nearest_level(theta[i], levels, ring)
             c[u] += weight[i] * math.cos(theta[i])
             s[u] += weight[i] * math.sin(theta[i])
             w[u] += weight[i]
@@ -124,9 +124,9 @@ def band_reads(region: np.ndarray, level: np.ndarray, theta: np.ndarray, core: n
     n, m = region.size, levels.size
     read = np.empty(n, np.int32)
     cores = 0
-    ring = _level_ring(levels)
+    ring = level_ring(levels)
     for i in range(n):
-        read[i] = _nearest_level(theta[i], levels, ring)
+        read[i] = one_nearest_level(theta[i], levels, ring)
         cores += core[i]
     group = np.empty(cores, np.int32)
     values = np.empty(cores, np.float64)
@@ -233,7 +233,7 @@ def band_runs(region: np.ndarray, row: np.ndarray, read: np.ndarray, kept: np.nd
         y1[r] = row[i]
         cw[r] += cos[i]
         sw[r] += sin[i]
-        off[r] += _wrapped_abs(theta[i] - levels[read[i]]) / half_gap[read[i]] * weight[i]
+        off[r] += wrapped_abs(theta[i] - levels[read[i]]) / half_gap[read[i]] * weight[i]
         ww[r] += weight[i]
         prev = i
     runs = r + 1
@@ -247,7 +247,7 @@ def band_runs(region: np.ndarray, row: np.ndarray, read: np.ndarray, kept: np.nd
             ww[:runs], misfit, uid[:runs], top_ok[:runs], bottom_ok[:runs])
 
 
-@_numba_inline
+@inline
 def _goes_on(region: np.ndarray, row: np.ndarray, prev: int, i: int) -> bool:
     """Kept entry ``i`` follows kept entry ``prev`` in one region, the rows between them
     (at most three) all dropped entries."""
@@ -255,9 +255,26 @@ def _goes_on(region: np.ndarray, row: np.ndarray, prev: int, i: int) -> bool:
     return region[i] == region[prev] and gap == i - prev - 1 and gap <= 3
 
 
-@_numba_inline
-def _wrapped_abs(x: float) -> float:
-    """``abs((x + pi) % 2pi - pi)`` in float64, as NumPy computes it."""
+@inline
+def wrapped_abs(x: float) -> float:
+    """``abs((x + pi) % 2pi - pi)`` in float64, as NumPy computes it: how far an angle is
+    from 0 around the circle (for the kernels here and in :mod:`.response_jit`).
+
+    Parameters
+    ----------
+    x : float
+        An angle in radians.
+
+    Returns
+    -------
+    float
+        Its distance from 0 on the circle, in ``[0, pi]``.
+
+    Examples
+    --------
+    >>> round(wrapped_abs(2 * math.pi - 0.25), 6), round(wrapped_abs(-3.0), 6)
+    (0.25, 3.0)
+    """
     a = x + math.pi
     if 0.0 <= a < TWO_PI:
         m = a
@@ -294,20 +311,36 @@ def nearest_levels(theta: np.ndarray, levels: np.ndarray) -> np.ndarray:
     [1, 1, 2, 0]
     """
     out = np.zeros(theta.size, np.int32)
-    ring = _level_ring(levels)
+    ring = level_ring(levels)
     for i in range(theta.size):
-        out[i] = _nearest_level(theta[i], levels, ring)
+        out[i] = one_nearest_level(theta[i], levels, ring)
     return out
 
 
 RING_GAP = 1e-9  # levels this far apart at least (radians) are searched as a ring
 
 
-@_numba_inline
-def _level_ring(levels: np.ndarray) -> bool:
+@inline
+def level_ring(levels: np.ndarray) -> bool:
     """Whether the levels ascend in [-pi, pi), each at least ``RING_GAP`` from the next
     around the circle: then the nearest to a phase in [-pi, pi] is one of the two that
-    bracket it (:func:`_nearest_level`)."""
+    bracket it (:func:`one_nearest_level`).
+
+    Parameters
+    ----------
+    levels : (L,) float64 array
+        Level phases in radians.
+
+    Returns
+    -------
+    bool
+        They form such a ring.
+
+    Examples
+    --------
+    >>> bool(level_ring(np.array([-2.0, 0.0, 2.0]))), bool(level_ring(np.array([0.0, -2.0])))
+    (True, False)
+    """
     m = levels.size
     if m < 2:
         return False
@@ -319,14 +352,34 @@ def _level_ring(levels: np.ndarray) -> bool:
     return levels[0] + TWO_PI - levels[m - 1] >= RING_GAP
 
 
-@_numba_inline
-def _nearest_level(t: float, levels: np.ndarray, ring: bool) -> int:
+@inline
+def one_nearest_level(t: float, levels: np.ndarray, ring: bool) -> int:
     """One phase's :func:`nearest_levels`.
 
-    On a ring of levels (:func:`_level_ring`) a phase in [-pi, pi] is compared with the two
+    On a ring of levels (:func:`level_ring`) a phase in [-pi, pi] is compared with the two
     levels that bracket it only, the lower index first (ties go to it, as ``argmin``): any
     other level lies beyond one of them, at least ``RING_GAP`` farther, far more than the
     distances' rounding. Otherwise every level, in order.
+
+    Parameters
+    ----------
+    t : float
+        A phase in radians.
+    levels : (L,) float64 array
+        Level phases in radians.
+    ring : bool
+        ``level_ring(levels)``.
+
+    Returns
+    -------
+    int
+        The index of the nearest level (the first of equally near ones).
+
+    Examples
+    --------
+    >>> levels = np.array([-2.0, 0.0, 2.0])
+    >>> one_nearest_level(3.1, levels, level_ring(levels))
+    2
     """
     if ring and -math.pi <= t <= math.pi:
         m = levels.size
@@ -337,13 +390,13 @@ def _nearest_level(t: float, levels: np.ndarray, ring: bool) -> int:
             a, b = 0, m - 1
         else:
             a, b = hi - 1, hi
-        return a if _wrapped_abs(t - levels[a]) <= _wrapped_abs(t - levels[b]) else b
+        return a if wrapped_abs(t - levels[a]) <= wrapped_abs(t - levels[b]) else b
     best = 0
-    low = _wrapped_abs(t - levels[0])
+    low = wrapped_abs(t - levels[0])
     if low != low:
         return 0
     for j in range(1, levels.size):
-        d = _wrapped_abs(t - levels[j])
+        d = wrapped_abs(t - levels[j])
         if d != d:  # NaN: numpy.argmin returns the first one
             return j
         if d < low:
@@ -381,7 +434,7 @@ def region_quantile(region: np.ndarray, values: np.ndarray, q: float) -> np.ndar
     return out
 
 
-@_numba_called
+@called
 def _region_quantile(region: np.ndarray, values: np.ndarray, q: float, out: np.ndarray
                      ) -> None:
     """:func:`region_quantile` into ``out``."""
@@ -433,7 +486,7 @@ def group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
     return _group_percentiles(group, values, n_groups, q)
 
 
-@_numba_called
+@called
 def _group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
                        q: float) -> np.ndarray:
     """The body of :func:`group_percentiles`."""
@@ -473,9 +526,9 @@ def _group_percentiles(group: np.ndarray, values: np.ndarray, n_groups: int,
     return out
 
 
-@_numba_inline
+@inline
 def _wrapped(x: float) -> float:
-    """``(x + pi) % 2pi - pi`` in float64, as NumPy computes it (:func:`_wrapped_abs`)."""
+    """``(x + pi) % 2pi - pi`` in float64, as NumPy computes it (:func:`wrapped_abs`)."""
     a = x + math.pi
     if 0.0 <= a < TWO_PI:
         m = a

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from ...core.jit import _numba_inline, kernel
+from ...core.jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -142,7 +142,7 @@ def band_evidence(region: np.ndarray, uid: np.ndarray, weight: np.ndarray,
 
 
 
-@_numba_inline
+@inline
 def _minimum(a: float, b: float) -> float:
     """``np.minimum``: NaN if either is."""
     if a != a or b != b:
@@ -151,7 +151,7 @@ def _minimum(a: float, b: float) -> float:
 
 
 
-@_numba_inline
+@inline
 def _two_heaviest(uid: np.ndarray, lo: int, hi: int, cls_w: np.ndarray) -> tuple[int, int]:
     """The levels of runs ``lo..hi-1`` with the largest and second largest weight (ties:
     the higher level first; -1 where there is no second)."""
@@ -169,7 +169,7 @@ def _two_heaviest(uid: np.ndarray, lo: int, hi: int, cls_w: np.ndarray) -> tuple
 
 
 
-@_numba_inline
+@inline
 def _quantize(theta: float, levels: int) -> int:
     """:func:`bistair.core.stair.quantize` of one phase."""
     two_pi = 2.0 * math.pi
@@ -177,9 +177,10 @@ def _quantize(theta: float, levels: int) -> int:
 
 
 
-@_numba_inline
+@inline
 def _level_misfit(theta: float, level: int, levels: int) -> float:
-    """:func:`bistair.core.stair.level_misfit` of one phase."""
+    """The squared distance of a phase from a stair level, in half steps (its NumPy
+    reference: ``tests/support/reference.py:level_misfit``)."""
     two_pi = 2.0 * math.pi
     phase = -math.pi + math.pi / levels + two_pi * level / levels
     d = (theta - phase + math.pi) % two_pi
@@ -187,7 +188,7 @@ def _level_misfit(theta: float, level: int, levels: int) -> float:
 
 
 
-@_numba_inline
+@inline
 def _length_cost(uid: np.ndarray, length: np.ndarray, complete: np.ndarray, lo: int,
                  hi: int, loc: int, par: int, h_loc: float, h_par: float) -> float:
     """How badly the run lengths fit the local (level ``loc``) and partition (``par``)
@@ -211,7 +212,7 @@ def _length_cost(uid: np.ndarray, length: np.ndarray, complete: np.ndarray, lo: 
     return cost
 
 
-@_numba_inline
+@inline
 def _together(reg: np.ndarray, solid: np.ndarray, first: int, second: int,
               third: int) -> bool:
     """Runs ``first``, ``second`` and ``third`` (-2: none) exist, lie in ``first``'s region

@@ -21,7 +21,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ...core.jit import _numba_called, kernel
+from ...core.jit import called, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -122,7 +122,7 @@ def _count_runs(code: np.ndarray, min_run: int) -> np.ndarray:
     return count
 
 
-@_numba_called
+@called
 def _store(i: int, start: np.ndarray, length: np.ndarray, first: np.ndarray,
            sum_sin: np.ndarray, sum_cos: np.ndarray, m_start: int, m_len: int,
            m_first: bool, m_sin: float, m_cos: float) -> None:
@@ -277,8 +277,9 @@ def _vote(labels: np.ndarray, offsets: np.ndarray, start: np.ndarray, length: np
 
 def run_label_modes(labels: np.ndarray, runs: ColumnRuns, value: np.ndarray, n_labels: int,
                     n_values: int, chunks: int = 4) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`~bistair.core.resolve.mode_by_label` of ``labels`` and of the image whose
-    pixels take their run's ``value`` (-1 outside every run), without making that image.
+    """The most frequent value per label (``tests/support/reference.py:mode_by_label``) of
+    ``labels`` and of the image whose pixels take their run's ``value`` (-1 outside every
+    run), without making that image.
 
     Parameters
     ----------

@@ -23,7 +23,7 @@ import math
 
 import numpy as np
 
-from ...core.jit import _fmax, _fmin, _numba_called, _numba_inline, kernel
+from ...core.jit import called, fmax, fmin, inline, kernel
 from ...core.memory import row_bands
 from ...core.regions_jit import TILE
 
@@ -32,7 +32,7 @@ BLOCK = 32  # rows per task of the parallel loops
 TWO_PI = 2.0 * math.pi
 
 
-@_numba_called
+@called
 def _row_labels(labels: np.ndarray, n_labels: int, y0: int, y1: int, start: np.ndarray,
                 entry: np.ndarray, write: bool) -> None:
     """Rows ``y0 .. y1-1``: the number of distinct labels (> 0) into ``start[y + 1]``, or,
@@ -149,7 +149,7 @@ def label_major(start: np.ndarray, entry: np.ndarray, count: np.ndarray, acc: np
     return keys, counts, sums
 
 
-@_numba_called
+@called
 def _sum_rows(labels: np.ndarray, values: np.ndarray, n_labels: int, start: np.ndarray,
               entry: np.ndarray, y0: int, y1: int, count: np.ndarray, acc: np.ndarray
               ) -> None:
@@ -241,7 +241,7 @@ def label_row_sums(labels: np.ndarray, values: np.ndarray, n_labels: int
     return label_major(start, entry, count, acc, n_labels)
 
 
-@_numba_inline
+@inline
 def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.float32,
                   m: np.float32) -> tuple:
     """One pixel's ``weight * cos``, ``weight * sin``, ``weight`` and ``ratio`` in float32,
@@ -250,14 +250,14 @@ def _stair_values(p: np.float32, cos_t: np.float32, sin_t: np.float32, sm: np.fl
     min(ratio, 1)`` (:func:`bistair.core.regions.core_weight`)."""
     tiny = np.float32(1e-6)
     zero, one, two = np.float32(0.0), np.float32(1.0), np.float32(2.0)
-    ratio = _fmin(_fmax(sm / _fmax(m, tiny), zero), two)
-    core = _fmin(_fmax(_fmin(p, np.float32(TWO_PI) - p) / np.float32(math.pi / 2),
+    ratio = fmin(fmax(sm / fmax(m, tiny), zero), two)
+    core = fmin(fmax(fmin(p, np.float32(TWO_PI) - p) / np.float32(math.pi / 2),
                        np.float32(0.1)), one)
-    weight = core * _fmin(ratio, one)
+    weight = core * fmin(ratio, one)
     return weight * cos_t, weight * sin_t, weight, ratio
 
 
-@_numba_called
+@called
 def _stair_sum_rows(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
                     sin_t: np.ndarray, stair_mod: np.ndarray, mod: np.ndarray, n_labels: int,
                     start: np.ndarray, entry: np.ndarray, y0: int, y1: int,
@@ -372,11 +372,11 @@ def label_stair_sums(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     return label_major(start, entry, count, acc, n_labels)
 
 
-@_numba_called
+@called
 def _relabel_count(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, n_labels: int,
                    y0: int, y1: int, count: np.ndarray) -> None:
     """Rows ``y0 .. y1-1``: the final labels ``remap[roots[labels]]`` written in place (as
-    :func:`bistair.core.regions_jit.relabel` writes them, a run of one label looked up
+    :func:`bistair.core.regions_labels_jit.relabel` writes them, a run of one label looked up
     once) and each row's distinct final labels (> 0) counted into ``count[y + 1]``."""
     w = labels.shape[1]
     stamp = np.zeros(n_labels + 1, np.int32)  # the row (+ 1) a label was last counted in
@@ -398,7 +398,7 @@ def _relabel_count(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, n_l
         count[y + 1] = m
 
 
-@_numba_called
+@called
 def _stair_run_sums(labels: np.ndarray, phi: np.ndarray, cos_t: np.ndarray,
                     sin_t: np.ndarray, stair_mod: np.ndarray, mod: np.ndarray, n_labels: int,
                     y0: int, y1: int, start: np.ndarray, entry: np.ndarray,
@@ -454,7 +454,7 @@ def relabel_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, phi: 
                  mod: np.ndarray, n_labels: int
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The final labels of a band of rows written in place
-    (:func:`bistair.core.regions_jit.relabel`, the hook its docstring describes) and, in
+    (:func:`bistair.core.regions_labels_jit.relabel`, the hook its docstring describes) and, in
     the same visit of each tile of rows, the five values of
     :func:`bistair.codecs.bidirectional.profiles.stair_values` summed per (label, row):
     ``(start (R+1,), entry (K,), count (K,), acc (5, K))``, row ``y``'s labels in order of
@@ -464,7 +464,7 @@ def relabel_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray, phi: 
     Parameters
     ----------
     labels : (R, W) int32 array
-        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        Provisional labels (:func:`bistair.core.regions_labels_jit.label_kept`), changed in
         place to the final ones.
     roots : int32 array
         The region of each provisional label.
@@ -526,7 +526,7 @@ def relabel_stair_sums(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
     Parameters
     ----------
     labels : (H, W) int32 array
-        Provisional labels (:func:`bistair.core.regions_jit.label_kept`), changed in
+        Provisional labels (:func:`bistair.core.regions_labels_jit.label_kept`), changed in
         place to the final ones.
     roots : int32 array
         The region of each provisional label.

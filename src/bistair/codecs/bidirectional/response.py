@@ -31,8 +31,8 @@ from ...core.stair import (
     half_gaps,
     level_readings,
     level_table,
+    relinearize_levels,
 )
-from ...core.stair_jit import relinearize32
 from .bands import Runs, union_levels
 from .profiles import RowProfiles
 from .response_jit import level_shares, weighted_medians
@@ -142,7 +142,7 @@ def linear_stair(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, ks: np
         table = level_table(read, levels)
     except ValueError:  # readings out of the levels' order: no power law explains them
         return LinearStair(theta, ks)
-    mapped, local = relinearize32(theta, table, spec.stairs, fs.valid)
+    mapped, local = relinearize_levels(theta, table, spec.stairs, fs.valid)
     return LinearStair(mapped, local, exponent, read)
 
 

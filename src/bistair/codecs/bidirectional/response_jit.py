@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...core.jit import _numba_inline, kernel
-from .bands_jit import _level_ring, _nearest_level, _wrapped_abs
+from ...core.jit import inline, kernel
+from .bands_jit import level_ring, one_nearest_level, wrapped_abs
 
 prange = range  # numba's prange once the first kernel of this module compiles (its helpers too)
 
@@ -57,11 +57,11 @@ def level_shares(theta: np.ndarray, levels: np.ndarray,
     n = theta.size
     nearest = np.empty(n, np.int32)
     share = np.empty(n, np.float64)
-    ring = _level_ring(levels)
+    ring = level_ring(levels)
     for i in range(n):
-        u = _nearest_level(theta[i], levels, ring)
+        u = one_nearest_level(theta[i], levels, ring)
         nearest[i] = u
-        share[i] = _wrapped_abs(theta[i] - levels[u]) / half_gap[u]
+        share[i] = wrapped_abs(theta[i] - levels[u]) / half_gap[u]
     return nearest, share
 
 
@@ -138,7 +138,7 @@ def weighted_medians(order: np.ndarray, share: np.ndarray, nearest: np.ndarray,
     return offset, per_level
 
 
-@_numba_inline
+@inline
 def _search(cum: np.ndarray, value: float) -> int:
     """``np.searchsorted(cum, value)`` (side left, NaN above every number) of an ascending
     ``cum``."""

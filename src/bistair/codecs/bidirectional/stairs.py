@@ -2,7 +2,9 @@
 fringe (:func:`stair_edges`), and the share of decoded pixels whose stair phase contradicts
 their order (:func:`stair_fit`, the check that refuses a spec that does not fit).
 
-Their compiled passes are in :mod:`.stairs_jit`.
+Their compiled passes are in :mod:`.stairs_jit`; the codec's stages take two of them
+through this module, their door: ``stair_noise`` (the stair phase's noise per pixel) and
+``stair_agreement`` (the share of pixels whose stair level agrees with their order).
 """
 
 from __future__ import annotations
@@ -18,6 +20,8 @@ from ...core.memory import row_bands
 from ...core.phase import TWO_PI, wrap
 from ...core.stair import stair_level_phase
 from .bands import nearest_level, observed_levels, union_levels
+from .stairs_jit import stair_agreement as stair_agreement  # (the stages' door to it)
+from .stairs_jit import stair_noise as stair_noise  # (the stages' door to it)
 from .stairs_jit import stair_turns
 
 if TYPE_CHECKING:

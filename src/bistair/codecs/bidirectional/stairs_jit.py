@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ...core.jit import _fmax, kernel
+from ...core.jit import fmax, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -237,5 +237,5 @@ def stair_noise(stair_mod: np.ndarray, noise_scale: float) -> np.ndarray:
     tiny = np.float32(1e-6)
     for y in prange(h):
         for x in range(w):
-            noise[y, x] = np.float32(noise_scale / np.float64(_fmax(stair_mod[y, x], tiny)))
+            noise[y, x] = np.float32(noise_scale / np.float64(fmax(stair_mod[y, x], tiny)))
     return noise
