@@ -38,8 +38,8 @@ import numpy as np
 
 from ..errors import BistairError
 from ..geometry.calibration import Calibration
+from ..geometry.stereo import cloud_points
 from ..geometry.stereo_calibration import StereoCalibration, load_stereo_calibration
-from ..geometry.stereo_jit import cloud_points
 from ..geometry.unwrap_stream import StereoStream, StreamDepth
 from ..io.atomic import check_output, output_folder
 from ..io.jsonfile import write_json
