@@ -40,7 +40,7 @@ from ..geometry.projection_matrices import (
     import_matrices,
     save_matrix_calibration,
 )
-from ..geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
+from ..geometry.stereo_calibration import StereoCalibration
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.atomic import check_output, output_file, output_folder, write_image
 from ..io.jsonfile import read_json, write_json
