@@ -48,8 +48,8 @@ from ..core.captures import prepare
 from ..core.measure import FringeSet, measure
 from ..core.result import make_result
 from ..errors import BistairError
-from .stereo import Rectification, StereoResult, _grey, rectify
 from .calibration import Calibration
+from .stereo import Rectification, StereoResult, _grey, rectify
 from .stereo_calibration import StereoCalibration
 from .stereo_jit import depth_counts, grid_points
 from .triangulate import check_depth_range, triangulate
