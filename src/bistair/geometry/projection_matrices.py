@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -217,6 +218,59 @@ def with_pixel_origin(calibration: StereoCalibration, shift: float) -> StereoCal
         return dataclasses.replace(dev, K=K)
 
     return calibration.replace(left=moved(calibration.left), right=moved(calibration.right))
+
+
+def registration(calibration: StereoCalibration, left: np.ndarray, right: np.ndarray,
+                 column: np.ndarray, shift: float = 0.0) -> float:
+    """How well two cameras' matched pixels and the projector agree: the median of the
+    projector column of each pair's triangulated point minus the column its absolute phase
+    gives (projector pixels), with the cameras' principal points moved by ``-shift``
+    (:func:`with_pixel_origin`). A wrong pixel origin moves every point sideways by about a
+    camera pixel's width: the median moves by about the ratio of the focal lengths.
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The cameras and the projector.
+    left, right : numpy.ndarray
+        ``(N, 2)`` matched pixels ``(u, v)`` of the left and right camera (0-based).
+    column : numpy.ndarray
+        ``(N,)`` the projector column of each match's absolute phase.
+    shift : float, optional
+        The principal points' move (pixels): 0 for the calibration as it is, +-1 for the
+        other pixel origin.
+
+    Returns
+    -------
+    float
+        The median residual (projector pixels), NaN without matches.
+
+    Examples
+    --------
+    >>> K = np.array([[1000.0, 0, 319.5], [0, 1000, 239.5], [0, 0, 1]])
+    >>> P = [K @ np.hstack([np.eye(3), [[x], [0], [0]]]) for x in (50.0, -150.0, -50.0)]
+    >>> cal = rig_from_matrices(P, (640, 480), (640, 480))
+    >>> X = np.array([[10.0, 5.0, 500.0], [-30.0, 0.0, 600.0]])  # left camera frame
+    >>> pix = [(k @ (X + [x, 0, 0]).T).T for k, x in ((K, 0.0), (K, -200.0), (K, -100.0))]
+    >>> l, r, p = (q[:, :2] / q[:, 2:] for q in pix)
+    >>> round(registration(cal, l, r, p[:, 0]), 6)
+    0.0
+    >>> round(registration(cal, l, r, p[:, 0], shift=-1.0), 3)  # 1-based read as 0-based
+    -1.0
+    """
+    import cv2
+
+    if not len(column):
+        return math.nan
+    cal = with_pixel_origin(calibration, shift)
+    rays = [cv2.undistortPoints(np.asarray(px, np.float64).reshape(-1, 1, 2), dev.K,
+                                dev.dist).reshape(-1, 2)
+            for px, dev in ((left, cal.left), (right, cal.right))]
+    points = cv2.triangulatePoints(np.hstack([np.eye(3), np.zeros((3, 1))]),
+                                   np.hstack([cal.R, cal.T[:, None]]), rays[0].T, rays[1].T)
+    points = (points[:3] / points[3]).T
+    u = cal.projector.project(points)[:, 0]
+    return float(np.median(u - np.asarray(column, np.float64)))
 
 
 def default_origin(files: Sequence[str | Path]) -> int:
