@@ -337,8 +337,8 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
          reach: float = 1.0) -> np.ndarray:
     """Decided disparities grown into the pixels left undecided (two or more candidates, or
     one the right camera could not confirm): from the decided pixels outwards (breadth
-    first), an undecided pixel takes the one candidate within ``reach`` of a decided 4-neighbour's disparity, and stays undecided
-    when none or more than one is.
+    first), an undecided pixel takes the one candidate within ``reach`` of a decided
+    4-neighbour's disparity, and stays undecided when none or more than one is.
 
     Parameters
     ----------
