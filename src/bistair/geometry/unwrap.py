@@ -805,7 +805,8 @@ def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = Non
 def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
                   calibration: StereoCalibration, min_depth: float, max_depth: float,
                   force: bool = False, min_modulation: float | None = None,
-                  tolerance: float | None = None) -> StereoResult:
+                  tolerance: float | None = None, pixel_origin: int | None = None
+                  ) -> StereoResult:
     """Two cameras' captures of one single-period N-step set to depth by stereo phase
     unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
 
@@ -824,6 +825,9 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     min_modulation, tolerance : float, optional
         The modulation a valid pixel needs (fraction of full scale; by default from the
         noise) and the phase tolerance (:func:`unwrap_stereo`).
+    pixel_origin : int, optional
+        The calibration's recorded pixel origin, checked against the data
+        (:func:`unwrap_stereo`).
 
     Returns
     -------
@@ -871,7 +875,7 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     noise = tuple(float(np.median(fs.phase_noise[fs.valid])) if fs.valid.any() else 0.0
                   for fs in (lfs, rfs))
     found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
-                          tolerance, force=force)
+                          tolerance, force=force, pixel_origin=pixel_origin)
     _, order = absolute_phase(found, lphase, calibration, period)
     left = make_result(spec.method, np.where(order >= 0, lphase, 0), order, period, lfs.mod,
                        lfs.avg, wrapped=lphase)
