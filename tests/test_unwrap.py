@@ -283,3 +283,27 @@ def test_growth_decides_more_and_keeps_the_orders(at):
     assert decided.sum() > 0.8 * valid and alone.mask.sum() < 0.6 * decided.sum()
     assert found.info["grown"] > 0 and alone.info["grown"] == 0
     assert (wrong & truth.mask).sum() == 0 and wrong.sum() <= 0.001 * decided.sum()
+
+
+def test_a_wrong_shift_sign_is_named():
+    """Captures of shift_sign +1 decoded as -1 (the phase negated in both cameras): the
+    projector confirms few pixels (the depth range check would blame the range); refused
+    naming the other sign; with force, a warning and no point decided."""
+    from bistair.codecs import encode, make_spec
+    from bistair.geometry.unwrap import stereo_unwrap
+
+    rig, scene = preset("two-masks", camera_size=(160, 120))
+    srig = StereoRig.default(camera_size=(160, 120), projector_size=rig.projector.size)
+    cal = StereoCalibration.from_rig(srig)
+    spec = make_spec("multifreq", width=rig.projector.size[0], height=rig.projector.size[1],
+                     periods=(48,))
+    im = Imaging(gamma=1.0)
+    left, right = (expose(trace(srig.rig(side), scene, im), encode(spec), im)
+                   for side in ("left", "right"))
+    wrong = spec.replace(shift_sign=-1)
+    with pytest.raises(BistairError, match=r"negated.*shift_sign -1.*--shift-sign 1\)"):
+        stereo_unwrap(left, right, wrong, cal, 540.0, 650.0)
+    forced = stereo_unwrap(left, right, wrong, cal, 540.0, 650.0, force=True)
+    assert "--shift-sign 1" in forced.info["warnings"][0] and forced.info["decided"] == 0
+    right_sign = stereo_unwrap(left, right, spec, cal, 540.0, 650.0)
+    assert right_sign.info["decided_fraction"] > 0.5 and not right_sign.info["warnings"]

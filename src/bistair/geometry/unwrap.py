@@ -658,6 +658,29 @@ def consistent_share(left_phase: np.ndarray, right_phase: np.ndarray,
     return float(np.sum(n_in >= 1) / valid) if valid else 0.0
 
 
+def _sign_check(lphase: np.ndarray, rphase: np.ndarray, calibration: StereoCalibration,
+                period: float, min_depth: float, max_depth: float,
+                noise: tuple[float, float], tolerance: float | None, sign: int) -> str:
+    """What to say when the phase negated (the other ``shift_sign``) fits the projector
+    clearly better than the spec's: the projector confirms over :data:`ORIGIN_RATIO`
+    times as many left pixels with it, and over :data:`ORIGIN_MIN` (benchmark: the wrong
+    sign confirms 3-23%, the right one 83-99%); ``""`` otherwise. Judged only when the
+    spec's phase confirms under half the pixels."""
+    tol = tolerance or max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*noise))
+    given = consistent_share(lphase, rphase, calibration, period, tol, min_depth, max_depth)
+    if given >= 0.5:
+        return ""
+    negated = [np.where(np.isfinite(p), np.mod(-p, 2 * np.pi), np.nan).astype(np.float32)
+               for p in (lphase, rphase)]
+    other = consistent_share(*negated, calibration, period, tol, min_depth, max_depth)
+    if not (other > ORIGIN_RATIO * given and other > ORIGIN_MIN):
+        return ""
+    return (f"the projector confirms {100 * other:.0f}% of the left pixels with the phase "
+            f"negated, {100 * given:.0f}% as the spec says (shift_sign {sign}): the "
+            f"patterns shift the other way, give a spec with shift_sign {-sign} (bistair "
+            f"patterns multifreq --shift-sign {-sign})")
+
+
 def _origin_check(left_phase: np.ndarray, right_phase: np.ndarray,
                   calibration: StereoCalibration, period: float, tolerance: float,
                   min_depth: float, max_depth: float, given: int) -> dict[str, Any]:
@@ -874,8 +897,14 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     (lphase, lfs), (rphase, rfs) = maps
     noise = tuple(float(np.median(fs.phase_noise[fs.valid])) if fs.valid.any() else 0.0
                   for fs in (lfs, rfs))
+    sign = _sign_check(lphase, rphase, calibration, period, min_depth, max_depth, noise,
+                       tolerance, spec.shift_sign)
+    if sign and not force:
+        raise BistairError(sign)
     found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
                           tolerance, force=force, pixel_origin=pixel_origin)
+    if sign:
+        found.info["warnings"].insert(0, sign)
     _, order = absolute_phase(found, lphase, calibration, period)
     left = make_result(spec.method, np.where(order >= 0, lphase, 0), order, period, lfs.mod,
                        lfs.avg, wrapped=lphase)
