@@ -87,7 +87,7 @@ def test_orders_against_the_truth(sphere):
     # on the rectified grid: where two or more agree, a disparity only where grown
     several = found.candidates >= 2
     assert 0 < np.isfinite(found.disparity[several]).sum() <= found.info["grown"]
-    assert np.isnan(found.disparity[several]).sum() > 0.5 * found.info["undecided"]
+    assert np.isnan(found.disparity[several]).sum() == found.info["undecided"] > 0
     on = decided & truth.mask
     assert np.median(np.abs(found.depth[on] - truth.depth[on])) < 0.5
 
