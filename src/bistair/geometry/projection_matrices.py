@@ -320,6 +320,11 @@ def recorded_origin(data: Mapping[str, Any]) -> int:
     int
         0 or 1: the origin of the matrices it was made from (its ``K`` are 0-based).
 
+    Raises
+    ------
+    BistairError
+        A ``pixel_origin`` that is not 0 or 1.
+
     Examples
     --------
     >>> recorded_origin({"pixel_origin": 1}), recorded_origin({})
