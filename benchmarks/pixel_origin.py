@@ -10,6 +10,12 @@ the projector confirms (``consistent_share``) under the given origin and the oth
 origin used, the decided share and its order errors.
 
     python benchmarks/pixel_origin.py [--camera 320x240] [--scenes plane,sphere-on-plane]
+    python benchmarks/pixel_origin.py --shares [--scenes all]
+
+``--shares``: only the shares the projector confirms (``consistent_share``, every eighth
+row) per scene, projector place and period (16 and 48 px): as rendered, with the cameras
+one pixel off both ways, and with the phase negated (the wrong ``shift_sign``): the margins
+of the origin and the sign checks, cheaply, on every scene.
 
 Done when the right origin is kept in every right case and taken in every wrong one
 (:data:`bistair.geometry.unwrap.ORIGIN_RATIO`, :data:`~bistair.geometry.unwrap.ORIGIN_MIN`).
@@ -27,13 +33,16 @@ from bistair.core.phase import phase_shift_patterns
 from bistair.geometry.projection_matrices import with_pixel_origin
 from bistair.geometry.stereo_calibration import StereoCalibration
 from bistair.geometry.unwrap import (
+    MIN_TOLERANCE,
     ORIGIN_MIN,
     ORIGIN_RATIO,
+    TOLERANCE_SIGMAS,
     absolute_phase,
+    consistent_share,
     unwrap_stereo,
     wrapped_of,
 )
-from bistair.sim import preset, trace
+from bistair.sim import preset, scene_names, trace
 from bistair.sim.render import Imaging, expose
 from bistair.sim.stereo import StereoRig
 
@@ -67,12 +76,44 @@ def render(scene: str, camera: tuple[int, int], projector_at: float, seed: int):
     return phases, tuple(noise), StereoCalibration.from_rig(srig), truth
 
 
+def shares(scenes: list[str], camera: tuple[int, int]) -> None:
+    """The confirmed shares of every case (``--shares``)."""
+    global PERIOD
+    low_right, high_wrong, low_sign_gap = 1.0, 0.0, math.inf
+    for scene in scenes:
+        for at in (0.5, 0.3):
+            for period in (16.0, 48.0):
+                PERIOD = period
+                (lp, rp), noise, cal, truth = render(scene, camera, at, 1)
+                z = truth.depth[np.isfinite(truth.depth)]
+                low, high = math.floor(z.min() - 10), math.ceil(z.max() + 10)
+                tol = max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*noise))
+                right = consistent_share(lp, rp, cal, period, tol, low, high)
+                off = [consistent_share(lp, rp, with_pixel_origin(cal, m), period, tol, low,
+                                        high) for m in (-1.0, 1.0)]
+                neg = [np.where(np.isfinite(p), np.mod(-p, 2 * np.pi), np.nan)
+                       .astype(np.float32) for p in (lp, rp)]
+                negated = consistent_share(*neg, cal, period, tol, low, high)
+                low_right = min(low_right, right)
+                high_wrong = max(high_wrong, *off, negated)
+                low_sign_gap = min(low_sign_gap, right / max(negated, 1e-9))
+                print(f"{scene:17s} at {at} T {period:g}: right {right:.4f}, one pixel off "
+                      f"{off[0]:.4f} / {off[1]:.4f}, negated {negated:.4f}", flush=True)
+    print(f"right inputs confirm at least {low_right:.4f}; wrong origins or sign at most "
+          f"{high_wrong:.4f}; right over negated at least {low_sign_gap:.1f}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--camera", default="320x240")
     parser.add_argument("--scenes", default=SCENES)
+    parser.add_argument("--shares", action="store_true")
     args = parser.parse_args()
     camera = tuple(int(v) for v in args.camera.split("x"))
+    if args.shares:
+        names = scene_names() if args.scenes == "all" else args.scenes.split(",")
+        shares(names, camera)
+        return
     worst = {"right": 0.0, "wrong": math.inf}  # the other's share over the given's
     misses = 0
     for scene in args.scenes.split(","):

@@ -25,6 +25,7 @@ Reported: bistair's points against the reference's, the median nearest-point dis
 (mm) and the share over 2 mm (scipy cKDTree), and both against the truth.
 
     python benchmarks/spu_reference.py [--camera 320x240] [--scenes two-masks,plane]
+        [--projector-at 0.5,0.3] [--motion 0,1]
 
 Done when (issue 34): bistair's points at least 90% of the reference's, median distance
 0.3 mm, at most 1% over 2 mm.
@@ -51,6 +52,7 @@ from bistair.app.cli import cli
 from bistair.codecs import encode, make_spec
 from bistair.io.atomic import write_image
 from bistair.sim import preset, trace
+from bistair.sim.motion import Motion, render_moving
 from bistair.sim.render import Imaging, expose
 from bistair.sim.rig import Camera, Projector, look_rotation
 from bistair.sim.stereo import StereoRig
@@ -247,8 +249,9 @@ def read_ply(path: Path) -> np.ndarray:
 
 
 def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
-        seed: int = 1) -> dict[str, float]:
-    """Render, run the reference and bistair's commands, compare; the figures."""
+        seed: int = 1, motion: float = 0.0) -> dict[str, float]:
+    """Render (the objects moving ``motion`` mm per frame along x, when given), run the
+    reference and bistair's commands, compare; the figures (the truth of frame 0)."""
     period = PROJECTOR[0] / FRINGES
     rig, geometry = preset(scene, camera_size=camera)
     srig = rectified_rig(camera, projector_at=projector_at)
@@ -260,7 +263,11 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
     for i, (side, name) in enumerate((("left", "1_Rectified"), ("right", "2_Rectified"))):
         cam = dataclasses.replace(im, seed=im.seed + i)
         traced = trace(srig.rig(side), geometry, cam)
-        imgs = expose(traced, patterns, cam)
+        if motion:
+            imgs, _ = render_moving(patterns, srig.rig(side), geometry,
+                                    Motion(translation=(motion, 0.0, 0.0)), cam)
+        else:
+            imgs = expose(traced, patterns, cam)
         (folder / name).mkdir(parents=True, exist_ok=True)
         for k, img in enumerate(imgs):
             write_image(folder / name / f"{k:04d}.bmp", img)
@@ -314,15 +321,18 @@ def main() -> None:
     parser.add_argument("--camera", default="320x240")
     parser.add_argument("--scenes", default="two-masks,sphere-on-plane,plane")
     parser.add_argument("--projector-at", default="0.5,0.3")
+    parser.add_argument("--motion", default="0", help="mm per frame along x, e.g. 0,1")
     args = parser.parse_args()
     camera = tuple(int(v) for v in args.camera.split("x"))
     for scene in args.scenes.split(","):
-        for at in (float(a) for a in args.projector_at.split(",")):
+        for at, moving in ((float(a), float(m)) for a in args.projector_at.split(",")
+                           for m in args.motion.split(",")):
             with tempfile.TemporaryDirectory() as tmp:
-                r = run(scene, camera, at, Path(tmp))
+                r = run(scene, camera, at, Path(tmp), motion=moving)
             extra = "".join(f", {k} {v:.3f}" for k, v in r.items() if "truth" in k)
-            print(f"{scene:16s} at {at}: reference {r['reference']} points, bistair "
-                  f"{r['bistair']} ({100 * r['ratio']:.1f}%), median distance "
+            print(f"{scene:16s} at {at} moving {moving:g} mm/frame: reference "
+                  f"{r['reference']} points, bistair {r['bistair']} "
+                  f"({100 * r['ratio']:.1f}%), median distance "
                   f"{r['median_mm']:.3f} mm, over 2 mm {100 * r['over_2mm']:.2f}%{extra}",
                   flush=True)
 
