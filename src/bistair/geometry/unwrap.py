@@ -12,13 +12,18 @@ from geometry instead of extra patterns:
    rectified row within the disparities the depth range allows are its candidates; each is
    triangulated and kept where it projects into the projector at a column whose phase
    agrees with the left pixel's within ``tolerance`` (:func:`~.unwrap_jit.unwrap_rows`).
-3. A pixel with exactly one consistent candidate in the depth range is decided: its depth
-   comes from that candidate's disparity, its fringe order from the projector column of
-   its point. Pixels with none or with two or more are left undecided (NaN, order -1),
-   never guessed.
-4. :func:`check_range`: when most points the search finds over a wider range (three
+3. A pixel with exactly one consistent candidate in the depth range is decided (when the
+   right camera's own search does not decide another disparity there and a row above or
+   below confirms it): its fringe order comes from the projector column of its point.
+4. Growth (:func:`~.unwrap_jit.grow`): from the decided pixels outwards, a pixel of one
+   to four candidates takes the one within :data:`REACH` pixels of a decided neighbour's
+   disparity; with none or several it is left undecided (NaN, order -1), never guessed.
+5. The depth of a decided pixel is the left camera's ray cut by the projector column of
+   its absolute phase (:func:`projector_depth`, as the published pipeline does).
+6. :func:`check_range`: when most points the search finds over a wider range (three
    times as wide, about the same centre) fall outside the depth range, the range is wrong
-   and refused.
+   and refused. With the calibration's recorded pixel origin, :func:`consistent_share`
+   under it and the other tells which one the data fit.
 
 What it cannot decide: a candidate repeats wherever the right camera's and the projector's
 fringes line up again along the left pixel's ray. With the projector halfway between the
@@ -94,7 +99,8 @@ class Unwrapped:
     ``disparity``: float32 on the rectified left grid, NaN where undecided; ``depth``
     (float32 ``z``, mm) and ``mask`` on the left camera's own grid; ``candidates``: int16
     on the rectified left grid, the consistent candidates in the depth range of each pixel
-    (0: none, 1: decided, 2 or more: left undecided); ``info``: counts and settings.
+    (0: none, 1: one, 2 or more: decided only by growth; -1: the search reaches past the
+    right view); ``info``: counts and settings.
     """
 
     disparity: np.ndarray
