@@ -272,17 +272,31 @@ def test_depth_comes_from_the_projector_column():
 
 @pytest.mark.parametrize("at", [0.5, 0.3])
 def test_growth_decides_more_and_keeps_the_orders(at):
-    """Growth from the decided pixels (one candidate continuous with a decided neighbour)
-    decides more pixels of two-masks with fine fringes (16 px) and none an order off on the
-    truth's mask; without it, far fewer (28.9% of the valid halfway)."""
+    """Growth from the decided pixels (one candidate continuous with two decided
+    neighbours) decides more pixels of two-masks with fine fringes (16 px: 58.3% and 60.7%
+    of the valid, 34.4% and 41.7% without) and none an order off on the truth's mask."""
     (lp, rp), noise, cal, truth = _render("two-masks", 16.0, projector_at=at)
     found = unwrap_stereo(lp, rp, cal, 16.0, 549.0, 644.0, noise)
     alone = unwrap_stereo(lp, rp, cal, 16.0, 549.0, 644.0, noise, propagate=False)
     wrong, decided, _ = _wrong(found, lp, cal, 16.0, truth)
     valid = np.isfinite(lp).sum()
-    assert decided.sum() > 0.8 * valid and alone.mask.sum() < 0.6 * decided.sum()
+    assert decided.sum() > 0.5 * valid and alone.mask.sum() < 0.75 * decided.sum()
     assert found.info["grown"] > 0 and alone.info["grown"] == 0
     assert (wrong & truth.mask).sum() == 0 and wrong.sum() <= 0.001 * decided.sum()
+
+
+def test_growth_does_not_leak_onto_a_repeat():
+    """mugs-on-wall, projector halfway, 48-px fringes: grown from one decided neighbour,
+    the wall's repeat (a ghost surface, continuous too) took over 46731 pixels an order
+    off; with two agreeing neighbours none on the truth's mask."""
+    (lp, rp), noise, cal, truth = _render("mugs-on-wall", 48.0)
+    z = truth.depth[np.isfinite(truth.depth)]
+    found = unwrap_stereo(lp, rp, cal, 48.0, np.floor(z.min() - 10), np.ceil(z.max() + 10),
+                          noise)
+    wrong, decided, _ = _wrong(found, lp, cal, 48.0, truth)
+    assert found.info["grown"] > 0
+    assert (wrong & truth.mask).sum() == 0 and wrong.sum() <= 0.001 * decided.sum(), (
+        wrong.sum(), decided.sum())
 
 
 def test_a_wrong_shift_sign_is_named():

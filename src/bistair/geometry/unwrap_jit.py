@@ -295,7 +295,7 @@ zmin, zmax, width, rows, from_right, whole
 
 @kernel()
 def _grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.ndarray,
-          reach: float) -> np.ndarray:
+          reach: float, support: int) -> np.ndarray:
     h, w = disparity.shape
     dy, dx = np.array([1, -1, 0, 0]), np.array([0, 0, 1, -1])
     out = disparity.copy()
@@ -320,13 +320,16 @@ def _grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np
             count, chosen = 0, math.nan
             for c in range(m):
                 d = kept[ny, nx, c]
+                agree = 0
                 for j in range(4):
                     my, mx = ny + dy[j], nx + dx[j]
                     if (0 <= my < h and 0 <= mx < w and abs(out[my, mx] - d) <= reach):
-                        count += 1
+                        agree += 1
+                if agree >= 1:
+                    count += 1
+                    if agree >= support:
                         chosen = d
-                        break
-            if count == 1:
+            if count == 1 and chosen == chosen:
                 out[ny, nx] = chosen
                 queue[tail] = ny * w + nx
                 tail += 1
@@ -334,11 +337,18 @@ def _grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np
 
 
 def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.ndarray,
-         reach: float = 1.0) -> np.ndarray:
+         reach: float = 1.0, support: int = 1) -> np.ndarray:
     """Decided disparities grown into the pixels left undecided (two or more candidates, or
     one the right camera could not confirm): from the decided pixels outwards (breadth
     first), an undecided pixel takes the one candidate within ``reach`` of a decided
-    4-neighbour's disparity, and stays undecided when none or more than one is.
+    4-neighbour's disparity when ``support`` of its decided 4-neighbours agree with it,
+    and stays undecided when no candidate or more than one is near a decided neighbour.
+
+    A repeat of a surface (a ghost: the fringes of the right camera and the projector
+    lining up again) is a continuous surface too: growth from one decided neighbour leaks
+    onto it where a depth step matches a repeat's spacing and then floods it (mugs-on-wall
+    halfway, 48-px fringes: 46731 pixels an order off). Two agreeing neighbours stop the
+    leak on every case of ``benchmarks/stereo_unwrap.py``.
 
     Parameters
     ----------
@@ -353,6 +363,8 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
         ``(H, W)`` bool: pixels never grown into (beside an occlusion).
     reach : float, optional
         The largest disparity step (pixels) between neighbours of one surface.
+    support : int, optional
+        The decided 4-neighbours (1 to 4) that must agree with the chosen candidate.
 
     Returns
     -------
@@ -369,8 +381,10 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
     >>> kept[0, 1:3, :2] = [[48.0, 20.5], [20.9, 47.8]]
     >>> [round(float(v), 1) for v in grow(d, n, kept, np.zeros((1, 4), bool))[0]]
     [20.2, 20.5, 20.9, nan]
+    >>> [round(float(v), 1) for v in grow(d, n, kept, np.zeros((1, 4), bool), support=2)[0]]
+    [20.2, nan, nan, nan]
     """
     return _grow(np.ascontiguousarray(disparity, np.float32),
                  np.ascontiguousarray(n_in, np.int16),
                  np.ascontiguousarray(kept, np.float32),
-                 np.ascontiguousarray(blocked, np.bool_), float(reach))
+                 np.ascontiguousarray(blocked, np.bool_), float(reach), int(support))
