@@ -32,8 +32,14 @@ def _matrices(srig: StereoRig, scale: tuple[float, float, float] = (1.0, -2.5, 0
     return out
 
 
+#: 0-based camera pixels to MATLAB's 1-based ones: (u + 1, v + 1)
+_ONE_BASED = np.array([[1.0, 0, 1], [0, 1, 1], [0, 0, 1]])
+
+
 def _write(folder, matrices, kind):
     paths = []
+    if kind == "mat":  # MATLAB's cameras number pixels from 1; the projector's column is kept
+        matrices = [_ONE_BASED @ P for P in matrices[:2]] + [matrices[2]]
     for name, P in zip(("left", "right", "projector"), matrices, strict=True):
         path = folder / f"{name}.{kind}"
         if kind == "npy":
@@ -62,8 +68,9 @@ def _same(cal: StereoCalibration, truth: StereoCalibration) -> None:
 
 @pytest.mark.parametrize("kind", ["npy", "txt", "mat"])
 def test_matrices_round_trip_to_the_rig(tmp_path, kind):
-    """The virtual rig's matrices (another world frame, scaled, one negated) come back as
-    its exact calibration, through each file format and the command."""
+    """The virtual rig's matrices (another world frame, scaled, one negated; 1-based camera
+    pixels in the .mat files, as MATLAB's) come back as its exact calibration, through each
+    file format and the command, which says and records the pixel origin."""
     srig = StereoRig.default(camera_size=(640, 480), projector_size=(1280, 800),
                              projector_at=0.3, right_height=5.0, right_roll_deg=1.0)
     truth = StereoCalibration.from_rig(srig)
@@ -74,8 +81,40 @@ def test_matrices_round_trip_to_the_rig(tmp_path, kind):
                                    "--projector-size", "1280x800", "--out", str(out)])
     assert res.exit_code == 0, res.output
     assert "baseline 200.06 mm" in res.output
+    origin = int(kind == "mat")
+    assert f"(pixel origin {origin})" in res.output
     _same(load_stereo_calibration(out), truth)
-    assert json.loads(out.read_text())["projector"]["width"] == 1280
+    data = json.loads(out.read_text())
+    assert data["projector"]["width"] == 1280 and data["pixel_origin"] == origin
+
+
+def test_pixel_origin_moves_the_cameras_principal_points(tmp_path):
+    """--pixel-origin overrides the default: MATLAB's 1-based matrices read 0-based keep
+    their principal points one pixel off (the projector's never moves); 0-based .npy
+    matrices read 1-based lose one."""
+    srig = StereoRig.default(camera_size=(640, 480), projector_size=(1280, 800))
+    truth = StereoCalibration.from_rig(srig)
+    mats = _write(tmp_path, _matrices(srig), "mat")
+    npys = _write(tmp_path, _matrices(srig), "npy")
+    for paths, origin, offset in ((mats, 0, 1.0), (npys, 1, -1.0), (npys, 0, 0.0)):
+        out = tmp_path / "rig.json"
+        res = CliRunner().invoke(cli, ["import-calibration", "--projection-matrices",
+                                       ",".join(map(str, paths)), "--camera-size", "640x480",
+                                       "--projector-size", "1280x800", "--pixel-origin",
+                                       str(origin), "--out", str(out)])
+        assert res.exit_code == 0 and f"(pixel origin {origin})" in res.output, res.output
+        cal = load_stereo_calibration(out)
+        for got, want in ((cal.left, truth.left), (cal.right, truth.right)):
+            np.testing.assert_allclose(got.K[:2, 2], want.K[:2, 2] + offset, atol=1e-6)
+        np.testing.assert_allclose(cal.projector.device.K, truth.projector.device.K,
+                                   atol=1e-6)
+        assert json.loads(out.read_text())["pixel_origin"] == origin
+    mixed = [mats[0], npys[1], npys[2]]
+    res = CliRunner().invoke(cli, ["import-calibration", "--projection-matrices",
+                                   ",".join(map(str, mixed)), "--camera-size", "640x480",
+                                   "--projector-size", "1280x800", "--out",
+                                   str(tmp_path / "mixed.json")])
+    assert res.exit_code == 2 and "give --pixel-origin" in res.output
 
 
 def test_decompose_gives_a_proper_rotation_and_positive_focals():

@@ -319,28 +319,35 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
               help="three 3x4 projection matrices of one world frame (.npy, .txt or .mat "
               "files; needs --camera-size and --projector-size): a calibration of two "
               "cameras and the projector in the left camera's frame, no distortion")
+@click.option("--pixel-origin", "pixel_origin", type=click.IntRange(0, 1), default=None,
+              help="with --projection-matrices: the cameras' pixel origin in the matrices, "
+              "0 (OpenCV) or 1 (MATLAB) [default: 1 for .mat files, 0 otherwise]")
 @reports_errors
 def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
                        camera_size: str | None, keys: str | None, stereo: bool,
-                       matrices: str | None) -> None:
+                       matrices: str | None, pixel_origin: int | None) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
     R, T map the camera frame to the projector frame; T in millimetres. With --stereo, two
     cameras: R, T map the left camera's frame to the right one's. With
     --projection-matrices (and no FILES), two cameras and the projector from their 3x4
-    matrices P = K [R | t] (X_device = R X_world + t, mm)."""
+    matrices P = K [R | t] (X_device = R X_world + t, mm); --pixel-origin 1 for matrices
+    of 1-based camera pixels (MATLAB's)."""
     if matrices is not None:
         from .jobs import import_projection_matrices
 
         if files or stereo or keys:
             raise CliError("--projection-matrices takes no FILES, --stereo or --keys")
-        rig = import_projection_matrices(matrices, out, camera_size, projector_size)
-        click.echo(f"cameras {rig.left.width}x{rig.left.height}, baseline "
-                   f"{rig.baseline:.2f} mm, projector {rig.projector.device.width}x"
+        rig, origin = import_projection_matrices(matrices, out, camera_size, projector_size,
+                                                 pixel_origin)
+        click.echo(f"cameras {rig.left.width}x{rig.left.height} (pixel origin {origin}), "
+                   f"baseline {rig.baseline:.2f} mm, projector {rig.projector.device.width}x"
                    f"{rig.projector.device.height} at "
                    f"{float(np.linalg.norm(rig.projector.R.T @ rig.projector.T)):.2f} mm from "
                    f"the left camera; wrote {out}")
         return
+    if pixel_origin is not None:
+        raise CliError("--pixel-origin goes with --projection-matrices")
     if not files:
         raise CliError("give the calibration FILES (or --projection-matrices)")
     if stereo:

@@ -89,8 +89,9 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     if info.get("unwrapping") == "stereo":
         click.echo(f"{info['decided']} points from {info['left_decoded']} decoded left pixels "
                    f"({100 * info['decided_fraction']:.1f}%; by the projector at "
-                   f"{low:g}-{high:g} mm: {info['undecided']} undecided, two or more "
-                   f"candidates agree; {info['no_candidate']} without one; "
+                   f"{low:g}-{high:g} mm, {info.get('grown', 0)} of them by their "
+                   f"neighbours: {info['undecided']} undecided, two or more candidates "
+                   f"agree; {info['no_candidate']} without one; "
                    f"{info['not_confirmed'] + info['unsupported']} not confirmed by the "
                    f"right camera or the rows beside); wrote {out}")
         return

@@ -41,7 +41,11 @@ from ..geometry.calibration import (
 )
 from ..geometry.height import HeightModel
 from ..geometry.opencv import read_opencv_calibration
-from ..geometry.projection_matrices import import_matrices
+from ..geometry.projection_matrices import (
+    default_origin,
+    import_matrices,
+    save_matrix_calibration,
+)
 from ..geometry.triangulate import Reconstruction, check_depth_range, check_fit, reconstruct
 from ..io.atomic import check_output, output_file, output_folder, write_image
 from ..io.jsonfile import read_json, write_json
@@ -301,13 +305,16 @@ def import_calibration(files: Sequence[str | Path], out: str | Path,
 
 def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Path,
                                camera_size: tuple[int, int] | str | None,
-                               projector_size: tuple[int, int] | str | None
-                               ) -> StereoCalibration:
+                               projector_size: tuple[int, int] | str | None,
+                               pixel_origin: int | None = None
+                               ) -> tuple[StereoCalibration, int]:
     """Read three 3x4 projection matrices (left camera, right camera, projector: ``.npy``,
     ``.txt`` or ``.mat``, one world frame) and write the two-camera-and-projector
     calibration ``out`` in the left camera's frame
-    (:mod:`~bistair.geometry.projection_matrices`). ``files`` may be ``"L,R,P"``. Nothing
-    is written on error."""
+    (:mod:`~bistair.geometry.projection_matrices`), recording the cameras' pixel origin
+    (``pixel_origin``: 0 or 1, by default 1 for ``.mat`` files, 0 otherwise). ``files``
+    may be ``"L,R,P"``. Returns the calibration and the origin used. Nothing is written on
+    error."""
     if isinstance(files, str):
         files = [f.strip() for f in files.split(",")]
     sizes = []
@@ -316,9 +323,10 @@ def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Pat
             raise BistairError(f"--projection-matrices needs {name} WxH (a matrix does not "
                                "hold the image size)")
         sizes.append(parse_size(size, name) if isinstance(size, str) else size)
-    cal = import_matrices(tuple(files), *sizes)
-    save_calibration(cal, out)
-    return cal
+    cal = import_matrices(tuple(files), *sizes, pixel_origin=pixel_origin)
+    origin = default_origin(files) if pixel_origin is None else int(pixel_origin)
+    save_matrix_calibration(cal, origin, out)
+    return cal, origin
 
 
 # -- option strings --------------------------------------------------------------------------

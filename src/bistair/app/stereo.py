@@ -20,6 +20,7 @@ leaves nothing behind.
 from __future__ import annotations
 
 import dataclasses
+import json
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -39,6 +40,7 @@ from ..geometry.calibration import (
     save_calibration,
 )
 from ..geometry.opencv import read_opencv_stereo
+from ..geometry.projection_matrices import recorded_origin
 from ..geometry.stereo import StereoResult, stereo
 from ..geometry.unwrap import is_single_period, stereo_unwrap
 from ..io.atomic import check_output, output_folder, write_image
@@ -97,7 +99,9 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
+    recorded = None
     if not isinstance(calibration, StereoCalibration):
+        recorded = _recorded_origin(calibration)
         calibration = load_calibration(calibration, STEREO)
     spec = find_spec(left, spec) if spec is not None else _one_spec(left, right)
     stacks = []
@@ -111,6 +115,8 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     if is_single_period(used):
         say(f"unwrapping 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
             f"by the projector at {min_depth:g}-{max_depth:g} mm")
+        if recorded is not None:  # import-calibration --projection-matrices's: checked
+            options = {"pixel_origin": recorded, **options}
         result = _unwrapped(lstack, rstack, used, calibration, min_depth, max_depth, force,
                             options)
     else:
@@ -137,14 +143,27 @@ def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
         raise BistairError("one period gives no fringe order: stereo phase unwrapping needs "
                            "the projector in the calibration (bistair simulate --cameras 2 "
                            "writes one; or import-calibration --projection-matrices)")
-    unknown = sorted(set(options) - {"min_modulation"})
+    unknown = sorted(set(options) - {"min_modulation", "pixel_origin"})
     if unknown:
         raise BistairError(f"stereo phase unwrapping takes no {', '.join(unknown)} option")
     if lstack.shape != rstack.shape:
         raise BistairError("left and right captures differ: " + " and ".join(
             f"{s[0]} frames of {s[2]}x{s[1]}" for s in (lstack.shape, rstack.shape)))
     return stereo_unwrap(lstack, rstack, spec, calibration, min_depth, max_depth, force,
-                         options.get("min_modulation"))
+                         options.get("min_modulation"),
+                         pixel_origin=options.get("pixel_origin"))
+
+
+def _recorded_origin(path: str | Path) -> int | None:
+    """The cameras' pixel origin a calibration file records (``"pixel_origin"``, written by
+    ``import-calibration --projection-matrices``), ``None`` when it records none."""
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, ValueError):
+        return None  # load_stereo_calibration says what is wrong with the file
+    if not isinstance(data, dict) or "pixel_origin" not in data:
+        return None
+    return recorded_origin(data)
 
 
 def _same_place(left: Any, right: Any) -> bool:

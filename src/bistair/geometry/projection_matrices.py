@@ -9,6 +9,16 @@ Files (:func:`read_matrix`): ``.npy``, text (``.txt``, ``.csv``, ...: three rows
 numbers separated by spaces or commas, ``#`` comments) or MATLAB ``.mat`` holding exactly
 one 3x4 numeric array.
 
+Pixel origin. bistair's pixel ``[v, u]`` (0-based array index) is the camera coordinate
+``(u, v)``, OpenCV's convention. MATLAB's grid (``meshgrid(1:W, 1:H)``) calls it
+``(u + 1, v + 1)``: a matrix made there, read 0-based, puts every camera pixel one pixel
+off (about 4 mm of depth on the virtual rig at 600 mm). ``pixel_origin`` 1 moves the cameras'
+principal points by -1 (:func:`with_pixel_origin`), so that nothing downstream changes; the
+default is 1 for ``.mat`` files, 0 otherwise (:func:`default_origin`). The projector's
+column is not moved: it is the pattern's column, which the phase (``2*pi*x_p/T``) and the
+spec's ``phase_offset`` define. The calibration file records the origin
+(``"pixel_origin"``, :func:`save_matrix_calibration`).
+
 Examples
 --------
 >>> K = np.array([[1000.0, 0, 320], [0, 1000, 240], [0, 0, 1]])
@@ -19,13 +29,22 @@ Examples
 
 from __future__ import annotations
 
+import dataclasses
+import json
+import math
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from ..errors import BistairError
+from ..io.atomic import output_file
 from .calibration import Device
 from .stereo_calibration import ProjectorPose, StereoCalibration
+
+#: The pixel origins a camera's matrix may use: 0 (OpenCV, bistair) or 1 (MATLAB).
+PIXEL_ORIGINS = (0, 1)
 
 
 def read_matrix(path: str | Path) -> np.ndarray:
@@ -162,10 +181,203 @@ def decompose(P: np.ndarray, name: str = "projection matrix"
     return K / K[2, 2], R, t
 
 
+def with_pixel_origin(calibration: StereoCalibration, shift: float) -> StereoCalibration:
+    """The calibration with both cameras' principal points moved by ``-shift`` pixels (the
+    projector's kept): a camera model of pixel origin ``o`` read as one of origin
+    ``o - shift``.
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The cameras (and the projector).
+    shift : float
+        What to subtract from each camera's ``cx`` and ``cy`` (pixels): 1 turns a MATLAB
+        (1-based) camera model into bistair's 0-based one.
+
+    Returns
+    -------
+    StereoCalibration
+        A copy; ``shift`` 0 returns ``calibration`` itself.
+
+    Examples
+    --------
+    >>> K = np.array([[1000.0, 0, 320.5], [0, 1000, 240.5], [0, 0, 1]])
+    >>> cal = StereoCalibration(Device(640, 480, K), Device(640, 480, K), np.eye(3),
+    ...                         [-200.0, 0, 0])
+    >>> moved = with_pixel_origin(cal, 1)
+    >>> moved.left.K[:2, 2].tolist(), moved.right.K[:2, 2].tolist()
+    ([319.5, 239.5], [319.5, 239.5])
+    """
+    if shift == 0:
+        return calibration
+
+    def moved(dev: Device) -> Device:
+        K = dev.K.copy()
+        K[0, 2] -= shift
+        K[1, 2] -= shift
+        return dataclasses.replace(dev, K=K)
+
+    return calibration.replace(left=moved(calibration.left), right=moved(calibration.right))
+
+
+def registration(calibration: StereoCalibration, left: np.ndarray, right: np.ndarray,
+                 column: np.ndarray, shift: float = 0.0) -> float:
+    """How well two cameras' matched pixels and the projector agree: the median of the
+    projector column of each pair's triangulated point minus the column its absolute phase
+    gives (projector pixels), with the cameras' principal points moved by ``-shift``
+    (:func:`with_pixel_origin`). A wrong pixel origin moves every point sideways by about a
+    camera pixel's width: the median moves by about the ratio of the focal lengths.
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The cameras and the projector.
+    left, right : numpy.ndarray
+        ``(N, 2)`` matched pixels ``(u, v)`` of the left and right camera (0-based).
+    column : numpy.ndarray
+        ``(N,)`` the projector column of each match's absolute phase.
+    shift : float, optional
+        The principal points' move (pixels): 0 for the calibration as it is, +-1 for the
+        other pixel origin.
+
+    Returns
+    -------
+    float
+        The median residual (projector pixels), NaN without matches.
+
+    Examples
+    --------
+    >>> K = np.array([[1000.0, 0, 319.5], [0, 1000, 239.5], [0, 0, 1]])
+    >>> P = [K @ np.hstack([np.eye(3), [[x], [0], [0]]]) for x in (50.0, -150.0, -50.0)]
+    >>> cal = rig_from_matrices(P, (640, 480), (640, 480))
+    >>> X = np.array([[10.0, 5.0, 500.0], [-30.0, 0.0, 600.0]])  # left camera frame
+    >>> pix = [(k @ (X + [x, 0, 0]).T).T for k, x in ((K, 0.0), (K, -200.0), (K, -100.0))]
+    >>> l, r, p = (q[:, :2] / q[:, 2:] for q in pix)
+    >>> round(registration(cal, l, r, p[:, 0]), 6)
+    0.0
+    >>> round(registration(cal, l, r, p[:, 0], shift=-1.0), 3)  # 1-based read as 0-based
+    -1.0
+    """
+    import cv2
+
+    if not len(column):
+        return math.nan
+    cal = with_pixel_origin(calibration, shift)
+    rays = [cv2.undistortPoints(np.asarray(px, np.float64).reshape(-1, 1, 2), dev.K,
+                                dev.dist).reshape(-1, 2)
+            for px, dev in ((left, cal.left), (right, cal.right))]
+    points = cv2.triangulatePoints(np.hstack([np.eye(3), np.zeros((3, 1))]),
+                                   np.hstack([cal.R, cal.T[:, None]]), rays[0].T, rays[1].T)
+    points = (points[:3] / points[3]).T
+    u = cal.projector.project(points)[:, 0]
+    return float(np.median(u - np.asarray(column, np.float64)))
+
+
+def default_origin(files: Sequence[str | Path]) -> int:
+    """The cameras' pixel origin when none is given: 1 when the camera matrices (the first
+    two files) are MATLAB ``.mat`` files, 0 otherwise.
+
+    Parameters
+    ----------
+    files : sequence of str or pathlib.Path
+        The left camera's, the right camera's (and the projector's) matrix files.
+
+    Returns
+    -------
+    int
+        0 or 1.
+
+    Raises
+    ------
+    BistairError
+        One camera's file a ``.mat`` and the other's not: the origin must be given.
+
+    Examples
+    --------
+    >>> default_origin(["mCamera1Rectified.mat", "mCamera2Rectified.mat", "mProjector.mat"])
+    1
+    >>> default_origin(["left.npy", "right.txt", "projector.npy"])
+    0
+    """
+    mat = [Path(f).suffix.lower() == ".mat" for f in list(files)[:2]]
+    if len(set(mat)) > 1:
+        raise BistairError("one camera's matrix is a .mat file and the other's not: give "
+                           "--pixel-origin 0 (OpenCV) or 1 (MATLAB)")
+    return int(all(mat))
+
+
+def recorded_origin(data: Mapping[str, Any]) -> int:
+    """The cameras' pixel origin a calibration file's dictionary records (0 when it records
+    none: bistair's own calibrations are 0-based).
+
+    Parameters
+    ----------
+    data : Mapping
+        A stereo calibration file's content.
+
+    Returns
+    -------
+    int
+        0 or 1: the origin of the matrices it was made from (its ``K`` are 0-based).
+
+    Raises
+    ------
+    BistairError
+        A ``pixel_origin`` that is not 0 or 1.
+
+    Examples
+    --------
+    >>> recorded_origin({"pixel_origin": 1}), recorded_origin({})
+    (1, 0)
+    """
+    origin = data.get("pixel_origin", 0)
+    if origin not in PIXEL_ORIGINS:
+        raise BistairError(f"calibration field 'pixel_origin' must be 0 or 1, got {origin!r}")
+    return int(origin)
+
+
+def save_matrix_calibration(calibration: StereoCalibration, pixel_origin: int,
+                            path: str | Path) -> Path:
+    """Write a stereo calibration file (atomically) that records the pixel origin of the
+    matrices it came from (``"pixel_origin"``; its ``K`` are 0-based either way).
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        What to save (:func:`import_matrices`).
+    pixel_origin : int
+        0 or 1.
+    path : str or pathlib.Path
+        The JSON file.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Examples
+    --------
+    >>> import pathlib, shutil, tempfile
+    >>> tmp = pathlib.Path(tempfile.mkdtemp())
+    >>> K = np.array([[1000.0, 0, 319.5], [0, 1000, 239.5], [0, 0, 1]])
+    >>> P = [K @ np.hstack([np.eye(3), [[x], [0], [0]]]) for x in (50.0, -150.0, -50.0)]
+    >>> path = save_matrix_calibration(rig_from_matrices(P, (640, 480), (640, 480)), 1,
+    ...                                tmp / "rig.json")
+    >>> json.loads(path.read_text())["pixel_origin"]
+    1
+    >>> shutil.rmtree(tmp)
+    """
+    path = Path(path)
+    with output_file(path) as tmp:
+        tmp.write_text(json.dumps({**calibration.to_dict(), "pixel_origin": int(pixel_origin)},
+                                  indent=2) + "\n")
+    return path
+
+
 def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
                       camera_size: tuple[int, int], projector_size: tuple[int, int],
-                      names: tuple[str, str, str] = ("LEFT", "RIGHT", "PROJECTOR")
-                      ) -> StereoCalibration:
+                      names: tuple[str, str, str] = ("LEFT", "RIGHT", "PROJECTOR"),
+                      pixel_origin: int = 0) -> StereoCalibration:
     """The two-camera-and-projector calibration of three projection matrices of one world
     frame, in the left camera's frame (no distortion).
 
@@ -178,6 +390,9 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
         ``(width, height)`` in pixels of each camera and of the projector.
     names : tuple of str, optional
         What the error messages call the three matrices.
+    pixel_origin : int, optional
+        The cameras' pixel origin in the matrices: 0 (OpenCV) or 1 (MATLAB; moved to 0 by
+        :func:`with_pixel_origin`).
 
     Returns
     -------
@@ -197,7 +412,12 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     >>> cal = rig_from_matrices(P, (640, 480), (640, 480))
     >>> cal.T.round(6).tolist(), cal.projector.T.round(6).tolist()
     ([-200.0, 0.0, 0.0], [-100.0, 0.0, 0.0])
+    >>> rig_from_matrices(P, (640, 480), (640, 480), pixel_origin=1).left.K[:2, 2].tolist()
+    [318.5, 238.5]
     """
+    if pixel_origin not in PIXEL_ORIGINS:
+        raise BistairError(f"the pixel origin must be 0 (OpenCV) or 1 (MATLAB), got "
+                           f"{pixel_origin!r}")
     parts = [decompose(P, f"{n} projection matrix") for P, n in zip(matrices, names,
                                                                     strict=True)]
     (kl, rl, tl), (kr, rr, tr), (kp, rp, tp) = parts
@@ -209,13 +429,14 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     (cw, ch), (pw, ph) = camera_size, projector_size
     R, T = relative(rr, tr)
     Rp, Tp = relative(rp, tp)
-    return StereoCalibration(Device(cw, ch, kl), Device(cw, ch, kr), R, T,
-                             projector=ProjectorPose(Device(pw, ph, kp), Rp, Tp))
+    cal = StereoCalibration(Device(cw, ch, kl), Device(cw, ch, kr), R, T,
+                            projector=ProjectorPose(Device(pw, ph, kp), Rp, Tp))
+    return with_pixel_origin(cal, pixel_origin)
 
 
 def import_matrices(files: tuple[str | Path, str | Path, str | Path],
-                    camera_size: tuple[int, int], projector_size: tuple[int, int]
-                    ) -> StereoCalibration:
+                    camera_size: tuple[int, int], projector_size: tuple[int, int],
+                    pixel_origin: int | None = None) -> StereoCalibration:
     """:func:`read_matrix` of three files (left camera, right camera, projector) and
     :func:`rig_from_matrices` of them.
 
@@ -225,6 +446,9 @@ def import_matrices(files: tuple[str | Path, str | Path, str | Path],
         The left camera's, the right camera's and the projector's matrix files.
     camera_size, projector_size : tuple of int
         ``(width, height)`` in pixels of each camera and of the projector.
+    pixel_origin : int, optional
+        The cameras' pixel origin in the matrices (0 or 1); :func:`default_origin` of the
+        files by default.
 
     Returns
     -------
@@ -256,7 +480,10 @@ def import_matrices(files: tuple[str | Path, str | Path, str | Path],
         raise BistairError(f"--projection-matrices takes LEFT,RIGHT,PROJECTOR: three files, "
                            f"got {len(files)}")
     roles = ("LEFT", "RIGHT", "PROJECTOR")
-    return rig_from_matrices(tuple(read_matrix(f) for f in files), camera_size,
+    matrices = tuple(read_matrix(f) for f in files)
+    origin = default_origin(files) if pixel_origin is None else pixel_origin
+    return rig_from_matrices(matrices, camera_size,
                              projector_size,
                              tuple(f"{r} ({Path(f).name})" for r, f in zip(roles, files,
-                                                                           strict=True)))
+                                                                           strict=True)),
+                             origin)

@@ -12,13 +12,19 @@ from geometry instead of extra patterns:
    rectified row within the disparities the depth range allows are its candidates; each is
    triangulated and kept where it projects into the projector at a column whose phase
    agrees with the left pixel's within ``tolerance`` (:func:`~.unwrap_jit.unwrap_rows`).
-3. A pixel with exactly one consistent candidate in the depth range is decided: its depth
-   comes from that candidate's disparity, its fringe order from the projector column of
-   its point. Pixels with none or with two or more are left undecided (NaN, order -1),
-   never guessed.
-4. :func:`check_range`: when most points the search finds over a wider range (three
+3. A pixel with exactly one consistent candidate in the depth range is decided (when the
+   right camera's own search does not decide another disparity there and a row above or
+   below confirms it): its fringe order comes from the projector column of its point.
+4. Growth (:func:`~.unwrap_jit.grow`): from the decided pixels outwards, a pixel of one
+   to four candidates takes the one within :data:`REACH` pixels of the disparity of
+   :data:`GROW_SUPPORT` decided neighbours; with none or several it is left undecided
+   (NaN, order -1), never guessed.
+5. The depth of a decided pixel is the left camera's ray cut by the projector column of
+   its absolute phase (:func:`projector_depth`, as the published pipeline does).
+6. :func:`check_range`: when most points the search finds over a wider range (three
    times as wide, about the same centre) fall outside the depth range, the range is wrong
-   and refused.
+   and refused. With the calibration's recorded pixel origin, :func:`consistent_share`
+   under it and the other tells which one the data fit.
 
 What it cannot decide: a candidate repeats wherever the right camera's and the projector's
 fringes line up again along the left pixel's ray. With the projector halfway between the
@@ -48,11 +54,13 @@ from ..core.captures import prepare
 from ..core.measure import FringeSet, measure
 from ..core.result import make_result
 from ..errors import BistairError
+from .calibration import Calibration
+from .projection_matrices import with_pixel_origin
 from .stereo import Rectification, StereoResult, _grey, rectify
 from .stereo_calibration import StereoCalibration
 from .stereo_jit import depth_counts, grid_points
-from .triangulate import check_depth_range
-from .unwrap_jit import unwrap_rows
+from .triangulate import check_depth_range, triangulate
+from .unwrap_jit import grow, unwrap_candidates
 
 #: The tolerance on the projector's phase is this many times the phase noise of the two
 #: cameras together (at least :data:`MIN_TOLERANCE` radians).
@@ -60,6 +68,17 @@ TOLERANCE_SIGMAS = 4.0
 MIN_TOLERANCE = 0.1
 #: A decided disparity must be confirmed within this many pixels by the row above or below.
 SUPPORT = 1.0
+#: A pixel of two or more candidates takes the one within this many pixels of a decided
+#: neighbour's disparity (one surface), when exactly one is (:func:`~.unwrap_jit.grow`).
+REACH = 1.0
+#: ... and when this many of its decided 4-neighbours agree: one lets growth leak onto a
+#: repeat of the surface (benchmarks/stereo_unwrap.py, mugs-on-wall halfway with 48-px
+#: fringes: 46731 pixels an order off; objects-on-plane with 16-px: 57630), two none.
+GROW_SUPPORT = 2
+#: The other pixel origin is taken when the projector confirms more than this many times
+#: as many left pixels with it, and more than this share (:func:`_origin_check`;
+#: benchmarks/pixel_origin.py).
+ORIGIN_RATIO, ORIGIN_MIN = 2.0, 0.2
 #: Decided pixels this close (rectified pixels along the row) to one the right camera does
 #: not confirm are dropped (:func:`_beside_occlusion`).
 EDGE = 2
@@ -85,7 +104,8 @@ class Unwrapped:
     ``disparity``: float32 on the rectified left grid, NaN where undecided; ``depth``
     (float32 ``z``, mm) and ``mask`` on the left camera's own grid; ``candidates``: int16
     on the rectified left grid, the consistent candidates in the depth range of each pixel
-    (0: none, 1: decided, 2 or more: left undecided); ``info``: counts and settings.
+    (0: none, 1: one, 2 or more: decided only by growth; -1: the search reaches past the
+    right view); ``info``: counts and settings.
     """
 
     disparity: np.ndarray
@@ -174,21 +194,23 @@ def rectified_phase(phase: np.ndarray, maps: tuple[np.ndarray, np.ndarray]) -> n
 def _search(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
             calibration: StereoCalibration, period: float, tolerance: float, low: float,
             high: float, window: tuple[float, float], rows: np.ndarray | None = None,
-            from_right: bool = False, whole: bool = True
-            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+            from_right: bool = False, whole: bool = True, everything: bool = False
+            ) -> tuple[np.ndarray, ...]:
     """:func:`~.unwrap_jit.unwrap_rows` over the disparities of depths ``window`` (for
-    the right grid's pixels with ``from_right``)."""
+    the right grid's pixels with ``from_right``; with ``everything``, the kept candidates
+    too: :func:`~.unwrap_jit.unwrap_candidates`)."""
     proj = calibration.projector
     lo, hi = rect.disparities(*window)
     own, other = (rrect, lrect) if from_right else (lrect, rrect)
-    return unwrap_rows(own, other, lo, min(hi, 4.0 * rect.size_right[0]), rect.shift,
-                       rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1.T, proj.device.K,
-                       proj.device.dist, proj.R, proj.T, period, tolerance, low, high,
-                       proj.device.width, rows, from_right, whole)
+    out = unwrap_candidates(own, other, lo, min(hi, 4.0 * rect.size_right[0]), rect.shift,
+                            rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1.T, proj.device.K,
+                            proj.device.dist, proj.R, proj.T, period, tolerance, low, high,
+                            proj.device.width, rows, from_right, whole)
+    return out if everything else out[:4]
 
 
 def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
-                  agree: float = 1.0) -> np.ndarray:
+                  agree: float = 1.0, contradicted: bool = False) -> np.ndarray:
     """The left grid's disparities that the right grid's decision at the matched place
     confirms (within ``agree`` px at the nearest right pixel), else NaN.
 
@@ -208,6 +230,9 @@ def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
         ``cx_left - cx_right`` of the rectification (pixels).
     agree : float, optional
         The largest difference (pixels) of the two disparities.
+    contradicted : bool, optional
+        Return instead where the right pixel decided a disparity more than ``agree`` off
+        (bool: its own, other point; a right pixel undecided says nothing).
 
     Returns
     -------
@@ -223,6 +248,9 @@ def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
     [[nan, nan, nan, nan]]
     >>> cross_checked(np.float32([[np.nan, np.nan, np.nan, 3.0]]), right, 0.0).tolist()
     [[nan, nan, nan, 3.0]]
+    >>> one = np.float32([[np.nan, np.nan, np.nan, 0.5]])  # lands on the right's 2.0
+    >>> cross_checked(one, right, 0.0, contradicted=True).tolist()
+    [[False, False, False, True]]
     """
     h, w = left.shape
     rows, cols = np.nonzero(np.isfinite(left))
@@ -230,7 +258,12 @@ def cross_checked(left: np.ndarray, right: np.ndarray, shift: float,
     xr = np.rint(cols - shift - d).astype(np.int64)
     inside = (xr >= 0) & (xr < right.shape[1])
     ok = np.zeros(d.shape, bool)
-    ok[inside] = np.abs(right[rows[inside], xr[inside]] - d[inside]) <= agree
+    there = right[rows[inside], xr[inside]]
+    if contradicted:
+        off = np.zeros((h, w), bool)
+        off[rows[inside], cols[inside]] = np.abs(there - d[inside]) > agree
+        return off
+    ok[inside] = np.abs(there - d[inside]) <= agree
     out = np.full((h, w), np.nan, np.float32)
     out[rows[ok], cols[ok]] = d[ok]
     return out
@@ -247,16 +280,79 @@ def _supported(disparity: np.ndarray, support: float) -> np.ndarray:
     return np.where(ok, d, np.float32(np.nan)).astype(np.float32)
 
 
-def _beside_occlusion(disparity: np.ndarray, occluded: np.ndarray, reach: int) -> np.ndarray:
-    """``disparity``, NaN within ``reach`` pixels along the row of an ``occluded`` pixel
-    (one whose point the right camera does not confirm): beside an occlusion, the left ray
-    grazes the occluding surface's silhouette, and a point of that surface that the right
-    camera sees agrees with the pixel's phase as well as the hidden true point would."""
+def _near_occlusion(occluded: np.ndarray, reach: int) -> np.ndarray:
+    """The pixels within ``reach`` pixels along the row of an ``occluded`` pixel (one whose
+    point the right camera does not confirm): beside an occlusion, the left ray grazes the
+    occluding surface's silhouette, and a point of that surface that the right camera sees
+    agrees with the pixel's phase as well as the hidden true point would."""
     near = occluded.copy()
     for k in range(1, reach + 1):
         near[:, k:] |= occluded[:, :-k]
         near[:, :-k] |= occluded[:, k:]
-    return np.where(near, np.float32(np.nan), disparity).astype(np.float32)
+    return near
+
+
+def projector_depth(depth: np.ndarray, mask: np.ndarray, phase: np.ndarray,
+                    calibration: StereoCalibration, period: float, rays: tuple[np.ndarray,
+                                                                            np.ndarray]
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The depth of each decided left pixel from the left camera's ray and the projector's
+    column of its absolute phase (as one-camera triangulation does); the two cameras' point
+    only chooses the fringe order.
+
+    Parameters
+    ----------
+    depth, mask : numpy.ndarray
+        ``(H, W)`` the two cameras' depth (float32, mm) and where a point is decided.
+    phase : numpy.ndarray
+        ``(H, W)`` the left camera's wrapped phase (radians, ``[0, 2*pi)``).
+    calibration : StereoCalibration
+        The cameras and the projector.
+    period : float
+        The fringe period (projector pixels).
+    rays : tuple of numpy.ndarray
+        The left pixels' undistorted rays ``x / z``, ``y / z`` (:class:`~.stereo.
+        Rectification` ``rays``).
+
+    Returns
+    -------
+    depth : numpy.ndarray
+        ``(H, W)`` float32 ``z`` (mm) from the projector, NaN where undecided or where the
+        column's plane does not cut the ray in front of both.
+    mask : numpy.ndarray
+        ``(H, W)`` bool: where it is finite.
+    residual : numpy.ndarray
+        ``(N,)`` float64 of the decided pixels (row-major): the projector column of the
+        two cameras' point minus the absolute phase's column (projector pixels).
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo import rectify
+    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> truth = trace(srig.rig("left"), scene).truth
+    >>> phase = np.float32(2 * np.pi * truth.coord_x / 48 % (2 * np.pi))
+    >>> near = np.where(truth.mask, truth.depth + 3.0, np.nan)  # the pair's point 3 mm off
+    >>> z, mask, res = projector_depth(near, truth.mask, phase, cal, 48.0, rectify(cal).rays)
+    >>> float(np.abs(z[mask] - truth.depth[mask]).max()) < 1e-3  # mm
+    True
+    """
+    rows, cols = np.nonzero(mask)
+    points = grid_points(np.where(mask, depth, np.nan).astype(np.float32), *rays)[rows, cols]
+    proj = calibration.projector
+    u = proj.project(points)[:, 0]
+    phi = phase[rows, cols].astype(np.float64)
+    k = np.rint((2 * np.pi * u / period - phi) / (2 * np.pi))
+    column = (phi + 2 * np.pi * k) * period / (2 * np.pi)
+    pair = Calibration(calibration.left, proj.device, proj.R, proj.T)
+    z = triangulate(np.column_stack([cols, rows]).astype(np.float64), column, pair)[:, 2]
+    out = np.full(mask.shape, np.nan, np.float32)
+    out[rows, cols] = z
+    return out, np.isfinite(out), u - column
 
 
 def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
@@ -342,7 +438,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   calibration: StereoCalibration, period: float, min_depth: float,
                   max_depth: float, noise: tuple[float, float] = (0.0, 0.0),
                   tolerance: float | None = None, rectification: Rectification | None = None,
-                  force: bool = False, check: bool = True) -> Unwrapped:
+                  force: bool = False, check: bool = True, depth_from: str = "projector",
+                  propagate: bool = True, pixel_origin: int | None = None) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -371,6 +468,21 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     check : bool, optional
         Run :func:`check_range` (about a fifth of the time); a stream of windows of one
         scene may check its first window alone (``info["range_check"]`` is then ``None``).
+    depth_from : {"projector", "cameras"}, optional
+        The depth of a decided pixel: the left camera's ray cut by the projector column of
+        its absolute phase (:func:`projector_depth`, as the published pipeline and
+        one-camera triangulation do), or the two cameras' disparity (on the virtual rig
+        two to three times more precise with the projector at 0.3 to 0.5 of the
+        baseline: the cameras lie further apart).
+    propagate : bool, optional
+        Grow the decided pixels into those of two or more candidates
+        (:func:`~.unwrap_jit.grow`: the one candidate within :data:`REACH` pixels of the
+        disparity of :data:`GROW_SUPPORT` decided neighbours, none guessed).
+    pixel_origin : int, optional
+        The pixel origin (0 or 1) of the matrices the calibration came from
+        (:func:`~.projection_matrices.recorded_origin`): checked against the data
+        (:func:`_origin_check`), and the other used, with a warning, when it explains the
+        data clearly better. ``None``: not checked.
 
     Returns
     -------
@@ -396,9 +508,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     >>> lp, rp = (np.float32(2 * np.pi * c / 48 % (2 * np.pi)) for c in x)  # period 48
     >>> found = unwrap_stereo(lp, rp, cal, 48.0, 500.0, 700.0)
     >>> found.info["decided_fraction"], found.info["undecided"]
-    (0.723333, 0)
+    (0.7725, 0)
     >>> round(float(np.median(found.depth[found.mask])), 1)  # mm
-    600.3
+    600.0
     >>> unwrap_stereo(lp, rp, cal, 48.0, 650.0, 750.0)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
@@ -433,27 +545,35 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                           max_depth, (0.5 * min_depth, 2.0 * max_depth))
         if far[2] is not None and far[0] > MOST_OUTSIDE_WIDE:
             (share, points, depths), limit = far, MOST_OUTSIDE_WIDE
-    n_in, disparity, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
-                                    min_depth, max_depth, (min_depth, max_depth))
-    _, from_right, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
-                                  min_depth, max_depth, (min_depth, max_depth),
-                                  from_right=True)
-    crossed = cross_checked(disparity, from_right, rect.shift, SUPPORT)
-    disparity = _beside_occlusion(_supported(crossed, SUPPORT), np.isfinite(lrect) & (
-        (n_in == 0) | ((n_in == 1) & np.isnan(crossed))), EDGE)
-    decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
-    depth, mask, outside, per_row, valid = depth_counts(
-        disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
-        min_depth, max_depth)
+    if depth_from not in ("projector", "cameras"):
+        raise BistairError(f"depth_from must be 'projector' or 'cameras', got {depth_from!r}")
+    origin: dict[str, Any] = {}
+    if pixel_origin is not None:
+        origin = _origin_check(left_phase, right_phase, calibration, period, tolerance,
+                               min_depth, max_depth, pixel_origin)
+        if origin["pixel_origin"] != pixel_origin:
+            calibration = with_pixel_origin(calibration, origin["pixel_origin"] - pixel_origin)
+            rect = rectify(calibration)
+            lrect = rectified_phase(left_phase, rect.maps_left)
+            rrect = rectified_phase(right_phase, rect.maps_right)
+    n_in, crossed, alone, disparity, depth, mask, per_row, valid = _decide(
+        lrect, rrect, left_phase, rect, calibration, period, tolerance, min_depth, max_depth,
+        propagate)
+    pdepth, pmask, residual = projector_depth(depth, mask, left_phase, calibration, period,
+                                              rect.rays)
+    if depth_from == "projector":
+        depth, mask = pdepth, pmask
     rectified_valid = int(np.isfinite(lrect).sum())
     info: dict[str, Any] = {
         "unwrapping": "stereo", "period": period, "depth_range": [min_depth, max_depth],
+        "depth_from": depth_from,
         "left_decoded": int(valid), "decided": int(per_row.sum()),
         "decided_fraction": round(float(per_row.sum() / max(valid, 1)), 6),
         "rectified_valid": rectified_valid,
         "no_candidate": int(np.sum(np.isfinite(lrect) & (n_in == 0))),
-        "undecided": int(np.sum(n_in >= 2)),
-        "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed))),
+        "undecided": int(np.sum((n_in >= 2) & np.isnan(disparity))),
+        "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone))),
+        "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed) & np.isnan(disparity))),
         "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
         "tolerance_rad": round(float(tolerance), 6),
         "noise_rad": [round(float(n), 6) for n in noise],
@@ -461,6 +581,11 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
             "outside": round(share, 6), "points": points,
             "depths": None if depths is None else [round(d, 1) for d in depths]},
         "warnings": []}
+    if origin:
+        info["pixel_origin"] = origin["pixel_origin"]
+        info["consistent"] = origin["consistent"]
+        if origin["pixel_origin"] != pixel_origin:
+            info["warnings"].append(origin["message"])
     if depths is not None and share > limit:
         lo, hi = depths
         message = (f"{100 * share:.0f}% of the points found near the depth range lie outside "
@@ -470,6 +595,124 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
             raise BistairError(message)
         info["warnings"].append(message)
     return Unwrapped(disparity, depth, mask, n_in, rect, info)
+
+
+def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
+            rect: Rectification, calibration: StereoCalibration, period: float,
+            tolerance: float, min_depth: float, max_depth: float, propagate: bool
+            ) -> tuple[Any, ...]:
+    """The search both ways, the cross-check, the support, the growth and the pair's depth
+    (:func:`unwrap_stereo`'s steps 2-3)."""
+    n_in, disparity, _, _, kept = _search(lrect, rrect, rect, calibration, period,
+                                          tolerance, min_depth, max_depth,
+                                          (min_depth, max_depth), everything=True)
+    _, from_right, _, _ = _search(lrect, rrect, rect, calibration, period, tolerance,
+                                  min_depth, max_depth, (min_depth, max_depth),
+                                  from_right=True)
+    crossed = cross_checked(disparity, from_right, rect.shift, SUPPORT)
+    near = _near_occlusion(np.isfinite(lrect) & ((n_in == 0) | cross_checked(
+        disparity, from_right, rect.shift, SUPPORT, contradicted=True)), EDGE)
+    alone = np.where(near, np.float32(np.nan), _supported(crossed, SUPPORT))
+    disparity = grow(alone, n_in, kept, near, REACH, GROW_SUPPORT) if propagate else alone
+    decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
+    depth, mask, _, per_row, valid = depth_counts(
+        disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
+        min_depth, max_depth)
+    return n_in, crossed, alone, disparity, depth, mask, per_row, valid
+
+
+def consistent_share(left_phase: np.ndarray, right_phase: np.ndarray,
+                     calibration: StereoCalibration, period: float, tolerance: float,
+                     min_depth: float, max_depth: float) -> float:
+    """The share of the valid left pixels (every :data:`CHECK_ROWS`-th rectified row) with
+    at least one candidate in the depth range that the projector confirms: near 1 where
+    the calibration fits the cameras' pixels, near 0 where it puts them a pixel off (the
+    projector's column then misses by about the ratio of the focal lengths, more than the
+    tolerance).
+
+    Parameters
+    ----------
+    left_phase, right_phase : numpy.ndarray
+        ``(H, W)`` each camera's wrapped phase (radians, NaN where unknown).
+    calibration : StereoCalibration
+        The cameras and the projector.
+    period, tolerance, min_depth, max_depth : float
+        As :func:`unwrap_stereo`.
+
+    Returns
+    -------
+    float
+        The share (0 without valid pixels).
+
+    Examples
+    --------
+    >>> from bistair.geometry.projection_matrices import with_pixel_origin
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> x = [trace(srig.rig(side), scene).truth.coord_x for side in ("left", "right")]
+    >>> lp, rp = (np.float32(2 * np.pi * c / 48 % (2 * np.pi)) for c in x)  # period 48
+    >>> round(consistent_share(lp, rp, cal, 48.0, 0.1, 500.0, 700.0), 3)
+    0.988
+    >>> round(consistent_share(lp, rp, with_pixel_origin(cal, 1), 48.0, 0.1, 500.0, 700.0), 3)
+    0.0
+    """
+    rect = rectify(calibration)
+    lrect = rectified_phase(left_phase, rect.maps_left)
+    rrect = rectified_phase(right_phase, rect.maps_right)
+    rows = np.arange(0, lrect.shape[0], CHECK_ROWS, dtype=np.int64)
+    n_in = _search(lrect, rrect, rect, calibration, period, tolerance, min_depth, max_depth,
+                   (min_depth, max_depth), rows, whole=False)[0]
+    valid = int(np.isfinite(lrect[rows]).sum())
+    return float(np.sum(n_in >= 1) / valid) if valid else 0.0
+
+
+def _sign_check(lphase: np.ndarray, rphase: np.ndarray, calibration: StereoCalibration,
+                period: float, min_depth: float, max_depth: float,
+                noise: tuple[float, float], tolerance: float | None, sign: int) -> str:
+    """What to say when the phase negated (the other ``shift_sign``) fits the projector
+    clearly better than the spec's: the projector confirms over :data:`ORIGIN_RATIO`
+    times as many left pixels with it, and over :data:`ORIGIN_MIN` (benchmark: the wrong
+    sign confirms 3-23%, the right one 83-99%); ``""`` otherwise. Judged only when the
+    spec's phase confirms under half the pixels."""
+    tol = tolerance or max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*noise))
+    given = consistent_share(lphase, rphase, calibration, period, tol, min_depth, max_depth)
+    if given >= 0.5:
+        return ""
+    negated = [np.where(np.isfinite(p), np.mod(-p, 2 * np.pi), np.nan).astype(np.float32)
+               for p in (lphase, rphase)]
+    other = consistent_share(*negated, calibration, period, tol, min_depth, max_depth)
+    if not (other > ORIGIN_RATIO * given and other > ORIGIN_MIN):
+        return ""
+    return (f"the projector confirms {100 * other:.0f}% of the left pixels with the phase "
+            f"negated, {100 * given:.0f}% as the spec says (shift_sign {sign}): the "
+            f"patterns shift the other way, give a spec with shift_sign {-sign} (bistair "
+            f"patterns multifreq --shift-sign {-sign})")
+
+
+def _origin_check(left_phase: np.ndarray, right_phase: np.ndarray,
+                  calibration: StereoCalibration, period: float, tolerance: float,
+                  min_depth: float, max_depth: float, given: int) -> dict[str, Any]:
+    """Which pixel origin (0 or 1) of the cameras the data fit: :func:`consistent_share`
+    under the calibration's origin ``given`` and under the other; the other is taken when
+    its share is over :data:`ORIGIN_RATIO` times the given one's and over
+    :data:`ORIGIN_MIN`."""
+    other = 1 - given
+    share = {given: consistent_share(left_phase, right_phase, calibration, period,
+                                     tolerance, min_depth, max_depth),
+             other: consistent_share(left_phase, right_phase,
+                                     with_pixel_origin(calibration, other - given), period,
+                                     tolerance, min_depth, max_depth)}
+    used = other if (share[other] > ORIGIN_RATIO * share[given]
+                     and share[other] > ORIGIN_MIN) else given
+    message = (f"the projector confirms {100 * share[other]:.0f}% of the left pixels with "
+               f"the cameras' pixel origin {other}, {100 * share[given]:.0f}% with the "
+               f"calibration's {given}: used {other} (import-calibration --pixel-origin "
+               f"{other} records it)")
+    return {"pixel_origin": used, "message": message,
+            "consistent": {str(o): round(v, 4) for o, v in share.items()}}
 
 
 def absolute_phase(unwrapped: Unwrapped, phase: np.ndarray, calibration: StereoCalibration,
@@ -596,7 +839,8 @@ def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = Non
 def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
                   calibration: StereoCalibration, min_depth: float, max_depth: float,
                   force: bool = False, min_modulation: float | None = None,
-                  tolerance: float | None = None) -> StereoResult:
+                  tolerance: float | None = None, pixel_origin: int | None = None
+                  ) -> StereoResult:
     """Two cameras' captures of one single-period N-step set to depth by stereo phase
     unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
 
@@ -615,6 +859,9 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     min_modulation, tolerance : float, optional
         The modulation a valid pixel needs (fraction of full scale; by default from the
         noise) and the phase tolerance (:func:`unwrap_stereo`).
+    pixel_origin : int, optional
+        The calibration's recorded pixel origin, checked against the data
+        (:func:`unwrap_stereo`).
 
     Returns
     -------
@@ -646,7 +893,7 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     >>> left, right = (expose(t, encode(spec), Imaging()) for t in traced)  # noisy 8-bit
     >>> res = stereo_unwrap(left, right, spec, cal, 500.0, 700.0)
     >>> res.info["matched_fraction"]
-    0.622083
+    0.646458
     >>> decided = res.left.order >= 0
     >>> err = res.left.phase[decided] - 2 * np.pi * traced[0].truth.coord_x[decided] / 48
     >>> round(float(np.abs(err).max()), 2)  # radians, under pi: no order off
@@ -661,8 +908,14 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     (lphase, lfs), (rphase, rfs) = maps
     noise = tuple(float(np.median(fs.phase_noise[fs.valid])) if fs.valid.any() else 0.0
                   for fs in (lfs, rfs))
+    sign = _sign_check(lphase, rphase, calibration, period, min_depth, max_depth, noise,
+                       tolerance, spec.shift_sign)
+    if sign and not force:
+        raise BistairError(sign)
     found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
-                          tolerance, force=force)
+                          tolerance, force=force, pixel_origin=pixel_origin)
+    if sign:
+        found.info["warnings"].insert(0, sign)
     _, order = absolute_phase(found, lphase, calibration, period)
     left = make_result(spec.method, np.where(order >= 0, lphase, 0), order, period, lfs.mod,
                        lfs.avg, wrapped=lphase)
