@@ -89,9 +89,11 @@ def test_orders_and_the_full_search(sim):
     """Where the tracker and the full search of the same window both decide, they decide
     the same disparity. The tracker decides about 1% more (a ghost two fringes away lies
     outside its margin; a single candidate the rows beside did not confirm last window is
-    searched near again), of the right order; and at most one pixel in a thousand fewer
-    (its narrow search found one candidate, which the right camera does not confirm, where
-    the full search found another). Orders off: at most 0.1% of the decided pixels."""
+    searched near again), of the right order. It decides at most 5% fewer: the full search
+    grows decisions from two agreeing neighbours (:func:`~bistair.geometry.unwrap_jit.grow`),
+    which the tracker does not yet do (3.9% on this stream), and a narrow search may find one
+    candidate the right camera does not confirm where the full search found another. Orders
+    off: at most 0.1% of the decided pixels."""
     tracked, lag = windows(sim, 0, 6.0)
     full, _ = windows(sim, 0, 0.0)
     near = 0
@@ -99,7 +101,7 @@ def test_orders_and_the_full_search(sim):
         da, db = np.isfinite(a.disparity), np.isfinite(b.disparity)
         both = da & db
         assert np.array_equal(a.disparity[both], b.disparity[both])
-        assert np.sum(da & ~db) <= 0.02 * da.sum() and np.sum(db & ~da) <= 0.001 * db.sum()
+        assert np.sum(da & ~db) <= 0.02 * da.sum() and np.sum(db & ~da) <= 0.05 * db.sum()
         near += a.info["searched_near"]
         truth = truth_at(sim, a.start + lag, "coord_x")
         off = np.abs(a.phase - 2 * np.pi * truth / PERIOD)
