@@ -36,26 +36,26 @@ prange = range  # numba's prange once the first kernel of this module compiles
 
 @_numba_inline
 def _wrap32(raw: np.float32) -> np.float32:
-    """``(raw + pi) % 2pi - pi`` in float32 (:func:`~bistair.core.phase_jit.wrap_angles`)."""
+    """``(raw + pi) % 2pi - pi`` in float32, as :func:`~bistair.core.phase_jit.wrap_angles`
+    computes it, for ``-3*pi <= raw < 3*pi`` (the difference of two of a stream's
+    phases: each within ``K*pi/2`` of ``[0, 2*pi)``); selects, so that its loop
+    vectorises."""
     d = raw + PI32
     m = d - TWO_PI32 if d >= TWO_PI32 else d
     m = m + TWO_PI32 if d < np.float32(0.0) else m
-    if not (d >= -TWO_PI32 and d < TWO_PI32 + TWO_PI32):
-        m = np.float32(d % TWO_PI32)
     return m - PI32
 
 
 @_numba_inline
 def _mod32(a: np.float32) -> np.float32:
-    """``np.mod(a, 2pi)`` of a float32 (NumPy's rule: ``fmod``, then ``+ 2pi`` below 0)."""
+    """``np.mod(a, 2pi)`` of a float32 as NumPy computes it (``fmod``, then ``+ 2pi`` below
+    0, one rounding) for ``-2*pi < a < 4*pi``; further out ``a - 2pi * floor(a / 2pi)``.
+    Selects, so that its loop vectorises."""
     zero = np.float32(0.0)
-    if zero <= a < TWO_PI32:
-        return a + zero  # (-0.0: 0.0)
-    if TWO_PI32 <= a < TWO_PI32 + TWO_PI32:
-        return a - TWO_PI32  # (exact)
-    if -TWO_PI32 < a < zero:
-        return a + TWO_PI32  # (fmod gives a; one rounding, as NumPy)
-    return np.float32(a % TWO_PI32)
+    far = a - TWO_PI32 * np.floor(a / TWO_PI32)
+    m = a + zero if zero <= a < TWO_PI32 else far  # (a + 0: -0.0 is 0.0)
+    m = a - TWO_PI32 if TWO_PI32 <= a < TWO_PI32 + TWO_PI32 else m  # (exact)
+    return a + TWO_PI32 if -TWO_PI32 < a < zero else m
 
 
 @kernel(parallel=True)
@@ -64,30 +64,33 @@ def _update(frame: np.ndarray, kept: np.ndarray, slot: int, full: bool, sin_k: f
             levels: np.ndarray, mods: np.ndarray, off_hi: np.float32, off_lo: np.float32,
             scale: np.float32, phase: np.ndarray, mod: np.ndarray) -> None:
     h, w = frame.shape
-    half = np.float32(0.5)
-    for y in prange(h):
+    half, two = np.float32(0.5), np.float32(2.0)
+    for y in prange(h):  # (loops without branches out: they vectorise)
         for x in range(w):
             f = float(frame[y, x])
             diff = f - float(kept[slot, y, x]) if full else f
             kept[slot, y, x] = frame[y, x]
             num[y, x] -= sin_k * diff
             den[y, x] += cos_k * diff
-            if windows == 0:
-                continue
+        if windows == 0:
+            continue
+        for x in range(w):
             a, b = np.float32(num[y, x]), np.float32(den[y, x])
-            new = _phase(a, b, off_hi, off_lo)
-            new_mod = _hypot32(a, b) * scale
-            for level in range(order + 1):
+            phase[y, x] = _phase(a, b, off_hi, off_lo)
+            mod[y, x] = _hypot32(a, b) * scale
+        for level in range(order + 1):  # phase, mod: the newest value of the level
+            if level == order or level + 1 >= windows:  # (no previous window above)
+                for x in range(w):
+                    levels[level, y, x], mods[level, y, x] = phase[y, x], mod[y, x]
+                break
+            reduce = level == order - 1
+            for x in range(w):
                 previous, previous_mod = levels[level, y, x], mods[level, y, x]
+                new, new_mod = phase[y, x], mod[y, x]
                 levels[level, y, x], mods[level, y, x] = new, new_mod
-                if level == order:
-                    phase[y, x], mod[y, x] = new, new_mod
-                    break
-                if level + 1 >= windows:  # (no previous window at this level yet)
-                    break
-                mean = previous + _wrap32(new - previous) / np.float32(2.0)
-                new = _mod32(mean) if level == order - 1 else mean
-                new_mod = (previous_mod + new_mod) * half
+                mean = previous + _wrap32(new - previous) / two
+                phase[y, x] = _mod32(mean) if reduce else mean
+                mod[y, x] = (previous_mod + new_mod) * half
 
 
 @dataclass
