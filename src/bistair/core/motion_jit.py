@@ -17,7 +17,7 @@ Examples
 >>> state = stream_state((1, 8), 4, 0, np.float32)
 >>> for i, f in enumerate(frames):
 ...     ready = stream_update(state, f, i, 4, 0, 1, 0.0)
->>> ready, np.round(state.phase, 4).tolist()[0][:3]
+>>> ready, state.phase.astype(float).round(4).tolist()[0][:3]
 (True, [0.0, 0.7854, 1.5708])
 """
 
@@ -160,7 +160,10 @@ def stream_update(state: StreamState, frame: np.ndarray, count: int, steps: int,
 
     Examples
     --------
-    See the module docstring.
+    >>> state = stream_state((1, 2), 3, 0, np.float64)
+    >>> [stream_update(state, np.float64([[v, 2 * v]]), i, 3, 0, 1, 0.0)
+    ...  for i, v in enumerate((1.0, 2.0, 3.0))]
+    [False, False, True]
     """
     slot = count % steps
     shift = np.float64(shift_sign * (2.0 * math.pi) * slot / steps)  # (stream_shifts)
