@@ -7,8 +7,10 @@ steady state is timed: each new frame pair updates both cameras' sums, unwraps (
 near the previous disparity, the full range where that fails, the confirmations) and
 triangulates (the projector's column planes). Process CPU time, the minimum of interleaved
 rounds, per depth map, beside two bare baselines of the same run: one ``cv2.remap`` of a
-640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. The decided pixels an
-order off are counted against the renderer's truth after the timing.
+640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. Then where the time goes:
+each stage of a depth map (both cameras) timed inside the stream's steps, the minimum over
+``--frames`` depth maps (the stages' minima need not add up to the whole's). The decided
+pixels an order off are counted against the renderer's truth after the timing.
 
     python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
 """
@@ -17,18 +19,30 @@ from __future__ import annotations
 
 import argparse
 import time
+from collections import defaultdict
+from collections.abc import Callable
 
 import cv2
 import numba
 import numpy as np
 
 from bistair.codecs import encode, make_spec
+from bistair.core.motion import PhaseStream
+from bistair.geometry import unwrap_stream
 from bistair.geometry.stereo_calibration import StereoCalibration
 from bistair.geometry.unwrap_stream import StereoStream
 from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.stereo import StereoRig
 
 RANGE = (520.0, 650.0)
+STAGES = {  # what each stage of a depth map calls (module or class, name)
+    "running sums (PhaseStream)": [(PhaseStream, "update")],
+    "resampling (rectify_pair)": [(unwrap_stream, "rectify_pair")],
+    "row searches (track_rows)": [(unwrap_stream, "track_rows")],
+    "confirmation (confirm)": [(unwrap_stream, "confirm")],
+    "depth (projector_pixels, plane_depth)": [(unwrap_stream, "projector_pixels"),
+                                              (unwrap_stream, "plane_depth")],
+}
 
 
 def scene_frames(width: int, height: int, count: int
@@ -55,6 +69,41 @@ def cpu(fn, repeat: int = 1) -> float:
     for _ in range(repeat):
         fn()
     return (time.process_time() - start) / repeat
+
+
+def stage_split(stream: StereoStream, left: np.ndarray, right: np.ndarray, first: int,
+                count: int) -> dict[str, float]:
+    """Process CPU seconds of each stage of a depth map, the minimum over ``count`` depth
+    maps (frames ``first ..``, wrapping), and of the whole ``push``."""
+    spent: dict[str, float] = defaultdict(float)
+    saved: list[tuple[object, str, Callable]] = []
+
+    def timed(stage: str, fn: Callable) -> Callable:
+        def call(*args: object, **kwargs: object) -> object:
+            start = time.process_time()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                spent[stage] += time.process_time() - start
+        return call
+
+    for stage, places in STAGES.items():
+        for owner, name in places:
+            saved.append((owner, name, getattr(owner, name)))
+            setattr(owner, name, timed(stage, getattr(owner, name)))
+    best = {name: float("inf") for name in (*STAGES, "whole depth map")}
+    try:
+        for i in range(first, first + count):
+            spent.clear()
+            start = time.process_time()
+            stream.push(left[i % len(left)], right[i % len(right)])
+            spent["whole depth map"] = time.process_time() - start
+            for name in best:
+                best[name] = min(best[name], spent[name])
+    finally:
+        for owner, name, fn in saved:
+            setattr(owner, name, fn)
+    return best
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -109,6 +158,14 @@ def main(argv: list[str] | None = None) -> int:
     for name in tasks:
         print(f"| {name} | {1000 * best[name]:.2f} | {best[name] / base:.1f} | "
               f"{1 / best[name]:.0f} | {1000 * wall[name]:.2f} | {1 / wall[name]:.0f} |")
+    for name, stream in streams.items():
+        split = stage_split(stream, left, right, position[name], args.frames)
+        print(f"\n| --window {name}: stage (both cameras) | CPU ms | / remap | share |")
+        print("| --- | ---: | ---: | ---: |")
+        for stage, seconds in split.items():
+            print(f"| {stage} | {1000 * seconds:.2f} | {seconds / base:.1f} | "
+                  f"{100 * seconds / split['whole depth map']:.0f}% |")
+    print()
     off = {name: [0, 0] for name in streams}
     for name, results in kept.items():  # (after the timing)
         for phase, mask in results:

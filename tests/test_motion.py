@@ -108,3 +108,57 @@ def test_refusals():
     stream.push(np.zeros((4, 6)))
     with pytest.raises(BistairError, match=r"frame 1 is \(4, 5\), the stream's frames are"):
         stream.push(np.zeros((4, 5)))
+
+
+def numpy_stream(frames, steps, order, shift_sign, phase_offset):
+    """The NumPy steps PhaseStream took before its compiled pass: float64 running sums,
+    ``phase_of_sums`` of their float32 values, rounds of ``pair_mean``."""
+    from bistair.core.motion import stream_shifts
+    from bistair.core.phase import phase_of_sums
+
+    shifts = stream_shifts(steps, steps, shift_sign)
+    sin, cos = np.sin(shifts), np.cos(shifts)
+    num = np.zeros(frames.shape[1:])
+    den = np.zeros(frames.shape[1:])
+    levels, mods, out = [None] * (order + 1), [None] * (order + 1), []
+    for i, frame in enumerate(frames):
+        diff = frame.astype(np.float64) - (frames[i - steps] if i >= steps else 0)
+        num -= sin[i % steps] * diff
+        den += cos[i % steps] * diff
+        if i < steps - 1:
+            continue
+        new, new_mod = phase_of_sums(num.astype(np.float32), den.astype(np.float32), steps,
+                                     phase_offset)
+        for level in range(order + 1):
+            previous, previous_mod = levels[level], mods[level]
+            levels[level], mods[level] = new, new_mod
+            if level == order:
+                out.append((new, new_mod))
+                break
+            if previous is None:
+                break
+            new = pair_mean(previous, new, reduce=level == order - 1)
+            new_mod = (previous_mod + new_mod) * np.float32(0.5)
+    return out
+
+
+@pytest.mark.parametrize("steps,order,shift_sign,phase_offset", [
+    (4, 0, 1, 0.0), (4, 2, 1, 0.0), (4, 3, -1, 0.7), (3, 1, 1, -2.0), (6, 4, -1, 0.3)])
+def test_the_compiled_pass_gives_the_numpy_steps_bit_for_bit(steps, order, shift_sign,
+                                                               phase_offset):
+    """Every window of a moving uint8 stream of 64 x 80 (past 4096 pixels, where ``wrap``
+    is its compiled pass), through every level of the compensation."""
+    rng = np.random.default_rng(steps + 7 * order)
+    x = np.tile(np.linspace(0, 200, 80), (64, 1)) + rng.uniform(0, 5, (64, 1))
+    count = steps + order + 12
+    frames = stream(x, steps, count, speed=1.3, period=24.0, shift_sign=shift_sign,
+                    phase_offset=phase_offset) + rng.normal(0, 0.02, (count, 64, 80))
+    frames = np.round(np.clip(frames, 0, 1) * 255).astype(np.uint8)
+    want = numpy_stream(frames, steps, order, shift_sign, phase_offset)
+    s = PhaseStream(steps, order, shift_sign, phase_offset)
+    got = [r for r in (s.push(f) for f in frames) if r is not None]
+    assert len(got) == len(want) == count - steps - order + 1
+    for (p, m), (wp, wm) in zip(got, want, strict=True):
+        assert p.dtype == m.dtype == np.float32
+        assert np.array_equal(p, wp) and np.array_equal(m, wm)
+    assert s.state is not None and s.update(frames[0]) and s.state.phase.shape == (64, 80)

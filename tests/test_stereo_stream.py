@@ -216,3 +216,35 @@ def test_depth_through_a_distorted_projector():
         err = err[np.isfinite(err)]
         assert result.info["decided_fraction"] > 0.6
         assert np.median(err) < 1.0 and np.max(err) < TOLERANCE_MM
+
+
+def test_rectify_pair_gives_rectified_phase_bit_for_bit():
+    """The stream's one-pass resampling equals the one-set path (``np.where`` of the
+    threshold, then ``rectified_phase``) on both grids of a rig whose right grid samples
+    between pixels, also at the image's edges, and its buffers are reused."""
+    from bistair.geometry.stereo import rectify
+    from bistair.geometry.stereo_calibration import StereoCalibration
+    from bistair.geometry.unwrap import rectified_phase
+    from bistair.geometry.unwrap_stream_jit import rectify_pair
+    from bistair.sim.stereo import StereoRig
+
+    srig = StereoRig.default(camera_size=SIZE, projector_size=(640, 480))
+    rect = rectify(StereoCalibration.from_rig(srig))
+    rng = np.random.default_rng(3)
+    yy, xx = np.mgrid[:SIZE[1], :SIZE[0]]
+    buffers: dict = {}
+    for maps in (rect.maps_left, rect.maps_right):
+        assert maps[0].dtype == np.float32
+        for _ in range(2):
+            phi = np.float32((2 * np.pi * xx / 21 + 0.01 * yy + rng.normal(0, 0.05, xx.shape))
+                             % (2 * np.pi))
+            mod = np.float32(rng.uniform(0, 1, phi.shape))
+            want_phase = np.where(mod >= 0.3, phi, np.float32(np.nan)).astype(np.float32)
+            want = rectified_phase(want_phase, maps)
+            phase, got, valid = rectify_pair(phi, mod, 0.3, maps, buffers)
+            assert valid == int(np.sum(mod >= 0.3))
+            assert np.array_equal(phase, want_phase, equal_nan=True)
+            assert np.array_equal(got, want, equal_nan=True)
+            assert 0.2 < np.isfinite(got).mean() < 0.9  # (both kinds of pixel)
+    fractions = rect.maps_right[0] - np.floor(rect.maps_right[0])
+    assert np.mean((fractions > 0.01) & (fractions < 0.99)) > 0.5  # between pixels

@@ -46,6 +46,7 @@ from math import comb
 import numpy as np
 
 from ..errors import BistairError
+from .motion_jit import StreamState, stream_state, stream_update
 from .phase import TWO_PI, phase_of_sums, wrap
 
 
@@ -240,7 +241,8 @@ class PhaseStream:
     frame adds its difference to the frame ``N`` before it, which has the same shift:
     two multiply-adds a pixel instead of a whole set's ``N``) and, for order ``K``, the
     newest value of each round of pairwise means of the phases and of the modulations
-    (``K`` of each a frame).
+    (``K`` of each a frame); all in one compiled pass a frame
+    (:func:`~bistair.core.motion_jit.stream_update`), in buffers reused.
 
     Examples
     --------
@@ -265,14 +267,9 @@ class PhaseStream:
             raise BistairError(f"shift_sign must be +1 or -1, got {shift_sign}")
         self.steps, self.order = steps, order
         self.shift_sign, self.phase_offset = shift_sign, phase_offset
-        shifts = stream_shifts(steps, steps, shift_sign)
-        self._sin, self._cos = np.sin(shifts), np.cos(shifts)
         self.count = 0  # frames pushed
-        self._frames: list[np.ndarray] = []
-        self._num: np.ndarray | None = None
-        self._den: np.ndarray | None = None
-        self._levels: list[np.ndarray | None] = [None] * (order + 1)  # newest of each round
-        self._mods: list[np.ndarray | None] = [None] * (order + 1)
+        self.state: StreamState | None = None  # the buffers, from the first frame
+        self._shape: tuple[int, ...] = ()
 
     @property
     def lag(self) -> float:
@@ -284,45 +281,52 @@ class PhaseStream:
         and modulation (float32; the modulation in the frames' own units, e.g. 0-255 for
         uint8 frames) of the newest window, compensated to order ``K``, once ``N + K``
         frames are in, else None."""
-        frame = np.asarray(frame)
-        n, k = self.steps, self.count % self.steps
-        if self._num is not None and frame.shape != self._num.shape:
-            raise BistairError(f"frame {self.count} is {frame.shape}, the stream's frames "
-                               f"are {self._num.shape}")
-        if self._num is None:
-            self._num = np.zeros(frame.shape, np.float64)
-            self._den = np.zeros(frame.shape, np.float64)
-        kept = frame.copy()  # a camera may grab every frame into one buffer
-        if len(self._frames) < n:
-            diff = frame.astype(np.float64)
-            self._frames.append(kept)
-        else:
-            diff = frame.astype(np.float64) - self._frames[k]
-            self._frames[k] = kept
-        self._num -= self._sin[k] * diff
-        self._den += self._cos[k] * diff
-        self.count += 1
-        if self.count < n:
+        if not self.update(frame):
             return None
-        phi, mod = phase_of_sums(self._num.astype(np.float32), self._den.astype(np.float32),
-                                 n, self.phase_offset)
-        return self._compensated(phi, mod)
+        assert self.state is not None
+        return (self.state.phase.reshape(self._shape).copy(),
+                self.state.mod.reshape(self._shape).copy())
 
-    def _compensated(self, phi: np.ndarray, mod: np.ndarray
-                     ) -> tuple[np.ndarray, np.ndarray] | None:
-        """Feed the newest window into the rounds of pairwise means (of the phases across
-        the wrap, brought into ``[0, 2*pi)`` at the last round; of the modulations)."""
-        new, new_mod = phi, mod
-        for level in range(self.order + 1):
-            previous, previous_mod = self._levels[level], self._mods[level]
-            self._levels[level], self._mods[level] = new, new_mod
-            if level == self.order:
-                return new, new_mod
-            if previous is None:
-                return None
-            new = pair_mean(previous, new, reduce=level == self.order - 1)
-            new_mod = (previous_mod + new_mod) * np.float32(0.5)
-        return None  # pragma: no cover - the loop returns
+    def update(self, frame: np.ndarray) -> bool:
+        """:meth:`push` without the copies: whether ``state.phase`` and ``state.mod`` now
+        hold the newest window's results (buffers the next frame overwrites).
+
+        Parameters
+        ----------
+        frame : numpy.ndarray
+            ``(H, W)`` the next frame.
+
+        Returns
+        -------
+        bool
+            ``N + K`` frames are in.
+
+        Examples
+        --------
+        >>> stream = PhaseStream(3)
+        >>> [stream.update(np.full((2, 2), v, np.uint8)) for v in (1, 2, 3)]
+        [False, False, True]
+        """
+        frame = np.asarray(frame)
+        state = self.state
+        if state is not None and frame.shape != self._shape:
+            raise BistairError(f"frame {self.count} is {frame.shape}, the stream's frames "
+                               f"are {self._shape}")
+        self._shape = frame.shape
+        if frame.ndim != 2:  # (the pass runs over rows)
+            frame = frame.reshape(-1, frame.shape[-1]) if frame.ndim else frame.reshape(1, 1)
+        kind = frame.dtype if frame.dtype in _KEPT else np.dtype(np.float64)
+        if state is None:
+            state = self.state = stream_state(frame.shape, self.steps, self.order, kind)
+        elif kind != state.kept.dtype:  # frames of another type: keep them all as float64
+            state.kept = state.kept.astype(np.float64)
+        ready = stream_update(state, frame, self.count, self.steps, self.order,
+                              self.shift_sign, self.phase_offset)
+        self.count += 1
+        return ready
+
+
+_KEPT = tuple(np.dtype(t) for t in (np.uint8, np.uint16, np.float32, np.float64))
 
 
 def _check_order(order: int) -> None:

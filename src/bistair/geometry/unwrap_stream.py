@@ -6,8 +6,9 @@ through a :class:`~bistair.core.motion.PhaseStream` (running sums: a new frame c
 multiply-adds a pixel; order ``K`` compensates motion). For each window:
 
 1. The wrapped phases (NaN below the modulation threshold measured on the first ``N``
-   frames) are resampled onto the rectified grids
-   (:func:`~bistair.geometry.unwrap.rectified_phase`).
+   frames) are resampled onto the rectified grids in one pass a camera
+   (:func:`~.unwrap_stream_jit.rectify_pair`: what
+   :func:`~bistair.geometry.unwrap.rectified_phase` gives, with fewer passes).
 2. The first window is unwrapped by :func:`~bistair.geometry.unwrap.unwrap_stereo`, as the
    one-set ``stereo`` command does, its depth range checked. Each later window searches
    each pixel of both rectified grids only within :data:`MARGIN` pixels of its single
@@ -79,10 +80,15 @@ from .unwrap import (
     SUPPORT,
     TOLERANCE_SIGMAS,
     is_single_period,
-    rectified_phase,
     unwrap_stereo,
 )
-from .unwrap_stream_jit import confirm, plane_depth, projector_pixels, track_rows
+from .unwrap_stream_jit import (
+    confirm,
+    plane_depth,
+    projector_pixels,
+    rectify_pair,
+    track_rows,
+)
 
 #: Half the width (rectified pixels) of a later window's search about the previous
 #: window's disparity (module docstring).
@@ -183,6 +189,7 @@ class StereoStream:
         rp = np.asarray(proj.R, np.float64)
         self.ax = (rp[0, 0] * rx + rp[0, 1] * ry + rp[0, 2]).astype(np.float32)
         self.az = (rp[2, 0] * rx + rp[2, 1] * ry + rp[2, 2]).astype(np.float32)
+        self.buffers: list[dict] = [{}, {}]  # rectify_pair's
 
     @property
     def lag(self) -> float:
@@ -220,17 +227,19 @@ class StereoStream:
                 kept.append(np.array(frame))
             if self.count == n - 1:
                 self._measure()
-        outs = [s.push(f) for s, f in zip(self.streams, (left, right), strict=True)]
+        ready = [s.update(f) for s, f in zip(self.streams, (left, right), strict=True)]
         self.count += 1
-        if outs[0] is None or outs[1] is None:
+        if not (ready[0] and ready[1]):
             return None
         assert self.thresholds is not None
-        phases = [np.where(mod >= t, phi, np.float32(np.nan)).astype(np.float32)
-                  for (phi, mod), t in zip(outs, self.thresholds, strict=True)]
+        states = [s.state for s in self.streams]
+        rectified = [rectify_pair(st.phase, st.mod, t, table, buffers)
+                     for st, t, table, buffers in zip(
+                         states, self.thresholds, (self.rect.maps_left, self.rect.maps_right),
+                         self.buffers, strict=True)]
         start = self.count - n - self.order
-        result = self._window(phases[0], phases[1], start)
-        mod = outs[0][1]
-        result.grey = np.clip(mod * np.float32(255 / max(self.scale, 1e-12)), 0,
+        result = self._window(rectified[0], rectified[1], start)
+        result.grey = np.clip(states[0].mod * np.float32(255 / max(self.scale, 1e-12)), 0,
                               255).astype(np.uint8)
         result.info["cpu_seconds"] = round(time.process_time() - clock, 6)
         return result
@@ -253,9 +262,13 @@ class StereoStream:
         if self.tolerance is None:
             self.tolerance = max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*self.noise))
 
-    def _window(self, lphase: np.ndarray, rphase: np.ndarray, start: int) -> StreamDepth:
-        """One window's depth from the two wrapped phases."""
+    def _window(self, left: tuple[np.ndarray, np.ndarray, int],
+                right: tuple[np.ndarray, np.ndarray, int], start: int) -> StreamDepth:
+        """One window's depth from the two wrapped phases (each camera's, NaN where not
+        modulated, on its own grid and on its rectified grid, and its count of valid
+        pixels: :func:`~.unwrap_stream_jit.rectify_pair`)."""
         rect = self.rect
+        (lphase, lrect, valid), (rphase, rrect, _) = left, right
         info: dict[str, Any]
         tracked = not (self.previous is None or self.margin == 0)
         if not tracked:
@@ -270,8 +283,6 @@ class StereoStream:
                                                 "unsupported", "warnings")}
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
         else:
-            lrect = rectified_phase(lphase, rect.maps_left)
-            rrect = rectified_phase(rphase, rect.maps_right)
             disparity, info = self._track(lrect, rrect)
         cols, rows = projector_pixels(disparity, *self.geometry)
         proj = self.calibration.projector
@@ -282,7 +293,6 @@ class StereoStream:
         if not tracked:  # (a tracked window keeps its single candidates: _track)
             self.previous, self.previous_right = disparity, None
         mask = np.isfinite(depth)
-        valid = int(np.isfinite(lphase).sum())
         decided = int(mask.sum())
         info = {"start": start, "decided": decided,
                 "decided_fraction": round(decided / max(valid, 1), 6), "left_decoded": valid,

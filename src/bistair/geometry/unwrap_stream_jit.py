@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 
 from ..core.jit import _numba_inline, kernel
@@ -505,3 +506,96 @@ def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: n
                               np.ascontiguousarray(right, np.float32), float(shift),
                               float(support), int(edge))
     return out, int(nc.sum()), int(un.sum())
+
+
+@kernel(parallel=True)
+def _mask(phi: np.ndarray, mod: np.ndarray, threshold: float, phase: np.ndarray,
+          zeroed: np.ndarray, valid: np.ndarray) -> int:
+    h, w = phi.shape
+    count = 0
+    for y in prange(h):
+        for x in range(w):
+            if mod[y, x] >= threshold:
+                phase[y, x] = zeroed[y, x] = phi[y, x]
+                valid[y, x] = np.float32(1.0)
+                count += 1
+            else:
+                phase[y, x] = np.float32(np.nan)
+                zeroed[y, x] = valid[y, x] = np.float32(0.0)
+    return count
+
+
+@kernel(parallel=True)
+def _finish(angle: np.ndarray, valid: np.ndarray) -> None:
+    oh, ow = angle.shape
+    two_pi = np.float32(TWO_PI)
+    for y in prange(oh):
+        for x in range(ow):
+            a = angle[y, x]
+            if valid[y, x] < np.float32(0.999):
+                angle[y, x] = np.float32(np.nan)
+            elif a < np.float32(0.0):
+                a = a + two_pi
+                angle[y, x] = np.float32(0.0) if a >= two_pi else a
+            elif a >= two_pi:
+                angle[y, x] = np.float32(0.0)
+
+
+def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
+                 maps: tuple[np.ndarray, np.ndarray], buffers: dict | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, int]:
+    """A camera's wrapped phase, NaN where its modulation is below ``threshold``, and that
+    phase resampled onto its rectified grid: bit for bit what ``np.where(mod >=
+    threshold, phi, nan)`` and :func:`~bistair.geometry.unwrap.rectified_phase` give (the
+    same ``cv2.remap`` of the cosine, sine and validity, NumPy's own ``cos``, ``sin`` and
+    ``arctan2``), the masks in two compiled passes, into reused buffers.
+
+    Parameters
+    ----------
+    phi, mod : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase and modulation.
+    threshold : float
+        The modulation a valid pixel needs.
+    maps : tuple of numpy.ndarray
+        The rectified grid's remap tables (rectified pixel -> camera pixel).
+    buffers : dict, optional
+        Arrays to reuse from one call to the next (an empty dict at first; the results
+        are among them: the next call overwrites them).
+
+    Returns
+    -------
+    phase : numpy.ndarray
+        ``(H, W)`` float32 the phase, NaN below the threshold.
+    rectified : numpy.ndarray
+        The phase on the rectified grid, in ``[0, 2*pi)``, NaN where unknown.
+    valid : int
+        The pixels of known phase.
+
+    Examples
+    --------
+    >>> phi = np.float32([[6.2, 0.1, 3.0]])
+    >>> mod = np.float32([[1.0, 1.0, 0.0]])
+    >>> maps = (np.float32([[0.5, 1.5]]), np.float32([[0.0, 0.0]]))
+    >>> phase, rect, n = rectify_pair(phi, mod, 0.5, maps)
+    >>> round(float(rect[0, 0]), 4), bool(np.isnan(rect[0, 1])), n
+    (0.0084, True, 2)
+    """
+    phi = np.ascontiguousarray(phi, np.float32)
+    shape = maps[0].shape
+    b = {} if buffers is None else buffers
+    if "phase" not in b or b["phase"].shape != phi.shape or b["angle"].shape != shape:
+        for name in ("phase", "zeroed", "valid", "cos", "sin"):
+            b[name] = np.empty(phi.shape, np.float32)
+        for name in ("c", "s", "v", "angle"):
+            b[name] = np.empty(shape, np.float32)
+    count = _mask(phi, np.ascontiguousarray(mod, np.float32), float(threshold), b["phase"],
+                  b["zeroed"], b["valid"])
+    np.cos(b["zeroed"], out=b["cos"])
+    np.sin(b["zeroed"], out=b["sin"])
+    np.multiply(b["cos"], b["valid"], out=b["cos"])  # (0 where not valid: cos 0 is 1)
+    for plane, out in (("cos", "c"), ("sin", "s"), ("valid", "v")):
+        cv2.remap(b[plane], maps[0], maps[1], cv2.INTER_LINEAR, dst=b[out],
+                  borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    np.arctan2(b["s"], b["c"], out=b["angle"])
+    _finish(b["angle"], b["v"])
+    return b["phase"], b["angle"], int(count)
