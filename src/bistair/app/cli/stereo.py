@@ -9,7 +9,8 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
+    CliError,
     Input,
     Output,
     _quiet,
@@ -66,9 +67,9 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     except for a single-period spec (patterns multifreq --periods T): its fringe order comes
     from the projector's pose in the calibration and --depth-range (stereo phase
     unwrapping); pixels that stay ambiguous are left out."""
-    from .jobs import parse_depth_range
-    from .progress import Progress
-    from .stereo import stereo_folder, warnings
+    from ..jobs import parse_depth_range
+    from ..progress import Progress
+    from ..stereo import stereo_folder, warnings
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if window is not None or starts is not None:
@@ -109,9 +110,8 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
                    min_modulation: float | None, quiet: bool) -> None:
     """``stereo --window``: a depth map per window of two streams
     (:mod:`bistair.app.stereo_stream`)."""
-    from .cli_options import CliError
-    from .progress import Progress
-    from .stereo_stream import stereo_stream
+    from ..progress import Progress
+    from ..stereo_stream import stereo_stream
 
     if window is None:
         raise CliError("--starts needs --window N or N+K")
@@ -147,8 +147,8 @@ def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
     POSES: one folder per pose holding a left and a right image (named left/right, else in
     name order), or left/ and right/ folders whose images pair up in name order. Poses
     where the board is not found in both images are skipped."""
-    from .progress import Progress
-    from .stereo import calibrate_stereo_folder
+    from ..progress import Progress
+    from ..stereo import calibrate_stereo_folder
 
     with Progress(quiet) as say:
         cal, skipped = calibrate_stereo_folder(poses, out, board, min_poses, progress=say)

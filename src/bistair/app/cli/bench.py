@@ -8,7 +8,7 @@ from pathlib import Path
 
 import click
 
-from .cli_options import _LazyHelp, _method_help, _quiet, _Size, _threads, reports_errors
+from .options import _LazyHelp, _method_help, _quiet, _Size, _threads, reports_errors
 
 
 @click.command()
@@ -36,8 +36,8 @@ def bench(camera: tuple[int, int], picked: tuple[str, ...], runs: int, json_path
     --runs decodes. The machine is described on the last line (cores, threads, CPU, numba's
     threading layer, load): compare the ratios, which a busy machine changes less than the
     times."""
-    from .bench import bench_lines, check_json_path, run_bench, write_bench_json
-    from .progress import Progress
+    from ..bench import bench_lines, check_json_path, run_bench, write_bench_json
+    from ..progress import Progress
 
     names = [name.strip() for item in picked for name in item.split(",") if name.strip()]
     if json_path is not None:  # refused before the work, not after it

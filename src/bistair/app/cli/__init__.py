@@ -17,12 +17,12 @@ from typing import Any
 import click
 import numpy as np
 
-from ..core.jit import interrupt
-from ..core.memory import keep_freed_memory
-from ..spec import BaseSpec, coerce_field, field_kind
-from .cli_batch import batch
-from .cli_bench import bench
-from .cli_options import (
+from ...core.jit import interrupt
+from ...core.memory import keep_freed_memory
+from ...spec import BaseSpec, coerce_field, field_kind
+from .batch import batch
+from .bench import bench
+from .options import (
     CliError,
     Input,
     Output,
@@ -37,9 +37,9 @@ from .cli_options import (
     board_choice,
     reports_errors,
 )
-from .cli_scan import scan
-from .cli_simulate import simulate
-from .cli_stereo import calibrate_stereo, stereo
+from .scan import scan
+from .simulate import simulate
+from .stereo import calibrate_stereo, stereo
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -53,12 +53,12 @@ class _MethodCommands(click.Group):
     ``bistair --version`` and ``--help`` do not import the codecs."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
-        from ..codecs import REGISTRY
+        from ...codecs import REGISTRY
 
         return [*REGISTRY, *(c for c in super().list_commands(ctx) if c not in REGISTRY)]
 
     def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
-        from ..codecs import REGISTRY
+        from ...codecs import REGISTRY
 
         codec = REGISTRY.get(cmd_name)
         if codec is None:
@@ -68,7 +68,7 @@ class _MethodCommands(click.Group):
     def resolve_command(self, ctx: click.Context, args: list[str]
                         ) -> tuple[str | None, click.Command | None, list[str]]:
         """An unknown name is refused with the closest method and the list of them."""
-        from ..codecs import REGISTRY
+        from ...codecs import REGISTRY
 
         name = args[0] if args else ""
         if name and not name.startswith("-") and self.get_command(ctx, name) is None:
@@ -111,7 +111,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
 
     @reports_errors
     def callback(out: Path, gamma_file: Path | None, **values: Any) -> None:
-        from .jobs import read_gamma, save_patterns
+        from ..jobs import read_gamma, save_patterns
 
         values = {key: coerce_field(fields[key], value) for key, value in values.items()}
         ctx = click.get_current_context()
@@ -145,7 +145,7 @@ _SPEC_TYPES = {int: "INTEGER", float: "NUMBER", str: "TEXT", tuple: "NUMBER,..."
 @reports_errors
 def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -> None:
     """A ramp of uniform grey frames (NN.png and ramp.json) for 'bistair gamma'."""
-    from .jobs import save_ramp
+    from ..jobs import save_ramp
 
     save_ramp(width, height, levels, int(bits), out)
     click.echo(f"wrote {levels} grey frames and ramp.json to {out}")
@@ -160,7 +160,7 @@ def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -
 @reports_errors
 def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
     """Measure the projector's gamma from captures of 'bistair patterns gamma'."""
-    from .jobs import measure_gamma
+    from ..jobs import measure_gamma
 
     fit = measure_gamma(list(captures), out, ramp)
     click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
@@ -197,14 +197,14 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     CAPTURES: a folder, image files, or quoted glob patterns ('scan/pat*.png'), in that
     order; a folder's or pattern's images in natural name order; or one .npy stack.
     """
-    from .jobs import decode_folder
-    from .progress import Progress
+    from ..jobs import decode_folder
+    from ..progress import Progress
 
     if window is not None or starts is not None:
         _decode_stream(list(captures), spec_path, out, window, starts, min_modulation,
                        strategy, force, quiet)
         return
-    from .stream import refuse_single_period
+    from ..stream import refuse_single_period
 
     refuse_single_period(list(captures), spec_path)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
@@ -229,8 +229,8 @@ def _decode_stream(captures: list[str], spec_path: Path | None, out: str, window
                    starts: str | None, min_modulation: float | None, strategy: str | None,
                    force: bool, quiet: bool) -> None:
     """``decode --window``: a stream decoded window by window (:mod:`bistair.app.stream`)."""
-    from .progress import Progress
-    from .stream import decode_stream
+    from ..progress import Progress
+    from ..stream import decode_stream
 
     if window is None:
         raise CliError("--starts needs --window N or N+K")
@@ -255,7 +255,7 @@ def _decode_stream(captures: list[str], spec_path: Path | None, out: str, window
 @reports_errors
 def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
     """The paper's simulation on the virtual rig: every method, one table, a report."""
-    from .demo import run_demo
+    from ..demo import run_demo
 
     run_demo(out, seed=seed, camera_size=camera)
 
@@ -282,9 +282,9 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
 
     Prints the reprojection errors and one standard deviation of every parameter; a pose
     that does not decode or does not show the board is skipped with a warning."""
-    from ..geometry.calibrate import MIN_POSES
-    from .calibrate import calibrate_folder, summary_lines
-    from .progress import Progress
+    from ...geometry.calibrate import MIN_POSES
+    from ..calibrate import calibrate_folder, summary_lines
+    from ..progress import Progress
 
     if min_poses < MIN_POSES:
         raise CliError(f"--min-poses {min_poses} is too few: a camera-projector calibration "
@@ -330,7 +330,7 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
     --projection-matrices (and no FILES), two cameras and the projector from their 3x4
     matrices P = K [R | t] (X_device = R X_world + t, mm)."""
     if matrices is not None:
-        from .jobs import import_projection_matrices
+        from ..jobs import import_projection_matrices
 
         if files or stereo or keys:
             raise CliError("--projection-matrices takes no FILES, --stereo or --keys")
@@ -344,8 +344,8 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
     if not files:
         raise CliError("give the calibration FILES (or --projection-matrices)")
     if stereo:
-        from ..geometry.stereo_calibration import short_baseline
-        from .stereo import import_stereo_calibration
+        from ...geometry.stereo_calibration import short_baseline
+        from ..stereo import import_stereo_calibration
 
         if projector_size is not None:
             raise CliError("--projector-size does not apply to a stereo calibration (two "
@@ -356,7 +356,7 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
         if short_baseline(pair):
             click.echo(f"Warning: {short_baseline(pair)}", err=True)
         return
-    from .jobs import import_calibration as run
+    from ..jobs import import_calibration as run
 
     cal = run(files, out, projector_size, camera_size, keys)
     click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
@@ -393,8 +393,8 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
     With a spec of both axes (orientation both), each point fits both projector
     coordinates, and pixels whose coordinates no point on their camera ray shows are
     dropped as wrong decodes."""
-    from .jobs import parse_depth_range, reconstruct_folder
-    from .progress import Progress
+    from ..jobs import parse_depth_range, reconstruct_folder
+    from ..progress import Progress
 
     if out.suffix.lower() != ".ply":
         raise CliError(f"--out {out} must name a .ply file: the point cloud is written as PLY")
@@ -441,8 +441,8 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
            planes: tuple[str, ...], geometry: str | None, quiet: bool) -> None:
     """Height above a reference plane without a calibration (phase-to-height)."""
-    from .jobs import height_folder
-    from .progress import Progress
+    from ..jobs import height_folder
+    from ..progress import Progress
 
     with Progress(quiet) as say:
         h = height_folder(captures, reference, out, spec_path, planes, geometry, progress=say)

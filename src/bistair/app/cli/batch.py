@@ -10,7 +10,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
     Output,
@@ -63,14 +63,14 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     Exit code 0 when every set decoded, 3 when some failed, 2 on bad input; after Ctrl-C
     1, after SIGTERM 143 (batch.csv lists the finished sets).
     """
-    from .batch import run_batch
-    from .jobs import parse_depth_range
+    from ..batch import run_batch
+    from ..jobs import parse_depth_range
 
     if depth_range is not None and calibration is None:
         raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if calibration is not None:  # a stereo one's baseline under 10 mm: said once
-        from ..geometry.calibration import StereoCalibration, load_calibration, short_baseline
+        from ...geometry.calibration import StereoCalibration, load_calibration, short_baseline
 
         cal = load_calibration(calibration)
         if isinstance(cal, StereoCalibration) and short_baseline(cal):

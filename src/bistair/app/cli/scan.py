@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
     Output,
@@ -78,11 +78,11 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
     grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly
     (with --scans, keeping the scans grabbed)."""
-    from .progress import Progress
+    from ..progress import Progress
 
     settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
     if measure_latency:
-        from .scan import measure_settle
+        from ..scan import measure_settle
 
         with Progress(quiet) as say:
             latency, path = measure_settle(display, camera, latency_file, progress=say,
@@ -110,8 +110,8 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
                 calibration, quiet, settle_ms=settle_ms, average=average, drop=drop,
                 latency_file=latency_file, compress_captures=compress_captures, **settings)
         return
-    from .jobs import parse_depth_range
-    from .scan import scan_folder
+    from ..jobs import parse_depth_range
+    from ..scan import scan_folder
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     with Progress(quiet) as say:
@@ -145,8 +145,8 @@ def _series(spec_path: Path, display: str, camera: str, out: Path, scans: int, d
             backlog: int, no_previews: bool, calibration: Path | None, quiet: bool,
             **options: object) -> None:
     """``bistair scan --scans N``: :func:`bistair.app.series.scan_series` and its summary."""
-    from .progress import Progress
-    from .series import scan_series, summary_lines
+    from ..progress import Progress
+    from ..series import scan_series, summary_lines
 
     if calibration is not None:
         raise CliError("--calibration applies to one scan: reconstruct a series afterwards "

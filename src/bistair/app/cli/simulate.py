@@ -10,7 +10,7 @@ from typing import Any
 
 import click
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
     Output,
@@ -109,14 +109,14 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
     projector between them, for 'bistair stereo'. With --spec, the set the spec describes
     (--method may then be left out). With --motion, things move between frames; with
     --frames N --continuous, a stream whose shift advances every frame."""
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     if not methods and spec_path is None:
         raise CliError("name a --method to render (or give --spec)")
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
     spec = None
     if spec_path is not None:
-        from ..io.read import load_spec
+        from ...io.read import load_spec
 
         if cameras == 2 or count is not None:
             raise CliError("--spec renders one scene with one camera: leave out --count and "
@@ -150,8 +150,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                 raise CliError(f"{name} applies to a data set: give --count too")
         if scene is None:
             raise CliError("name a --scene (or give --count with --vary objects)")
-        from .progress import Progress
-        from .simulate import simulate as run
+        from ..progress import Progress
+        from ..simulate import simulate as run
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
@@ -172,7 +172,7 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
         return
     if no_white or both_axes:
         raise CliError("--no-white and --both-axes are for --scene calibration")
-    from .simulate import simulate_many
+    from ..simulate import simulate_many
 
     try:
         report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
@@ -202,8 +202,8 @@ def _simulate_motion(scene: str | None, methods: list[str], out: Path,
                      continuous: bool, quiet: bool, imaging: dict[str, Any],
                      stream: dict[str, Any] | None = None) -> None:
     """``bistair simulate --motion`` / ``--frames N --continuous``."""
-    from .progress import Progress
-    from .simulate_motion import simulate_motion
+    from ..progress import Progress
+    from ..simulate_motion import simulate_motion
 
     if count is not None or vary is not None:
         raise CliError("--motion and --continuous render one scene: leave out --count and "
@@ -233,8 +233,8 @@ def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
                      count: int | None, baseline: float, quiet: bool,
                      imaging: dict[str, Any]) -> None:
     """``bistair simulate --cameras 2``."""
-    from .progress import Progress
-    from .stereo import simulate_stereo
+    from ..progress import Progress
+    from ..stereo import simulate_stereo
 
     if count is not None:
         raise CliError("--cameras 2 renders one scene: leave out --count")

@@ -13,7 +13,7 @@ from typing import Any
 
 import click
 
-from ..errors import BistairError
+from ...errors import BistairError
 
 
 class CliError(click.ClickException):
@@ -28,8 +28,8 @@ def reports_errors(func: Callable) -> Callable:
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        from ..io.atomic import check_output
-        from ..io.inputs import reading
+        from ...io.atomic import check_output
+        from ...io.inputs import reading
 
         ctx = click.get_current_context(silent=True)
         params = [] if ctx is None else [p for p in ctx.command.params if p.name in kwargs]
@@ -99,7 +99,7 @@ def board_file(value: str) -> str | None:
     >>> board_file("chessboard:9x7:25"), board_file("calib/board.json")
     (None, 'calib/board.json')
     """
-    from ..geometry.board import is_board_text
+    from ...geometry.board import is_board_text
 
     return None if is_board_text(value) else value
 
@@ -147,7 +147,7 @@ def _threads(func: Callable) -> Callable:
         if value is not None:
             import cv2
 
-            from ..core.jit import set_threads
+            from ...core.jit import set_threads
 
             set_threads(value)
             cv2.setNumThreads(value)
@@ -204,7 +204,7 @@ class _Strategy(_Text):
 
 def _strategies() -> dict[str, tuple[str, ...]]:
     """Each method's strategies, its default first (from the codecs' order stages)."""
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     return {name: codec.choices["strategy"] for name, codec in REGISTRY.items()
             if "strategy" in codec.choices}
@@ -212,7 +212,7 @@ def _strategies() -> dict[str, tuple[str, ...]]:
 
 
 def _strategy_help() -> str:
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     listed = "; ".join(f"{name}: {' [default] | '.join(values)}"
                        for name, values in _strategies().items())
@@ -222,7 +222,7 @@ def _strategy_help() -> str:
 
 
 def _method_help() -> str:
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     return ", ".join(REGISTRY)
 
