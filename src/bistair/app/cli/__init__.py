@@ -26,16 +26,15 @@ from .options import (
     CliError,
     Input,
     Output,
-    _force,
-    _quiet,
-    _show,
-    _Size,
-    _strategy,
-    _Text,
-    _threads,
-    _warn,
+    Size,
+    Text,
     board_choice,
+    force_option,
+    print_warnings,
+    quiet_option,
     reports_errors,
+    strategy_option,
+    threads_option,
 )
 from .scan import scan
 from .simulate import simulate
@@ -97,7 +96,7 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
         default = f.default
         shown = ",".join(_show(v) for v in default) if kind is tuple else _show(default)
         opt: dict[str, Any] = {"help": f.metadata.get("help", ""), "show_default": True,
-                               "default": shown, "type": _Text(_SPEC_TYPES[kind])}
+                               "default": shown, "type": Text(_SPEC_TYPES[kind])}
         if "choices" in f.metadata:
             opt["type"] = click.Choice([_show(c) for c in f.metadata["choices"]])
             if tuple(f.metadata["choices"]) == (0, 1):  # a switch: --white alone means 1
@@ -130,6 +129,11 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
 
 # how a spec field's value is shown in the help (numbers may be fractions or hold pi)
 _SPEC_TYPES = {int: "INTEGER", float: "NUMBER", str: "TEXT", tuple: "NUMBER,..."}
+
+
+def _show(value: Any) -> str:
+    """A default as the command line shows it: 30 rather than 30.0."""
+    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
 
 
 @patterns.command("gamma")
@@ -174,7 +178,7 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
 @click.option("--out", "-o", required=True, type=Output(text=True),
               help="output folder: phase.npy, coord.npy, order.npy, ..., the PNG previews "
               "and info.json")
-@_strategy
+@strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
@@ -185,9 +189,9 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
               "K) into OUT/<start>/ (wrapped.npy, modulation.npy, info.json)")
 @click.option("--starts", default=None, metavar="S,S,...",
               help="with --window: the window starts to write [default: every one]")
-@_force
-@_threads
-@_quiet
+@force_option
+@threads_option
+@quiet_option
 @reports_errors
 def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy: str | None,
            min_modulation: float | None, no_previews: bool, window: str | None,
@@ -212,7 +216,7 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
     with Progress(quiet) as say:
         result = decode_folder(list(captures), out, spec_path, previews=not no_previews,
                                progress=say, **options)
-    _warn(result)
+    print_warnings(result)
     if quiet:
         return
     if hasattr(result, "x"):
@@ -250,7 +254,7 @@ def _decode_stream(captures: list[str], spec_path: Path | None, out: str, window
               show_default=True, help="output folder")
 @click.option("--seed", type=int, default=0, show_default=True,
               help="seed of the rendered noise")
-@click.option("--camera", type=_Size("WxH"), default="1280x1024", show_default=True,
+@click.option("--camera", type=Size("WxH"), default="1280x1024", show_default=True,
               help="camera size WIDTHxHEIGHT")
 @reports_errors
 def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
@@ -273,7 +277,7 @@ def demo(out: Path, seed: int, camera: tuple[int, int]) -> None:
 @click.option("--corner-fit", type=click.Choice(["homography", "quadratic"]),
               default="homography", show_default=True,
               help="how a board feature is mapped to the projector")
-@_quiet
+@quiet_option
 @reports_errors
 def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | None,
               min_poses: int, corner_fit: str, quiet: bool) -> None:
@@ -375,15 +379,15 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
               help="point cloud to write (.ply)")
 @click.option("--depth", type=Output(), default=None,
               help="folder for depth.npy and depth.png [default: OUT without .ply + -depth]")
-@_strategy
+@strategy_option
 @click.option("--depth-range", default=None, metavar="MIN:MAX",
               help="keep points with depth z in [MIN, MAX] mm (camera frame)")
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="specs of both axes: drop pixels whose projector column and "
               "row lie farther than this (projector pixels) from the camera ray's projection")
-@_force
-@_threads
-@_quiet
+@force_option
+@threads_option
+@quiet_option
 @reports_errors
 def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: Path,
                 depth: Path | None, strategy: str | None, depth_range: str | None,
@@ -436,7 +440,7 @@ def reconstruct(captures: Path, spec_path: Path | None, calibration: Path, out: 
 @click.option("--geometry", default=None, metavar="DISTANCE,BASELINE,FREQUENCY",
               help="mm, mm and fringes per mm on the reference, for the classical formula "
               "instead of planes")
-@_quiet
+@quiet_option
 @reports_errors
 def height(captures: Path, reference: Path, spec_path: Path | None, out: Path,
            planes: tuple[str, ...], geometry: str | None, quiet: bool) -> None:

@@ -1,6 +1,6 @@
 """``bistair batch``: many capture sets on Dask.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
 
 from __future__ import annotations
 
@@ -14,10 +14,10 @@ from .options import (
     CliError,
     Input,
     Output,
-    _force,
-    _quiet,
-    _strategy,
+    force_option,
+    quiet_option,
     reports_errors,
+    strategy_option,
 )
 
 BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batch.csv)
@@ -37,7 +37,7 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
               help="run on an existing Dask cluster instead (its workers must see the same "
               "paths)")
 @click.option("--resume", is_flag=True, help="skip sets whose outputs are complete")
-@_strategy
+@strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
@@ -47,8 +47,8 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="with --calibration and specs of both axes: see "
               "'bistair reconstruct --help'")
-@_force
-@_quiet
+@force_option
+@quiet_option
 @reports_errors
 def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
           workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,

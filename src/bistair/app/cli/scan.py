@@ -1,6 +1,6 @@
 """``bistair scan``: project a pattern set and grab it with a camera.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
 
 from __future__ import annotations
 
@@ -13,8 +13,8 @@ from .options import (
     CliError,
     Input,
     Output,
-    _quiet,
-    _warn,
+    print_warnings,
+    quiet_option,
     reports_errors,
 )
 
@@ -65,7 +65,7 @@ from .options import (
 @click.option("--compress-captures", is_flag=True,
               help="with --scans: deflate the captures' PNG as one scan does (files 2.2 "
               "times smaller, five times the CPU time) instead of storing them")
-@_quiet
+@quiet_option
 @reports_errors
 def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
          settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
@@ -123,7 +123,7 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     for message in info["warnings"]:
         click.echo(f"Warning: {message}", err=True)
     if report.decoded is not None:
-        _warn(report.decoded)
+        print_warnings(report.decoded)
     if quiet:
         return
     frames = report.scan.frames

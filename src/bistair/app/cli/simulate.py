@@ -1,6 +1,6 @@
 """``bistair simulate``: preset scenes, data sets and two cameras on the virtual rig.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
 
 from __future__ import annotations
 
@@ -13,11 +13,11 @@ import click
 from .options import (
     CliError,
     Input,
+    LazyHelp,
     Output,
-    _LazyHelp,
-    _method_help,
-    _quiet,
-    _Size,
+    Size,
+    method_names,
+    quiet_option,
     reports_errors,
 )
 
@@ -28,7 +28,7 @@ from .options import (
               "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
               "checkerboard in eight poses)")
 @click.option("--method", "methods", multiple=True, metavar="METHOD",
-              cls=_LazyHelp, help_from=_method_help,
+              cls=LazyHelp, help_from=method_names,
               help="method to render (repeatable): {} or all; with --spec, its method or "
               "none")
 @click.option("--spec", "spec_path", type=Input(), default=None,
@@ -38,7 +38,7 @@ from .options import (
               help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
               "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
               "(OUT/<method>/ each for several methods)")
-@click.option("--camera", type=_Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
+@click.option("--camera", type=Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
               "[default: 1280x1024]")
 @click.option("--noise", type=float, default=0.01, show_default=True,
               help="read noise, fraction of full scale")
@@ -93,7 +93,7 @@ from .options import (
 @click.option("--period", type=float, default=None,
               help="with --continuous: the stream's fringe period in projector pixels "
               "[default: 30]")
-@_quiet
+@quiet_option
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,

@@ -1,6 +1,6 @@
 """``bistair stereo`` and ``bistair calibrate-stereo``: two cameras and a projector.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
 
 from __future__ import annotations
 
@@ -13,11 +13,11 @@ from .options import (
     CliError,
     Input,
     Output,
-    _quiet,
-    _strategy,
-    _threads,
     board_choice,
+    quiet_option,
     reports_errors,
+    strategy_option,
+    threads_option,
 )
 
 
@@ -37,7 +37,7 @@ from .options import (
               "spec (stereo phase unwrapping)")
 @click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
               "matches; the decoder's checks where it offers this), as warnings in info.json")
-@_strategy
+@strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale [default: from noise]")
 @click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
@@ -51,8 +51,8 @@ from .options import (
               "needs --depth-range")
 @click.option("--starts", default=None, metavar="S,S,...",
               help="with --window: the window starts to write [default: every one]")
-@_threads
-@_quiet
+@threads_option
+@quiet_option
 @reports_errors
 def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
            depth_range: str | None, force: bool, strategy: str | None,
@@ -138,7 +138,7 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
               help="stereo calibration file to write (JSON)")
 @click.option("--min-poses", type=int, default=3, show_default=True,
               help="fewest poses with the board found in both images (3 or more)")
-@_quiet
+@quiet_option
 @reports_errors
 def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
                      quiet: bool) -> None:
