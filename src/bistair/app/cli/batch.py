@@ -1,6 +1,7 @@
 """``bistair batch``: many capture sets on Dask.
 
-Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -64,7 +65,7 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     1, after SIGTERM 143 (batch.csv lists the finished sets).
     """
     from ..batch import run_batch
-    from ..jobs import parse_depth_range
+    from ..decode import parse_depth_range
 
     if depth_range is not None and calibration is None:
         raise CliError("--depth-range applies to the reconstruction: give --calibration too")

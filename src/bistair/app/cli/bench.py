@@ -1,6 +1,7 @@
 """``bistair bench``: every codec's decode speed on this machine against the OpenCV floor.
 
-Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the command, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+command, as there."""
 
 from __future__ import annotations
 

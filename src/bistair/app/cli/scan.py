@@ -1,6 +1,7 @@
 """``bistair scan``: project a pattern set and grab it with a camera.
 
-Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -110,7 +111,7 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
                 calibration, quiet, settle_ms=settle_ms, average=average, drop=drop,
                 latency_file=latency_file, compress_captures=compress_captures, **settings)
         return
-    from ..jobs import parse_depth_range
+    from ..decode import parse_depth_range
     from ..scan import scan_folder
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)

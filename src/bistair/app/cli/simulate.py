@@ -1,6 +1,7 @@
 """``bistair simulate``: preset scenes, data sets and two cameras on the virtual rig.
 
-Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -234,7 +235,7 @@ def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
                      imaging: dict[str, Any]) -> None:
     """``bistair simulate --cameras 2``."""
     from ..progress import Progress
-    from ..stereo import simulate_stereo
+    from ..simulate import simulate_stereo
 
     if count is not None:
         raise CliError("--cameras 2 renders one scene: leave out --count")
