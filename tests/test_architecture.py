@@ -117,3 +117,51 @@ def test_no_imports_hidden_in_functions(graph):
     hidden = {name: sorted(local) for name, (_, local) in graph.items()
               if local and name not in LAZY_OK and not name.startswith("bistair.app.cli.")}
     assert not hidden
+
+
+def _private_imports(path: Path, modules: dict[str, Path], name: str) -> list[str]:
+    """``module._name`` for every name with a leading underscore that the file imports from
+    another bistair module (at the top or in a function)."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if not isinstance(node, ast.ImportFrom):
+            continue
+        base = node.module or ""
+        if node.level:
+            parts = package.split(".")
+            base = ".".join(parts[:len(parts) - node.level + 1] + ([base] if base else []))
+        if not base.startswith("bistair"):
+            continue
+        found += [f"{base}.{a.name}" for a in node.names
+                  if a.name.startswith("_") and a.name != "__future__"
+                  and f"{base}.{a.name}" not in modules]  # a module of its own is no name
+    return found
+
+
+def test_app_imports_no_private_name_from_another_file():
+    """A name with a leading underscore stays in its file (issue 35): what another file of
+    app/ needs is public there."""
+    modules = _modules()
+    found = {name: _private_imports(path, modules, name) for name, path in modules.items()
+             if name.startswith("bistair.app.")}
+    assert not {name: names for name, names in found.items() if names}
+
+
+def test_each_command_module_has_its_job_module(graph):
+    """``ls app/cli/`` and ``ls app/`` show the commands and their jobs under the same names:
+    app/cli/NAME.py holds the commands of app/NAME.py and imports that job module (when a
+    command runs), and the group itself imports no job (``bistair --help`` stays fast)."""
+    commands = sorted(p.stem for p in (SRC / "app" / "cli").glob("*.py")
+                      if p.stem not in ("__init__", "options"))
+    assert len(commands) >= 9
+    missing = [name for name in commands if not (SRC / "app" / f"{name}.py").is_file()]
+    assert not missing
+    unused = [name for name in commands
+              if not any(d == f"bistair.app.{name}" or d.startswith(f"bistair.app.{name}.")
+                         for d in graph[f"bistair.app.cli.{name}"][1])]
+    assert not unused
+    jobs_at_start = {name: sorted(d for d in top if d.startswith("bistair.app.")
+                                  and not d.startswith("bistair.app.cli"))
+                     for name, (top, _) in graph.items() if name.startswith("bistair.app.cli")}
+    assert not {name: deps for name, deps in jobs_at_start.items() if deps}
