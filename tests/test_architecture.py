@@ -165,3 +165,18 @@ def test_each_command_module_has_its_job_module(graph):
                                   and not d.startswith("bistair.app.cli"))
                      for name, (top, _) in graph.items() if name.startswith("bistair.app.cli")}
     assert not {name: deps for name, deps in jobs_at_start.items() if deps}
+
+
+# app/ modules that are no command's job: what every job shares
+APP_SHARED = {"engine", "progress", "kernels"}
+
+
+def test_every_job_module_is_a_family_or_part_of_one():
+    """``ls app/`` lists the jobs: each module is NAME.py of a command module app/cli/NAME.py,
+    or a part of that family, NAME_PART.py (decode_stream.py: ``decode --window``), or one of
+    the modules every job shares."""
+    families = {p.stem for p in (SRC / "app" / "cli").glob("*.py")} - {"__init__", "options"}
+    strays = [p.name for p in (SRC / "app").glob("*.py")
+              if p.stem not in families | APP_SHARED | {"__init__"}
+              and not any(p.stem.startswith(f"{family}_") for family in families)]
+    assert not strays

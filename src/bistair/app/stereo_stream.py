@@ -46,8 +46,7 @@ from ..io.jsonfile import write_json
 from ..io.read import capture_files, find_spec, read_captures
 from ..io.writers import write_ply
 from ..spec import BaseSpec
-from .stereo import one_spec, same_place
-from .stream import (
+from .decode_stream import (
     Window,
     check_stream_spec,
     frame_count,
@@ -56,6 +55,7 @@ from .stream import (
     remove_other_windows,
     shown_window,
 )
+from .stereo import one_spec, same_place
 
 
 def stereo_stream(left: str | Path, right: str | Path, out: str | Path,

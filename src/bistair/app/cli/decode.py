@@ -1,6 +1,6 @@
 """``bistair decode``, ``bistair reconstruct`` and ``bistair height``: captures into phase,
 points and heights (:mod:`bistair.app.decode`; ``decode --window``:
-:mod:`bistair.app.stream`).
+:mod:`bistair.app.decode_stream`).
 
 Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
 commands, as there."""
@@ -62,7 +62,7 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
         _decode_stream(list(captures), spec_path, out, window, starts, min_modulation,
                        strategy, force, quiet)
         return
-    from ..stream import refuse_single_period
+    from ..decode_stream import refuse_single_period
 
     refuse_single_period(list(captures), spec_path)
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation),
@@ -86,9 +86,10 @@ def decode(captures: tuple[str, ...], spec_path: Path | None, out: str, strategy
 def _decode_stream(captures: list[str], spec_path: Path | None, out: str, window: str | None,
                    starts: str | None, min_modulation: float | None, strategy: str | None,
                    force: bool, quiet: bool) -> None:
-    """``decode --window``: a stream decoded window by window (:mod:`bistair.app.stream`)."""
+    """``decode --window``: a stream decoded window by window
+    (:mod:`bistair.app.decode_stream`)."""
+    from ..decode_stream import decode_stream
     from ..progress import Progress
-    from ..stream import decode_stream
 
     if window is None:
         raise CliError("--starts needs --window N or N+K")

@@ -145,9 +145,9 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
 def _series(spec_path: Path, display: str, camera: str, out: Path, scans: int, decode: bool,
             backlog: int, no_previews: bool, calibration: Path | None, quiet: bool,
             **options: object) -> None:
-    """``bistair scan --scans N``: :func:`bistair.app.series.scan_series` and its summary."""
+    """``bistair scan --scans N``: :func:`bistair.app.scan_series.scan_series` and its summary."""
     from ..progress import Progress
-    from ..series import scan_series, summary_lines
+    from ..scan_series import scan_series, summary_lines
 
     if calibration is not None:
         raise CliError("--calibration applies to one scan: reconstruct a series afterwards "
