@@ -32,8 +32,8 @@ COMMANDS = (batch.batch, bench.bench, calibrate.calibrate, calibrate.calibrate_s
             calibrate.import_calibration, decode.decode, decode.height, decode.reconstruct,
             demo.demo, patterns.gamma, patterns.patterns, scan.scan, simulate.simulate,
             stereo.stereo)
-for command in COMMANDS:
-    cli.add_command(command)
+for _command in COMMANDS:
+    cli.add_command(_command)
 
 
 def _terminated(signum: int, frame: Any) -> None:

@@ -2,7 +2,7 @@
 (:mod:`bistair.app.demo`).
 
 Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
-commands, as there."""
+command, as there."""
 
 from __future__ import annotations
 
@@ -10,11 +10,7 @@ from pathlib import Path
 
 import click
 
-from .options import (
-    Output,
-    Size,
-    reports_errors,
-)
+from .options import Output, Size, reports_errors
 
 
 @click.command()
