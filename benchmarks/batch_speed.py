@@ -3,7 +3,7 @@
 Renders (once, kept in ``--data``) 20 scenes of 1280 x 1024 (1.3 MP) with
 ``bistair simulate --count`` (bidirectional, optics, objects and pose varied), then decodes
 them, in rounds, three ways, each in a new Python process as a user runs them: a plain loop
-of :func:`bistair.app.jobs.decode_folder` (a script's loop over the sets), and
+of :func:`bistair.app.decode.decode_folder` (a script's loop over the sets), and
 :func:`bistair.app.batch.run_batch` (what ``bistair batch`` runs) on a local cluster of 1
 and of 2 workers. Each is timed from after its imports to its end: the loop pays the
 kernels' loading in its first decode, the batch its cluster's start and stop, its workers'
@@ -67,7 +67,7 @@ def data_set(folder: Path, sets: int) -> list[Path]:
 LOOP = """
 import json, sys, time
 from pathlib import Path
-from bistair.app.jobs import decode_folder
+from bistair.app.decode import decode_folder
 from bistair.core.memory import keep_freed_memory
 keep_freed_memory()  # as the command line and each batch task do
 folders, out, previews = json.loads(sys.argv[1]), Path(sys.argv[2]), sys.argv[3] == "1"

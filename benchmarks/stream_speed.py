@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from bistair.app.stream import decode_stream
+from bistair.app.decode_stream import decode_stream
 from bistair.codecs import make_spec
 from bistair.core.motion import PhaseStream, window_phases
 from bistair.io.atomic import write_image

@@ -41,7 +41,7 @@ def leaf_sections(app: Any, pagename: str, templatename: str, context: dict,
 
 def hold_method_commands() -> None:
     """Put every method's ``bistair patterns`` command into the group, for sphinx-click."""
-    from bistair.app.cli import patterns
+    from bistair.app.cli.patterns import patterns
 
     for name in patterns.list_commands(None):  # type: ignore[arg-type]
         if name not in patterns.commands:

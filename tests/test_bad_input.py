@@ -26,7 +26,7 @@ import pytest
 from conftest import cli_run
 
 import bistair
-from bistair.app.jobs import save_patterns, save_ramp
+from bistair.app.patterns import save_patterns, save_ramp
 from bistair.io.atomic import write_image
 from bistair.io.read import read_image
 

@@ -16,7 +16,7 @@ from conftest import cli_run
 from plyfile import PlyData
 
 import bistair
-from bistair.app.jobs import reconstruct_folder
+from bistair.app.decode import reconstruct_folder
 from bistair.core.result import AxesResult, DecodeResult
 from bistair.errors import BistairError
 from bistair.geometry.calibration import Calibration, Device, save_calibration

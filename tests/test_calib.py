@@ -13,7 +13,7 @@ from conftest import cli_run
 
 import bistair
 from bistair.app.calibrate import calibrate_folder, read_pose
-from bistair.app.jobs import reconstruct_folder
+from bistair.app.decode import reconstruct_folder
 from bistair.errors import BistairError
 from bistair.evaluation.metrics import fit_sphere
 from bistair.geometry.board import Board

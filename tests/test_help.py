@@ -79,3 +79,22 @@ def test_a_strategy_no_decoder_has_is_refused_in_one_line(tmp_path, monkeypatch,
                            "--strategy", "mode")
     assert code == 2 and len(err.strip().splitlines()) == 1
     assert "'mode' is no decoder's strategy (bidirectional: region [default] | paper" in err
+
+
+def test_every_command_of_app_cli_is_on_the_group():
+    """Each command module of app/cli/ (one per job module, issue 35) puts every click
+    command it defines on the group: a command made and left off would be missing from
+    ``bistair --help``."""
+    import importlib
+    from pathlib import Path
+
+    folder = Path(importlib.import_module("bistair.app.cli").__file__).parent
+    made = []
+    for path in sorted(folder.glob("*.py")):
+        module = importlib.import_module("bistair.app.cli" + (
+            "" if path.stem == "__init__" else f".{path.stem}"))
+        made += [value for value in vars(module).values() if isinstance(value, click.Command)
+                 and value is not cli and value.callback.__module__ == module.__name__]
+    on_group = [cmd for _, cmd, _ in COMMANDS] + [cmd for cmd in cli.commands.values()]
+    assert len(made) >= 15
+    assert [c.name for c in made if not any(c is cmd for cmd in on_group)] == []

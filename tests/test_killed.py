@@ -15,7 +15,7 @@ import pytest
 from conftest import PATIENCE
 
 import bistair
-from bistair.app.jobs import save_patterns
+from bistair.app.patterns import save_patterns
 from bistair.io.atomic import output_folder, remove_stale
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
@@ -161,11 +161,11 @@ def test_a_command_signalled_inside_a_kernel_stops_cleanly(tmp_path, sig, code, 
     save_patterns(bistair.make_spec("graycode", width=64, height=48, period=16), pats)
     script = (f"import sys; sys.path.insert(0, {str(folder)!r})\n"
               "import numpy as np\n"
-              "import bistair.app.jobs as jobs\n"
+              "import bistair.app.decode as job\n"
               "from signal_kernel import signal_self\n"
               "def decode(stack, spec, **options):\n"
               f"    signal_self({int(sig)}, np.zeros(3))\n"
-              "jobs.decode = decode\n"
+              "job.decode = decode\n"
               "from bistair.app.cli import main\n"
               "main()\n")
     out = tmp_path / "out"

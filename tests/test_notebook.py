@@ -13,7 +13,7 @@ import pytest
 from conftest import cli_run
 
 import bistair
-from bistair.app.jobs import save_patterns
+from bistair.app.patterns import save_patterns
 from bistair.app.simulate import simulate
 from bistair.geometry.calibration import Calibration
 from bistair.sim import Imaging, preset, render

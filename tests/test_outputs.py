@@ -11,7 +11,7 @@ import pytest
 from conftest import cli_run
 
 import bistair
-from bistair.app.jobs import save_patterns
+from bistair.app.patterns import save_patterns
 from bistair.errors import BistairError
 from bistair.io.atomic import check_output, output_file, output_folder, replace_folder
 from bistair.io.inputs import reading

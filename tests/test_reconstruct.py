@@ -15,7 +15,7 @@ from conftest import cli_run
 from plyfile import PlyData
 
 import bistair
-from bistair.app.jobs import reconstruct_folder
+from bistair.app.decode import reconstruct_folder
 from bistair.errors import BistairError
 from bistair.evaluation.metrics import fit_plane, fit_sphere
 from bistair.evaluation.views import render_cloud

@@ -20,8 +20,8 @@ import pytest
 from conftest import cli_run
 
 from bistair.acquire.cameras import SIM_IMAGING, SimCamera
-from bistair.app import series
-from bistair.app.series import BEHIND, scan_series, summary_lines
+from bistair.app import scan_series as series
+from bistair.app.scan_series import BEHIND, scan_series, summary_lines
 from bistair.codecs import decode, encode, make_spec
 from bistair.errors import BistairError
 from bistair.io.read import read_captures

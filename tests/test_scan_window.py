@@ -28,7 +28,7 @@ from support.xserver import own_xvfb
 from bistair.acquire import displays
 from bistair.acquire.cameras import ScreenCamera
 from bistair.acquire.displays import WindowDisplay
-from bistair.app.jobs import save_patterns
+from bistair.app.patterns import save_patterns
 from bistair.codecs import make_spec, methods
 from bistair.errors import BistairError
 from bistair.evaluation.benchmark import method_specs

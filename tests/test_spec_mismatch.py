@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 import bistair
-from bistair.app.jobs import require_valid
+from bistair.app.decode import require_valid
 from bistair.codecs import REGISTRY, lv
 from bistair.errors import BistairError
 from bistair.sim import Imaging, expose, preset, trace

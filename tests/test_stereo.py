@@ -25,7 +25,7 @@ from conftest import cli_run
 from plyfile import PlyData
 
 import bistair
-from bistair.app.stereo import simulate_stereo
+from bistair.app.simulate import simulate_stereo
 from bistair.core.jit import set_threads
 from bistair.errors import BistairError
 from bistair.evaluation.stereo import score_stereo

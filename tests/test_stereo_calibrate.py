@@ -375,8 +375,7 @@ def test_the_old_module_names_read_on():
 def test_one_board_parser_for_both_calibrations(boards, tmp_path, monkeypatch, capfd):
     """calibrate and calibrate-stereo read --board alike (one parser, issue 35): the same
     option and the same refusal of a description without its spacing."""
-    from bistair.app.cli import calibrate
-    from bistair.app.cli_stereo import calibrate_stereo
+    from bistair.app.cli.calibrate import calibrate, calibrate_stereo
 
     options = [next(p for p in cmd.params if p.name == "board")
                for cmd in (calibrate, calibrate_stereo)]

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import cli_run
 
+from bistair.app.decode_stream import decode_stream
 from bistair.app.simulate_motion import simulate_motion
-from bistair.app.stream import decode_stream
 from bistair.codecs import decode, encode, make_spec
 from bistair.core.motion import compensate, compensate_modulation, window_phases
 from bistair.core.phase import TWO_PI, wrap

@@ -67,6 +67,7 @@ from ..io.read import (
     load_spec,
     natural_key,
 )
+from .decode import decode_folder, reconstruct_folder
 from .engine import (
     BATCH_PREFIX,
     check_workers,
@@ -75,7 +76,6 @@ from .engine import (
     run_prefix,
     run_tasks,
 )
-from .jobs import decode_folder, reconstruct_folder
 from .stereo import stereo_folder, stereo_pair
 
 MARKER = "batch-set.json"  # written last into every complete set folder

@@ -19,11 +19,17 @@ coordinates around it (:func:`~bistair.geometry.calibrate.board_view`). A pose w
 captures do not decode, or whose board is not found or not mapped, is skipped (the
 ``skipped`` callback names it and says why); a spec that cannot be read or does not fit its
 folder, projector sizes or camera images that differ, stop the job.
+
+The other calibrations of a rig live here too: two cameras from board image pairs
+(:func:`calibrate_stereo_folder`, ``bistair calibrate-stereo``), and calibrations made
+elsewhere, imported (``bistair import-calibration``: :func:`import_calibration`,
+:func:`import_stereo_calibration` with ``--stereo``, :func:`import_projection_matrices`
+with ``--projection-matrices``).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -39,14 +45,21 @@ from ..geometry.calibrate import (
     BoardView,
     PoseCapture,
     board_view,
+    calibrate_stereo_images,
     calibrate_views,
     check_min_poses,
 )
-from ..geometry.calibration import Calibration, save_calibration
-from ..io.read import load_spec, natural_key, read_with_spec
+from ..geometry.calibration import Calibration, StereoCalibration, save_calibration
+from ..geometry.opencv import read_opencv_calibration, read_opencv_stereo
+from ..geometry.projection_matrices import (
+    default_origin,
+    import_matrices,
+    save_matrix_calibration,
+)
+from ..io.read import list_images, load_spec, natural_key, read_image, read_with_spec
 from ..spec import BaseSpec
+from .progress import Say, silent
 
-Say = Callable[[str], None]
 Skipped = Callable[[str, str], None]
 AXES = ("columns", "rows")
 
@@ -169,7 +182,7 @@ def calibrate_folder(folder: str | Path, out: str | Path | None = None,
     stage's name as it starts, ``skipped`` with the name of each pose left out and why.
     Layouts and rules: see the module's notes.
     """
-    say = progress or _silent
+    say = progress or silent
     check_min_poses(min_poses)
     folder = Path(folder)
     if not folder.is_dir():
@@ -264,5 +277,179 @@ def summary_lines(cal: Calibration, out: str | Path) -> list[str]:
     return lines
 
 
-def _silent(stage: str) -> None:
-    """The progress callback of a job nobody watches."""
+# -- two cameras ------------------------------------------------------------------------------
+def board_pairs(folder: str | Path) -> tuple[list[str], list[Path], list[Path]]:
+    """The poses of a stereo calibration folder: ``(names, left images, right images)``.
+
+    Either ``left/`` and ``right/`` folders whose images pair up in natural name order, or
+    one sub-folder per pose holding two images: the one whose name says ``left`` (or ``l``)
+    and the one that says ``right`` (or ``r``), else the first and second in name order.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise BistairError(f"calibration captures {folder} not found")
+    if (folder / "left").is_dir() and (folder / "right").is_dir():
+        left, right = (list_images(folder / side) for side in ("left", "right"))
+        if len(left) != len(right) or not left:
+            raise BistairError(f"{folder}/left has {len(left)} images and {folder}/right "
+                               f"{len(right)}: they pair up one to one")
+        return [p.stem for p in left], left, right
+    names, lefts, rights = [], [], []
+    for sub in sorted((p for p in folder.iterdir() if p.is_dir()),
+                      key=lambda p: natural_key(p.name)):
+        images = list_images(sub)
+        if len(images) != 2:
+            raise BistairError(f"pose {sub.name} holds {len(images)} images: one left and one "
+                               "right image are needed")
+        sides = [_side(p.stem) for p in images]
+        if sides == ["right", "left"]:
+            images = images[::-1]
+        names.append(sub.name)
+        lefts.append(images[0])
+        rights.append(images[1])
+    if not names:
+        raise BistairError(f"no poses in {folder}: give one folder per pose holding a left and "
+                           "a right image, or left/ and right/ folders of pairs")
+    return names, lefts, rights
+
+def _side(stem: str) -> str | None:
+    words = stem.lower().replace("-", "_").replace(".", "_").split("_")
+    if "left" in words or "l" in words or stem.lower().startswith("left"):
+        return "left"
+    if "right" in words or "r" in words or stem.lower().startswith("right"):
+        return "right"
+    return None
+
+def calibrate_stereo_folder(folder: str | Path, out: str | Path | None = None,
+                            board: Board | str | Path | None = None, min_poses: int = 3,
+                            progress: Say | None = None
+                            ) -> tuple[StereoCalibration, list[str]]:
+    """Calibrate two cameras from board image pairs (:func:`board_pairs`) and write the
+    stereo calibration to ``out`` (atomically) if given; returns it and the poses skipped
+    (board not found in both images). ``board``: a Board, ``"chessboard:9x6:20"``, a
+    ``board.json``, or by default ``FOLDER/board.json``."""
+    say = progress or silent
+    names, lefts, rights = board_pairs(folder)
+    board = board_option(board, Path(folder))
+    say(f"reading {len(names)} image pairs")
+    left = [read_image(p) for p in lefts]
+    right = [read_image(p) for p in rights]
+    say(f"finding the board and calibrating from {len(names)} poses")
+    cal, skipped = calibrate_stereo_images(left, right, board, names, min_poses)
+    if out is not None:
+        save_calibration(cal, out)
+    return cal, skipped
+
+
+# -- imported calibrations -------------------------------------------------------------------
+def import_calibration(files: Sequence[str | Path], out: str | Path,
+                       projector_size: tuple[int, int] | str | None,
+                       camera_size: tuple[int, int] | str | None = None,
+                       keys: Mapping[str, str] | str | None = None) -> Calibration:
+    """Read an OpenCV FileStorage calibration (YAML or XML, keys of several files merged)
+    and write it as a bistair calibration file ``out`` (atomically).
+
+    Sizes are ``(width, height)`` or ``"WxH"``, or ``None`` to read them from the files;
+    ``keys`` renames parts (a mapping or ``"camera=M1,T=T"``), see
+    :func:`~bistair.geometry.opencv.read_opencv_calibration`.
+    Nothing is written on error.
+    """
+    if isinstance(projector_size, str):
+        projector_size = parse_size(projector_size, "--projector-size")
+    if isinstance(camera_size, str):
+        camera_size = parse_size(camera_size, "--camera-size")
+    if isinstance(keys, str):
+        keys = parse_keys(keys)
+    cal = read_opencv_calibration(list(files), projector_size, camera_size, keys)
+    save_calibration(cal, out)
+    return cal
+
+def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Path,
+                               camera_size: tuple[int, int] | str | None,
+                               projector_size: tuple[int, int] | str | None,
+                               pixel_origin: int | None = None
+                               ) -> tuple[StereoCalibration, int]:
+    """Read three 3x4 projection matrices (left camera, right camera, projector: ``.npy``,
+    ``.txt`` or ``.mat``, one world frame) and write the two-camera-and-projector
+    calibration ``out`` in the left camera's frame
+    (:mod:`~bistair.geometry.projection_matrices`), recording the cameras' pixel origin
+    (``pixel_origin``: 0 or 1, by default 1 for ``.mat`` files, 0 otherwise). ``files``
+    may be ``"L,R,P"``. Returns the calibration and the origin used. Nothing is written on
+    error."""
+    if isinstance(files, str):
+        files = [f.strip() for f in files.split(",")]
+    sizes = []
+    for size, name in ((camera_size, "--camera-size"), (projector_size, "--projector-size")):
+        if size is None:
+            raise BistairError(f"--projection-matrices needs {name} WxH (a matrix does not "
+                               "hold the image size)")
+        sizes.append(parse_size(size, name) if isinstance(size, str) else size)
+    cal = import_matrices(tuple(files), *sizes, pixel_origin=pixel_origin)
+    origin = default_origin(files) if pixel_origin is None else int(pixel_origin)
+    save_matrix_calibration(cal, origin, out)
+    return cal, origin
+
+
+def import_stereo_calibration(files: Sequence[str | Path], out: str | Path,
+                              camera_size: tuple[int, int] | str | None = None,
+                              keys: Mapping[str, str] | str | None = None
+                              ) -> StereoCalibration:
+    """Read an OpenCV FileStorage stereo calibration (left camera first) and write it as a
+    bistair stereo calibration ``out`` (atomically); ``keys`` renames parts (a mapping or
+    ``"left=K1,T=T"``). Nothing is written on error."""
+    if isinstance(camera_size, str):
+        camera_size = parse_size(camera_size, "--camera-size")
+    if isinstance(keys, str):
+        keys = parse_keys(keys)
+    cal = read_opencv_stereo(list(files), camera_size, keys)
+    save_calibration(cal, out)
+    return cal
+
+
+# -- option strings --------------------------------------------------------------------------
+def parse_size(text: str, name: str = "size") -> tuple[int, int]:
+    """``"WxH"`` as ``(width, height)``, positive integers.
+
+    Raises
+    ------
+    BistairError
+        If ``text`` is not two positive whole numbers joined by ``x``.
+
+    Examples
+    --------
+    >>> parse_size("1920x1080")
+    (1920, 1080)
+    >>> parse_size("1920")
+    Traceback (most recent call last):
+    ...
+    bistair.errors.BistairError: size must be WIDTHxHEIGHT in pixels, e.g. 1920x1080, got '1920'
+    """
+    parts = text.strip().lower().split("x")
+    if len(parts) != 2 or not all(p.strip().isdigit() and int(p) > 0 for p in parts):
+        raise BistairError(f"{name} must be WIDTHxHEIGHT in pixels, e.g. 1920x1080, got "
+                           f"{text!r}")
+    return int(parts[0]), int(parts[1])
+
+def parse_keys(text: str) -> dict[str, str]:
+    """``"NAME=KEY,NAME=KEY"`` as a dictionary (names checked by the reader).
+
+    Raises
+    ------
+    BistairError
+        If an item is not ``NAME=KEY`` or a name repeats.
+
+    Examples
+    --------
+    >>> parse_keys("camera=K_cam, T=translation")
+    {'camera': 'K_cam', 'T': 'translation'}
+    """
+    out: dict[str, str] = {}
+    for item in text.split(","):
+        name, sep, key = (part.strip() for part in item.partition("="))
+        if not sep or not name or not key:
+            raise BistairError(f"--keys must be NAME=KEY items joined by commas, e.g. "
+                               f"camera=M1,T=T; got {item.strip()!r}")
+        if name in out:
+            raise BistairError(f"--keys names {name} twice")
+        out[name] = key
+    return out

@@ -23,10 +23,28 @@ import os
 import sys
 import threading
 import time
+from collections.abc import Callable
 from types import TracebackType
 from typing import IO
 
 from ..core.jit import on_compile
+
+Say = Callable[[str], None]  # a job's progress callback: called with each stage as it starts
+
+
+def silent(stage: str) -> None:
+    """The progress callback of a job nobody watches: says nothing.
+
+    Parameters
+    ----------
+    stage : str
+        The stage the job starts.
+
+    Examples
+    --------
+    >>> silent("decoding")
+    """
+
 
 COMPILE_NOTICE = ("compiling the decode kernels for this machine: a minute or two, once "
                   "(they are kept; an install from source compiles them beforehand)")

@@ -47,7 +47,7 @@ from ..io.atomic import TEMP_PREFIX, check_output, replace_folder, write_image
 from ..io.jsonfile import to_jsonable, write_json
 from ..io.read import load_spec
 from ..spec import BaseSpec
-from .jobs import decode_folder, reconstruct_folder
+from .decode import decode_folder, reconstruct_folder
 
 DECODE_FOLDER = "decode"
 
@@ -75,7 +75,7 @@ def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str
     ``calibration`` also reconstructs there (``depth_range``: ``(min, max)`` depth in mm)."""
     say = progress or (lambda text: None)
     out = check_output(out)
-    _check_out(out)
+    check_out(out)
     if not isinstance(spec, BaseSpec):
         spec = load_spec(spec)
     cal = None
@@ -118,7 +118,7 @@ def scan_folder(spec: BaseSpec | str | Path, display: str, camera: str, out: str
     return report
 
 
-def _check_out(out: Path) -> None:
+def check_out(out: Path) -> None:
     """Refuse an output that is a file, or a folder that holds anything but an earlier
     scan or series of scans (it is replaced as a whole)."""
     if out.exists() and not out.is_dir():

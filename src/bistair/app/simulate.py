@@ -20,6 +20,9 @@ that layout, ``DATA/scene-0000/`` ..., in parallel on Dask (see
 (:mod:`bistair.sim.variation`), and ``DATA/index.csv``, which is also a manifest for
 ``bistair batch``.
 
+:func:`simulate_stereo` (``bistair simulate --cameras 2``) renders a scene on the
+two-camera rig instead; moving scenes (``--motion``) are :mod:`bistair.app.simulate_motion`.
+
 Examples
 --------
 >>> import tempfile, pathlib
@@ -49,12 +52,13 @@ from ..core.captures import to_bit_depth
 from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
 from ..geometry.board import Board
-from ..geometry.calibration import Calibration, save_calibration
+from ..geometry.calibration import Calibration, StereoCalibration, save_calibration
 from ..io.atomic import output_file, output_folder, replace_folder, write_image
 from ..io.jsonfile import write_json
 from ..sim import Imaging, Rig, Scene, Truth, expose, preset, scene_names, trace
 from ..sim.boards import write_board_sets
 from ..sim.rig import check_size
+from ..sim.stereo import StereoRig, write_board_pairs
 from ..sim.variation import build, check_vary, draw, streams
 from ..spec import BaseSpec
 from .engine import (
@@ -65,6 +69,7 @@ from .engine import (
     run_prefix,
     run_tasks,
 )
+from .progress import Say, silent
 
 
 def simulate(scene: str, methods: Iterable[str], out: str | Path,
@@ -98,8 +103,8 @@ def simulate(scene: str, methods: Iterable[str], out: str | Path,
                            "calibration)")
     if spec is not None:
         methods = _spec_methods(methods, spec)
-    methods = _check_methods(methods)
-    im = _imaging(compensated, imaging)
+    methods = check_methods(methods)
+    im = make_imaging(compensated, imaging)
     if spec is not None and scene == "calibration":
         raise BistairError("--spec renders a preset scene; board captures (scene "
                            "calibration) take each method's comparable set")
@@ -166,7 +171,7 @@ def write_scene(folder: Path, rig: Rig, geometry: Scene, imaging: Imaging,
     write_truth(folder / "truth", traced.truth, next(iter(specs.values()))[0])
     save_calibration(Calibration.from_rig(rig), folder / "calibration.json")
     write_json(folder / "scene.json", {**about, "imaging": dataclasses.asdict(imaging),
-                                       "rig": _rig_dict(rig)})
+                                       "rig": rig_dict(rig)})
 
 
 def write_truth(folder: Path, truth: Truth, spec: BaseSpec) -> None:
@@ -189,7 +194,26 @@ def write_truth(folder: Path, truth: Truth, spec: BaseSpec) -> None:
         np.save(folder / f"{name}.npy", arr)
 
 
-def _rig_dict(rig: Any) -> dict[str, Any]:
+def rig_dict(rig: Any) -> dict[str, Any]:
+    """A camera-projector rig as ``scene.json`` records it: each device's size,
+    intrinsics, distortion and pose.
+
+    Parameters
+    ----------
+    rig : Rig
+        The rig (:class:`~bistair.sim.Rig`).
+
+    Returns
+    -------
+    dict
+        ``{"camera": {...}, "projector": {...}}``.
+
+    Examples
+    --------
+    >>> from bistair.sim import preset
+    >>> sorted(rig_dict(preset("plane", camera_size=(64, 48))[0])["camera"])
+    ['K', 'R', 'dist', 'height', 't', 'width']
+    """
     def device(d: Any) -> dict[str, Any]:
         return {"width": d.width, "height": d.height, "K": np.asarray(d.K).tolist(),
                 "dist": np.asarray(d.dist_coeffs).ravel().tolist(),
@@ -217,7 +241,29 @@ def _calibration(methods: list[str], out: str | Path, camera_size: tuple[int, in
                             imaging=imaging, progress=progress)
 
 
-def _check_methods(methods: Iterable[str]) -> list[str]:
+def check_methods(methods: Iterable[str]) -> list[str]:
+    """The methods to render, refused if none or one the registry does not know.
+
+    Parameters
+    ----------
+    methods : iterable of str
+        Method names (``all`` already expanded).
+
+    Returns
+    -------
+    list of str
+        The methods, in the order given.
+
+    Raises
+    ------
+    BistairError
+        If there is none, or an unknown one.
+
+    Examples
+    --------
+    >>> check_methods(["graycode"])
+    ['graycode']
+    """
     methods = list(methods)
     if not methods:
         raise BistairError("name a method to render (or all)")
@@ -228,7 +274,33 @@ def _check_methods(methods: Iterable[str]) -> list[str]:
     return methods
 
 
-def _imaging(compensated: bool, imaging: dict[str, Any]) -> Imaging:
+def make_imaging(compensated: bool, imaging: dict[str, Any]) -> Imaging:
+    """The camera's imaging (:class:`~bistair.sim.Imaging`) from its keyword parameters,
+    refused with a one-line error for a parameter it does not have or, with patterns that
+    pre-compensate it (``compensated``), a gamma outside [0.2, 5].
+
+    Parameters
+    ----------
+    compensated : bool
+        The patterns pre-compensate the projector's gamma.
+    imaging : dict
+        Keyword parameters of :class:`~bistair.sim.Imaging`.
+
+    Returns
+    -------
+    Imaging
+        The imaging.
+
+    Raises
+    ------
+    BistairError
+        On a parameter Imaging does not have, or a gamma that cannot be compensated.
+
+    Examples
+    --------
+    >>> make_imaging(True, {"gamma": 2.2}).gamma
+    2.2
+    """
     try:
         im = Imaging(**imaging)
     except TypeError as exc:  # a parameter Imaging does not have
@@ -237,6 +309,74 @@ def _imaging(compensated: bool, imaging: dict[str, Any]) -> Imaging:
         raise BistairError(f"patterns cannot pre-compensate a projector gamma of {im.gamma:g} "
                            "(a spec's gamma lies in [0.2, 5]); simulate it uncompensated")
     return im
+
+
+# -- two cameras ------------------------------------------------------------------------------
+def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
+                    camera_size: tuple[int, int] | None = None, baseline: float = 200.0,
+                    compensated: bool = True, progress: Say | None = None,
+                    **imaging: Any) -> Path:
+    """Render ``scene`` on the two-camera rig (:class:`~bistair.sim.stereo.StereoRig`:
+    cameras ``baseline`` mm apart, the projector between them) for each method and write::
+
+        OUT/<method>/L/, OUT/<method>/R/   each camera's captures and spec.json
+        OUT/truth/L/, OUT/truth/R/         each camera's truth (as bistair simulate)
+        OUT/stereo.json                    the cameras' exact calibration, the projector's
+                                           included
+        OUT/calibration.json               the left camera and the projector's
+        OUT/scene.json                     the scene, rig and imaging
+
+    The scene ``calibration`` writes a 9 x 6 chessboard (20 mm) in eight poses instead,
+    ``OUT/pose-NN/left.png`` and ``right.png`` with ``board.json`` (what ``bistair
+    calibrate-stereo`` reads). ``imaging`` goes to :class:`~bistair.sim.Imaging`.
+    """
+    say = progress or silent
+    if not 10 <= baseline <= 2000:
+        raise BistairError(f"--baseline must be 10 to 2000 mm, got {baseline:g}")
+    if scene not in (*scene_names(), "calibration"):
+        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
+                           "calibration)")
+    im = make_imaging(compensated, imaging)
+    size = {} if camera_size is None else {"camera_size": camera_size}
+    if scene == "calibration":
+        srig = StereoRig.default(baseline=baseline, **size)
+        return write_board_pairs(srig, Board("checkerboard", 9, 6, 20.0), out, imaging=im)
+    rig, geometry = preset(scene, **size)
+    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
+                             baseline=baseline)
+    specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
+                         methods=methods)
+    patterns = {method: encode(spec) for method, (spec, _) in specs.items()}
+    with output_folder(out) as tmp:
+        truths = {}
+        for i, (side, folder) in enumerate((("left", "L"), ("right", "R"))):
+            say(f"tracing the scene from the {side} camera")
+            cam = dataclasses.replace(im, seed=im.seed + i)
+            traced = trace(srig.rig(side), geometry, cam)
+            truths[folder] = traced.truth
+            for method, (spec, _) in specs.items():
+                say(f"rendering {method} ({side})")
+                sub = tmp / method / folder
+                sub.mkdir(parents=True)
+                for k, img in enumerate(expose(traced, patterns[method], cam)):
+                    write_image(sub / f"{k:02d}.png", img)
+                (sub / "spec.json").write_text(spec.to_json())
+        (tmp / "truth").mkdir()
+        first = next(iter(specs.values()))[0]
+        for folder, truth in truths.items():
+            write_truth(tmp / "truth" / folder, truth, first)
+        save_calibration(StereoCalibration.from_rig(srig), tmp / "stereo.json")
+        save_calibration(Calibration.from_rig(srig.rig("left")), tmp / "calibration.json")
+        write_json(tmp / "scene.json", {
+            "scene": scene, "methods": list(methods), "compensated": compensated,
+            "cameras": 2, "baseline": baseline, "imaging": dataclasses.asdict(im),
+            "rig": {name: _device(getattr(srig, name))
+                    for name in ("left", "right", "projector")}})
+    return Path(out)
+
+def _device(dev: Any) -> dict[str, Any]:
+    return {"width": dev.width, "height": dev.height, "K": dev.K.tolist(),
+            "dist": list(dev.dist), "R": dev.R.tolist(), "t": dev.t.tolist()}
 
 
 # -- data sets: many scenes on Dask -----------------------------------------------------------
@@ -333,7 +473,7 @@ def simulate_many(count: int, methods: Iterable[str], out: str | Path, seed: int
         raise BistairError(f"--seed must be a whole number of 0 or more, got {seed!r}")
     check_workers(workers, scheduler)
     vary = check_vary(vary)
-    methods = _check_methods(methods)
+    methods = check_methods(methods)
     if "objects" in vary and scene is not None:
         raise BistairError("--vary objects draws the scenes: leave out --scene")
     if scene == "calibration":
@@ -344,10 +484,10 @@ def simulate_many(count: int, methods: Iterable[str], out: str | Path, seed: int
     if camera_size is not None:
         camera_size = check_size(camera_size, "camera")
     imaging.pop("seed", None)
-    _imaging(compensated, imaging)
+    make_imaging(compensated, imaging)
     params = scene_parameters(count, seed, vary, scene, camera_size, imaging)
     for p in params:  # drawn optics stay in range; check before any work
-        _imaging(compensated, p["imaging"])
+        make_imaging(compensated, p["imaging"])
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise BistairError(f"output {out} exists and is not a folder")

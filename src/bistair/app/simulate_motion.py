@@ -53,7 +53,7 @@ from ..sim import Imaging, Trace, expose, preset, scene_names
 from ..sim.motion import parse_motion, trace_frames
 from ..sim.stereo import StereoRig
 from ..spec import BaseSpec
-from .simulate import _check_methods, _imaging, _rig_dict, write_truth
+from .simulate import check_methods, make_imaging, rig_dict, write_truth
 
 STREAM_STEPS = 4
 STREAM_PERIOD = 30
@@ -85,7 +85,7 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
     if scene not in scene_names():
         raise BistairError(f"unknown scene {scene!r} for a moving render (known: "
                            f"{', '.join(scene_names())})")
-    methods = _check_methods(methods)
+    methods = check_methods(methods)
     if continuous != (frames is not None):
         raise BistairError("a stream needs both --frames N and --continuous")
     if continuous and methods != ["multifreq"]:
@@ -103,7 +103,7 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
         raise BistairError(f"--cameras must be 1 or 2, got {cameras!r}")
     if cameras == 2 and not 10 <= baseline <= 2000:
         raise BistairError(f"--baseline must be 10 to 2000 mm, got {baseline:g}")
-    im = _imaging(compensated, imaging)
+    im = make_imaging(compensated, imaging)
     gamma = im.gamma if compensated else 1.0
     rig, geometry = preset(scene, **({} if camera_size is None else
                                      {"camera_size": camera_size}))
@@ -151,10 +151,10 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
             "motion": {**mm.to_dict(), **({"pixels": list(moving.pixels)}
                                           if moving.pixels is not None else {})},
             "reference_frame": 0, "frames": count, "continuous": continuous,
-            "rig": ({"left": _rig_dict(sides["L"])["camera"],
-                     "right": _rig_dict(sides["R"])["camera"],
-                     "projector": _rig_dict(sides["L"])["projector"]}
-                    if cameras == 2 else _rig_dict(rig))})
+            "rig": ({"left": rig_dict(sides["L"])["camera"],
+                     "right": rig_dict(sides["R"])["camera"],
+                     "projector": rig_dict(sides["L"])["projector"]}
+                    if cameras == 2 else rig_dict(rig))})
     return Path(out)
 
 

@@ -1,7 +1,8 @@
-"""The binocular jobs behind the command line: reconstruct from two cameras
-(``bistair stereo``), calibrate two cameras from board pairs (``bistair calibrate-stereo``),
-import an OpenCV stereo calibration (``bistair import-calibration --stereo``) and render a
-two-camera scene (``bistair simulate --cameras 2``).
+"""The binocular job behind the command line: reconstruct from two cameras and a projector
+(``bistair stereo``). Two cameras are calibrated by :mod:`bistair.app.calibrate`
+(``calibrate-stereo``, ``import-calibration --stereo``) and rendered by
+:mod:`bistair.app.simulate` (``simulate --cameras 2``); ``stereo --window`` is
+:mod:`bistair.app.stereo_stream`.
 
 Each reads its inputs, works in memory and writes its outputs atomically, so a failed job
 leaves nothing behind.
@@ -19,55 +20,36 @@ leaves nothing behind.
 
 from __future__ import annotations
 
-import dataclasses
 import json
-from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..codecs import encode
 from ..errors import BistairError
-from ..evaluation.benchmark import method_specs
-from ..geometry.board import Board
-from ..geometry.calibrate import calibrate_stereo_images
 from ..geometry.calibration import (
     STEREO,
     Calibration,
     StereoCalibration,
     load_calibration,
-    save_calibration,
 )
-from ..geometry.opencv import read_opencv_stereo
 from ..geometry.projection_matrices import recorded_origin
 from ..geometry.stereo import StereoResult, stereo
 from ..geometry.unwrap import is_single_period, stereo_unwrap
-from ..io.atomic import check_output, output_folder, write_image
+from ..io.atomic import check_output, output_folder
 from ..io.jsonfile import write_json
 from ..io.read import (
     default_spec_path,
     find_spec,
-    list_images,
-    natural_key,
-    read_image,
     read_with_spec,
 )
 from ..io.writers import write_depth, write_ply, write_result
-from ..sim import preset, scene_names, trace
-from ..sim.render import expose
-from ..sim.stereo import StereoRig, write_board_pairs
 from ..spec import BaseSpec
-from .calibrate import board_option
-from .jobs import parse_keys, parse_size
-from .simulate import _imaging, write_truth
+from .progress import Say, silent
 
-Say = Callable[[str], None]
 SIDES = (("L", "R"), ("left", "right"))  # the folders of a stereo capture set
 
 
-def _silent(stage: str) -> None:
-    """The progress callback of a job nobody watches."""
 
 
 # -- reconstruct -----------------------------------------------------------------------------
@@ -90,10 +72,10 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     see :func:`~bistair.geometry.stereo.reconstruct_stereo`. ``options`` are decoder
     options. Nothing is written on error.
     """
-    say = progress or _silent
+    say = progress or silent
     for side in (left, right):
         check_output(out, side)
-    if _same_place(left, right):
+    if same_place(left, right):
         raise BistairError(f"LEFT and RIGHT are the same captures ({left}): give each camera's "
                            "own")
     if isinstance(calibration, Calibration):
@@ -103,7 +85,7 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     if not isinstance(calibration, StereoCalibration):
         recorded = _recorded_origin(calibration)
         calibration = load_calibration(calibration, STEREO)
-    spec = find_spec(left, spec) if spec is not None else _one_spec(left, right)
+    spec = find_spec(left, spec) if spec is not None else one_spec(left, right)
     stacks = []
     for name, captures in (("left", left), ("right", right)):
         say(f"reading the {name} captures")
@@ -166,14 +148,14 @@ def _recorded_origin(path: str | Path) -> int | None:
     return recorded_origin(data)
 
 
-def _same_place(left: Any, right: Any) -> bool:
+def same_place(left: Any, right: Any) -> bool:
     """Whether LEFT and RIGHT name the same folder, file or pattern."""
     if not (isinstance(left, str | Path) and isinstance(right, str | Path)):
         return False
     return Path(left).expanduser().resolve() == Path(right).expanduser().resolve()
 
 
-def _one_spec(left: Any, right: Any) -> BaseSpec:
+def one_spec(left: Any, right: Any) -> BaseSpec:
     """The spec beside the left captures, refused if the right captures have their own and
     it differs (:func:`spec_differences`)."""
     spec = find_spec(left)
@@ -254,155 +236,3 @@ def stereo_pair(captures: str | Path) -> tuple[Path, Path] | None:
         if all((folder / n).is_dir() for n in names):
             return folder / names[0], folder / names[1]
     return None
-
-
-# -- calibrate -------------------------------------------------------------------------------
-def board_pairs(folder: str | Path) -> tuple[list[str], list[Path], list[Path]]:
-    """The poses of a stereo calibration folder: ``(names, left images, right images)``.
-
-    Either ``left/`` and ``right/`` folders whose images pair up in natural name order, or
-    one sub-folder per pose holding two images: the one whose name says ``left`` (or ``l``)
-    and the one that says ``right`` (or ``r``), else the first and second in name order.
-    """
-    folder = Path(folder)
-    if not folder.is_dir():
-        raise BistairError(f"calibration captures {folder} not found")
-    if (folder / "left").is_dir() and (folder / "right").is_dir():
-        left, right = (list_images(folder / side) for side in ("left", "right"))
-        if len(left) != len(right) or not left:
-            raise BistairError(f"{folder}/left has {len(left)} images and {folder}/right "
-                               f"{len(right)}: they pair up one to one")
-        return [p.stem for p in left], left, right
-    names, lefts, rights = [], [], []
-    for sub in sorted((p for p in folder.iterdir() if p.is_dir()),
-                      key=lambda p: natural_key(p.name)):
-        images = list_images(sub)
-        if len(images) != 2:
-            raise BistairError(f"pose {sub.name} holds {len(images)} images: one left and one "
-                               "right image are needed")
-        sides = [_side(p.stem) for p in images]
-        if sides == ["right", "left"]:
-            images = images[::-1]
-        names.append(sub.name)
-        lefts.append(images[0])
-        rights.append(images[1])
-    if not names:
-        raise BistairError(f"no poses in {folder}: give one folder per pose holding a left and "
-                           "a right image, or left/ and right/ folders of pairs")
-    return names, lefts, rights
-
-
-def _side(stem: str) -> str | None:
-    words = stem.lower().replace("-", "_").replace(".", "_").split("_")
-    if "left" in words or "l" in words or stem.lower().startswith("left"):
-        return "left"
-    if "right" in words or "r" in words or stem.lower().startswith("right"):
-        return "right"
-    return None
-
-
-def calibrate_stereo_folder(folder: str | Path, out: str | Path | None = None,
-                            board: Board | str | Path | None = None, min_poses: int = 3,
-                            progress: Say | None = None
-                            ) -> tuple[StereoCalibration, list[str]]:
-    """Calibrate two cameras from board image pairs (:func:`board_pairs`) and write the
-    stereo calibration to ``out`` (atomically) if given; returns it and the poses skipped
-    (board not found in both images). ``board``: a Board, ``"chessboard:9x6:20"``, a
-    ``board.json``, or by default ``FOLDER/board.json``."""
-    say = progress or _silent
-    names, lefts, rights = board_pairs(folder)
-    board = board_option(board, Path(folder))
-    say(f"reading {len(names)} image pairs")
-    left = [read_image(p) for p in lefts]
-    right = [read_image(p) for p in rights]
-    say(f"finding the board and calibrating from {len(names)} poses")
-    cal, skipped = calibrate_stereo_images(left, right, board, names, min_poses)
-    if out is not None:
-        save_calibration(cal, out)
-    return cal, skipped
-
-
-def import_stereo_calibration(files: Sequence[str | Path], out: str | Path,
-                              camera_size: tuple[int, int] | str | None = None,
-                              keys: Mapping[str, str] | str | None = None
-                              ) -> StereoCalibration:
-    """Read an OpenCV FileStorage stereo calibration (left camera first) and write it as a
-    bistair stereo calibration ``out`` (atomically); ``keys`` renames parts (a mapping or
-    ``"left=K1,T=T"``). Nothing is written on error."""
-    if isinstance(camera_size, str):
-        camera_size = parse_size(camera_size, "--camera-size")
-    if isinstance(keys, str):
-        keys = parse_keys(keys)
-    cal = read_opencv_stereo(list(files), camera_size, keys)
-    save_calibration(cal, out)
-    return cal
-
-
-# -- simulate --------------------------------------------------------------------------------
-def simulate_stereo(scene: str, methods: Sequence[str], out: str | Path,
-                    camera_size: tuple[int, int] | None = None, baseline: float = 200.0,
-                    compensated: bool = True, progress: Say | None = None,
-                    **imaging: Any) -> Path:
-    """Render ``scene`` on the two-camera rig (:class:`~bistair.sim.stereo.StereoRig`:
-    cameras ``baseline`` mm apart, the projector between them) for each method and write::
-
-        OUT/<method>/L/, OUT/<method>/R/   each camera's captures and spec.json
-        OUT/truth/L/, OUT/truth/R/         each camera's truth (as bistair simulate)
-        OUT/stereo.json                    the cameras' exact calibration, the projector's
-                                           included
-        OUT/calibration.json               the left camera and the projector's
-        OUT/scene.json                     the scene, rig and imaging
-
-    The scene ``calibration`` writes a 9 x 6 chessboard (20 mm) in eight poses instead,
-    ``OUT/pose-NN/left.png`` and ``right.png`` with ``board.json`` (what ``bistair
-    calibrate-stereo`` reads). ``imaging`` goes to :class:`~bistair.sim.Imaging`.
-    """
-    say = progress or _silent
-    if not 10 <= baseline <= 2000:
-        raise BistairError(f"--baseline must be 10 to 2000 mm, got {baseline:g}")
-    if scene not in (*scene_names(), "calibration"):
-        raise BistairError(f"unknown scene {scene!r} (known: {', '.join(scene_names())}, "
-                           "calibration)")
-    im = _imaging(compensated, imaging)
-    size = {} if camera_size is None else {"camera_size": camera_size}
-    if scene == "calibration":
-        srig = StereoRig.default(baseline=baseline, **size)
-        return write_board_pairs(srig, Board("checkerboard", 9, 6, 20.0), out, imaging=im)
-    rig, geometry = preset(scene, **size)
-    srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,
-                             baseline=baseline)
-    specs = method_specs(rig.projector.size, gamma=im.gamma if compensated else 1.0,
-                         methods=methods)
-    patterns = {method: encode(spec) for method, (spec, _) in specs.items()}
-    with output_folder(out) as tmp:
-        truths = {}
-        for i, (side, folder) in enumerate((("left", "L"), ("right", "R"))):
-            say(f"tracing the scene from the {side} camera")
-            cam = dataclasses.replace(im, seed=im.seed + i)
-            traced = trace(srig.rig(side), geometry, cam)
-            truths[folder] = traced.truth
-            for method, (spec, _) in specs.items():
-                say(f"rendering {method} ({side})")
-                sub = tmp / method / folder
-                sub.mkdir(parents=True)
-                for k, img in enumerate(expose(traced, patterns[method], cam)):
-                    write_image(sub / f"{k:02d}.png", img)
-                (sub / "spec.json").write_text(spec.to_json())
-        (tmp / "truth").mkdir()
-        first = next(iter(specs.values()))[0]
-        for folder, truth in truths.items():
-            write_truth(tmp / "truth" / folder, truth, first)
-        save_calibration(StereoCalibration.from_rig(srig), tmp / "stereo.json")
-        save_calibration(Calibration.from_rig(srig.rig("left")), tmp / "calibration.json")
-        write_json(tmp / "scene.json", {
-            "scene": scene, "methods": list(methods), "compensated": compensated,
-            "cameras": 2, "baseline": baseline, "imaging": dataclasses.asdict(im),
-            "rig": {name: _device(getattr(srig, name))
-                    for name in ("left", "right", "projector")}})
-    return Path(out)
-
-
-def _device(dev: Any) -> dict[str, Any]:
-    return {"width": dev.width, "height": dev.height, "K": dev.K.tolist(),
-            "dist": list(dev.dist), "R": dev.R.tolist(), "t": dev.t.tolist()}
-

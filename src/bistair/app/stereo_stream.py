@@ -46,8 +46,7 @@ from ..io.jsonfile import write_json
 from ..io.read import capture_files, find_spec, read_captures
 from ..io.writers import write_ply
 from ..spec import BaseSpec
-from .stereo import _one_spec, _same_place
-from .stream import (
+from .decode_stream import (
     Window,
     check_stream_spec,
     frame_count,
@@ -56,6 +55,7 @@ from .stream import (
     remove_other_windows,
     shown_window,
 )
+from .stereo import one_spec, same_place
 
 
 def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
@@ -116,7 +116,7 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
                            "fringe order")
     for side in (left, right):
         check_output(out, side)
-    if _same_place(left, right):
+    if same_place(left, right):
         raise BistairError(f"LEFT and RIGHT are the same captures ({left}): give each camera's "
                            "own")
     if isinstance(calibration, Calibration):
@@ -125,7 +125,7 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
     if not isinstance(calibration, StereoCalibration):
         calibration = load_stereo_calibration(calibration)
     spec = check_stream_spec(find_spec(left, spec) if spec is not None
-                             else _one_spec(left, right))
+                             else one_spec(left, right))
     win = parse_window(window, spec.steps)
     files = [capture_files(side) for side in (left, right)]
     counts = [frame_count(f) for f in files]

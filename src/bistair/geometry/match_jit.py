@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel
+from ..core.jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
@@ -73,13 +73,13 @@ def drop_kinks(values: np.ndarray, limit: float, reach: int = 2) -> np.ndarray:
     return _kinks(np.ascontiguousarray(values, np.float32), float(limit), int(reach))
 
 
-@_numba_inline
+@inline
 def _joined(a: float, b: float, jump: float) -> bool:
     """Two neighbouring samples of one surface: both valid, at most ``jump`` apart."""
     return abs(float(a) - float(b)) <= jump  # False where either is NaN
 
 
-@_numba_inline
+@inline
 def _fit_at(line: np.ndarray, x: int, a: int, b: int, radius: int,
             coefficients: np.ndarray) -> float:
     """The least-squares line through ``line[x-a .. x+b]`` at ``x``: a weighted sum."""
@@ -89,7 +89,7 @@ def _fit_at(line: np.ndarray, x: int, a: int, b: int, radius: int,
     return total
 
 
-@_numba_inline
+@inline
 def _reach(line: np.ndarray, x: int, step: int, r: int, jump: float) -> int:
     """How many neighbours of sample ``x`` of ``line``, up to ``r``, its run holds on the
     side ``step`` (-1 or +1)."""
@@ -170,7 +170,7 @@ def _smooth(values: np.ndarray, radius: int, coefficients: np.ndarray, jump: flo
     return out
 
 
-@_numba_inline
+@inline
 def _filter_line(line: np.ndarray, full: np.ndarray, r: int, jump: float, row: np.ndarray,
                  whole: np.ndarray) -> None:
     """``row``: ``line`` filtered with the whole window's weights ``full`` where the window
@@ -288,7 +288,7 @@ def smooth_runs(values: np.ndarray, sigma: float, jump: float, kink: float = mat
                    int(kink_reach), bool(negate))
 
 
-@_numba_inline
+@inline
 def _first_at_least(arr: np.ndarray, a: int, b: int, q: float, hint: int) -> int:
     """The first index in ``[a, b)`` of the non-decreasing ``arr`` with ``arr >= q`` (``b``
     if none), searched from ``hint`` outward in doubling steps (the answer is usually a
@@ -324,7 +324,7 @@ def _first_at_least(arr: np.ndarray, a: int, b: int, q: float, hint: int) -> int
     return lo
 
 
-@_numba_inline
+@inline
 def _fit_crossing(xs: np.ndarray, vs: np.ndarray, a: int, b: int, q: float,
                   fallback: float) -> float:
     """Where the least-squares line through the samples ``[a, b)`` takes ``q``."""
@@ -343,7 +343,7 @@ def _fit_crossing(xs: np.ndarray, vs: np.ndarray, a: int, b: int, q: float,
     return x0 + (sx + (n * q - sv) * (n * sxx - sx * sx) / cov) / n
 
 
-@_numba_inline
+@inline
 def _along(row: np.ndarray, x: float) -> float:
     """``row`` at ``x``, linear between its two neighbours (NaN if one it needs is)."""
     if not x >= 0.0:
@@ -361,7 +361,7 @@ def _along(row: np.ndarray, x: float) -> float:
 
 
 
-@_numba_inline
+@inline
 def _bridged(xs: np.ndarray, vs: np.ndarray, k: int, e: int, n: int) -> bool:
     """Whether samples ``e - 1`` and ``e`` (``k``: the run's first) may be joined across the
     columns between them: always beside each other; across a gap, where the step is what
@@ -387,7 +387,7 @@ def _bridged(xs: np.ndarray, vs: np.ndarray, k: int, e: int, n: int) -> bool:
     return abs(vs[e] - vs[e - 1] - g * slope) <= 0.5 * abs(slope) * g
 
 
-@_numba_inline
+@inline
 def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray,
           begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
           hints: np.ndarray) -> int:
@@ -432,7 +432,7 @@ def _runs(row: np.ndarray, gap: int, jump: float, xs: np.ndarray, vs: np.ndarray
     return runs
 
 
-@_numba_inline
+@inline
 def _value_alone(vs: np.ndarray, begins: np.ndarray, ends: np.ndarray, runs: int,
                  alone: np.ndarray) -> None:
     """Mark the runs whose value range (first to last value, rising) meets no other run's:
@@ -454,7 +454,7 @@ def _value_alone(vs: np.ndarray, begins: np.ndarray, ends: np.ndarray, runs: int
         reach = max(reach, hi)
 
 
-@_numba_inline
+@inline
 def _crossing(r: int, q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
               begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
               hints: np.ndarray, reach: int) -> tuple[bool, float, float]:
@@ -486,7 +486,7 @@ def _crossing(r: int, q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.n
     return True, x1, x2
 
 
-@_numba_inline
+@inline
 def _find(q: float, xlo: float, xhi: float, xs: np.ndarray, vs: np.ndarray,
           begins: np.ndarray, ends: np.ndarray, pmax: np.ndarray, smin: np.ndarray,
           hints: np.ndarray, runs: int, wiggle: float, reach: int, alone: np.ndarray,
@@ -578,7 +578,7 @@ def _pair(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: floa
     return disparity, status
 
 
-@_numba_inline
+@inline
 def _alone(xs: np.ndarray, begins: np.ndarray, ends: np.ndarray, hints: np.ndarray,
            runs: int, value_alone: np.ndarray, alone: np.ndarray) -> None:
     """Mark the columns of the runs that rise strictly (``hints[r, 2]``) and share no value

@@ -368,7 +368,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         depths = m.depth[mask]
         info["warnings"].append(short + (f"; the points lie {np.min(depths):.3g}-"
                                          f"{np.max(depths):.3g} mm away" if depths.size else ""))
-    return StereoResult(m.disparity, m.depth, _grey(left, offset), mask, left, right, rect,
+    return StereoResult(m.disparity, m.depth, grey_image(left, offset), mask, left, right, rect,
                         info)
 
 
@@ -470,9 +470,29 @@ def _coordinates(left: DecodeResult | AxesResult, right: DecodeResult | AxesResu
     return {orientation: (left.coord, right.coord)}
 
 
-def _grey(result: DecodeResult | AxesResult, offset: float) -> np.ndarray:
-    """Grey per pixel (uint8): the white frame, else the fringes' average over the
-    patterns' mean."""
+def grey_image(result: DecodeResult | AxesResult, offset: float) -> np.ndarray:
+    """Grey per pixel (uint8) for a point cloud's colours: the white frame, else the
+    fringes' average over the patterns' mean.
+
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        A decode (its first axis for both axes).
+    offset : float
+        The patterns' mean ``a`` (fraction of full scale; 0 means 0.5).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` uint8, 0 where the average is unknown.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> r = SimpleNamespace(texture=None, average=np.array([[0.25, np.nan]], np.float32))
+    >>> grey_image(r, 0.5).tolist()
+    [[128, 0]]
+    """
     first = result.x if isinstance(result, AxesResult) else result
     if first.texture is not None:
         grey = np.asarray(first.texture, np.float32) * np.float32(255)

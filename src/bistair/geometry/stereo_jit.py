@@ -21,12 +21,12 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel
+from ..core.jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
 
-@_numba_inline
+@inline
 def _bilinear(values: np.ndarray, sx: float, sy: float, max_step: float) -> float:
     """``values`` at ``(sx, sy)`` from the 2 x 2 pixels around it, NaN when one of those it
     needs is NaN or outside, or when they spread over more than ``max_step``."""

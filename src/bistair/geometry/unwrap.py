@@ -56,7 +56,7 @@ from ..core.result import make_result
 from ..errors import BistairError
 from .calibration import Calibration
 from .projection_matrices import with_pixel_origin
-from .stereo import Rectification, StereoResult, _grey, rectify
+from .stereo import Rectification, StereoResult, grey_image, rectify
 from .stereo_calibration import StereoCalibration
 from .stereo_jit import depth_counts, grid_points
 from .triangulate import check_depth_range, triangulate
@@ -924,5 +924,5 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     info = dict(found.info)
     info["matched"] = info["decided"]
     info["matched_fraction"] = info["decided_fraction"]
-    return StereoResult(found.disparity, found.depth, _grey(left, spec.offset), found.mask,
+    return StereoResult(found.disparity, found.depth, grey_image(left, spec.offset), found.mask,
                         left, right, found.rectification, info)

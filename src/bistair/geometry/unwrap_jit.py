@@ -33,7 +33,7 @@ import math
 
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel
+from ..core.jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -41,13 +41,13 @@ TWO_PI = 2.0 * math.pi
 KEPT = 4
 
 
-@_numba_inline
+@inline
 def _wrapped(angle: float) -> float:
     """``angle`` wrapped into ``[-pi, pi)``."""
     return angle - TWO_PI * math.floor((angle + math.pi) / TWO_PI)
 
 
-@_numba_inline
+@inline
 def _near(difference: float) -> float:
     """The difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (NaN
     stays NaN)."""
@@ -58,7 +58,7 @@ def _near(difference: float) -> float:
     return difference
 
 
-@_numba_inline
+@inline
 def _projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
                       rp: np.ndarray, tp: np.ndarray) -> float:
     """The projector column (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of the

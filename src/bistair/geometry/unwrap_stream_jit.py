@@ -33,13 +33,13 @@ import math
 import cv2
 import numpy as np
 
-from ..core.jit import _numba_inline, kernel
+from ..core.jit import inline, kernel
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
 
 
-@_numba_inline
+@inline
 def _near(difference: float) -> float:
     """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)``."""
     if difference >= math.pi:
@@ -49,7 +49,7 @@ def _near(difference: float) -> float:
     return difference
 
 
-@_numba_inline
+@inline
 def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int, j1: int,
           lo: float, hi: float, shift: float, f: float, cx: float, yr: float, tx: float,
           back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
@@ -93,7 +93,7 @@ def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int,
     return count, found
 
 
-@_numba_inline
+@inline
 def _project(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
              rp: np.ndarray, tp: np.ndarray) -> tuple[float, float]:
     """The projector pixel (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of a point of
@@ -282,7 +282,7 @@ def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, c
                     arr(dp, (5,)), arr(rp, (3, 3)), arr(tp, (3,)))
 
 
-@_numba_inline
+@inline
 def _corner(grid: np.ndarray, y: int, x: int, w: float, total: float, low: float,
             high: float) -> tuple[float, float, float]:
     """Add one corner of a bilinear sample: its weighted value, and the spread seen."""

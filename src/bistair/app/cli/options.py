@@ -13,12 +13,17 @@ from typing import Any
 
 import click
 
-from ..errors import BistairError
+from ...errors import BistairError
 
 
 class CliError(click.ClickException):
-    exit_code = 2
+    """A refusal of the command line: ``Error: <message>`` on one line and exit code 2.
 
+    >>> CliError("--min-poses 1 is too few").exit_code
+    2
+    """
+
+    exit_code = 2
 
 
 def reports_errors(func: Callable) -> Callable:
@@ -28,8 +33,8 @@ def reports_errors(func: Callable) -> Callable:
 
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        from ..io.atomic import check_output
-        from ..io.inputs import reading
+        from ...io.atomic import check_output
+        from ...io.inputs import reading
 
         ctx = click.get_current_context(silent=True)
         params = [] if ctx is None else [p for p in ctx.command.params if p.name in kwargs]
@@ -47,7 +52,6 @@ def reports_errors(func: Callable) -> Callable:
             raise CliError("not enough memory for these captures") from None
 
     return wrapper
-
 
 
 class Input(click.Path):
@@ -76,7 +80,6 @@ class Input(click.Path):
         return [v for v in found if v]
 
 
-
 def board_choice(default: str) -> Callable[[Callable], Callable]:
     """The ``--board`` option of ``calibrate`` and ``calibrate-stereo`` (a ``board.json`` or
     a description such as ``chessboard:9x7:25``, read by
@@ -99,10 +102,9 @@ def board_file(value: str) -> str | None:
     >>> board_file("chessboard:9x7:25"), board_file("calib/board.json")
     (None, 'calib/board.json')
     """
-    from ..geometry.board import is_board_text
+    from ...geometry.board import is_board_text
 
     return None if is_board_text(value) else value
-
 
 
 class Output(click.Path):
@@ -122,16 +124,46 @@ class Output(click.Path):
         return super().convert(value, param, ctx)
 
 
+def quiet_option(func: Callable) -> Callable:
+    """``--quiet``: no progress and no summary; errors and warnings are still printed.
 
-def _quiet(func: Callable) -> Callable:
-    """``--quiet``: no progress and no summary; errors and warnings are still printed."""
+    Parameters
+    ----------
+    func : callable
+        The command (under its ``@click.command``), given a ``quiet`` argument.
+
+    Returns
+    -------
+    callable
+        ``func`` with the option.
+
+    Examples
+    --------
+    >>> quiet_option(lambda quiet: quiet).__click_params__[0].opts
+    ['--quiet', '-q']
+    """
     return click.option("--quiet", "-q", is_flag=True,
                         help="print only errors and warnings (no progress, no summary)")(func)
 
 
+def force_option(func: Callable) -> Callable:
+    """``--force``: decode where a thresholded check would refuse.
 
-def _force(func: Callable) -> Callable:
-    """``--force``: decode where a thresholded check would refuse."""
+    Parameters
+    ----------
+    func : callable
+        The command, given a ``force`` argument.
+
+    Returns
+    -------
+    callable
+        ``func`` with the option.
+
+    Examples
+    --------
+    >>> force_option(lambda force: force).__click_params__[0].is_flag
+    True
+    """
     return click.option("--force", is_flag=True,
                         help="decode where a thresholded check would refuse the captures: its "
                         "reasons are printed as warnings and kept in info.json ('forced'); "
@@ -139,15 +171,31 @@ def _force(func: Callable) -> Callable:
                         "errors")(func)
 
 
+def threads_option(func: Callable) -> Callable:
+    """``--threads N``: at most N threads in the decode's kernels and OpenCV, set when the
+    option is parsed (the command is given no argument for it).
 
-def _threads(func: Callable) -> Callable:
-    """``--threads N``: at most N threads in the decode's kernels and OpenCV."""
+    Parameters
+    ----------
+    func : callable
+        The command.
+
+    Returns
+    -------
+    callable
+        ``func`` with the option.
+
+    Examples
+    --------
+    >>> threads_option(lambda: None).__click_params__[0].expose_value
+    False
+    """
 
     def limit(ctx: click.Context, param: click.Parameter, value: int | None) -> int | None:
         if value is not None:
             import cv2
 
-            from ..core.jit import set_threads
+            from ...core.jit import set_threads
 
             set_threads(value)
             cv2.setNumThreads(value)
@@ -158,10 +206,13 @@ def _threads(func: Callable) -> Callable:
                         help="use at most N threads [default: every core]")(func)
 
 
-
-class _Text(click.ParamType):
+class Text(click.ParamType):
     """A value kept as text for the command to parse, shown in the help by its form
-    (``WxH``, ``NUMBER``: a number, a fraction such as 1920/58 or ``-2*pi/3``, ...)."""
+    (``WxH``, ``NUMBER``: a number, a fraction such as 1920/58 or ``-2*pi/3``, ...).
+
+    >>> Text("NUMBER").convert("1920/58", None, None)
+    '1920/58'
+    """
 
     def __init__(self, metavar: str) -> None:
         self.name = metavar.lower()
@@ -175,9 +226,12 @@ class _Text(click.ParamType):
         return value
 
 
+class Size(Text):
+    """``WIDTHxHEIGHT`` as ``(width, height)``.
 
-class _Size(_Text):
-    """``WIDTHxHEIGHT`` as ``(width, height)``."""
+    >>> Size("WxH").convert("1280x1024", None, None)
+    (1280, 1024)
+    """
 
     def convert(self, value: Any, param: click.Parameter | None,
                 ctx: click.Context | None) -> Any:
@@ -190,8 +244,7 @@ class _Size(_Text):
         return width, height
 
 
-
-class _Strategy(_Text):
+class _Strategy(Text):
     """A fringe-order strategy of some method's decoder (each decoder checks its own)."""
 
     def convert(self, value: Any, param: click.Parameter | None,
@@ -201,18 +254,16 @@ class _Strategy(_Text):
         return value
 
 
-
 def _strategies() -> dict[str, tuple[str, ...]]:
     """Each method's strategies, its default first (from the codecs' order stages)."""
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     return {name: codec.choices["strategy"] for name, codec in REGISTRY.items()
             if "strategy" in codec.choices}
 
 
-
 def _strategy_help() -> str:
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     listed = "; ".join(f"{name}: {' [default] | '.join(values)}"
                        for name, values in _strategies().items())
@@ -220,17 +271,33 @@ def _strategy_help() -> str:
     return listed + (f" ({' and '.join(alone)}: none)" if alone else "")
 
 
+def method_names() -> str:
+    """The registry's methods joined by commas, for a help made when it is shown
+    (:class:`LazyHelp`).
 
-def _method_help() -> str:
-    from ..codecs import REGISTRY
+    Returns
+    -------
+    str
+        The method names.
+
+    Examples
+    --------
+    >>> "graycode" in method_names().split(", ")
+    True
+    """
+    from ...codecs import REGISTRY
 
     return ", ".join(REGISTRY)
 
 
-
-class _LazyHelp(click.Option):
+class LazyHelp(click.Option):
     """An option whose help names what the registry holds, made when the help is shown (so
-    that ``bistair --help`` and every command itself do not import the codecs for it)."""
+    that ``bistair --help`` and every command itself do not import the codecs for it):
+    ``help_from()`` fills the ``{}`` of its help.
+
+    >>> LazyHelp(["--method"], help_from=method_names, help="one of {}").help_text
+    'one of {}'
+    """
 
     def __init__(self, *args: Any, help_from: Callable[[], str], **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
@@ -241,23 +308,43 @@ class _LazyHelp(click.Option):
         return super().get_help_record(ctx)
 
 
+def strategy_option(func: Callable) -> Callable:
+    """``--strategy``: a fringe-order strategy, listed per method in the help; a name that
+    is no decoder's strategy is refused (each decoder checks its own).
 
-def _strategy(func: Callable) -> Callable:
-    """``--strategy``: a fringe-order strategy, listed per method in the help."""
-    return click.option("--strategy", type=_Strategy("STRATEGY"), default=None, cls=_LazyHelp,
+    Parameters
+    ----------
+    func : callable
+        The command, given a ``strategy`` argument (``None`` when not given).
+
+    Returns
+    -------
+    callable
+        ``func`` with the option.
+
+    Examples
+    --------
+    >>> strategy_option(lambda strategy: strategy).__click_params__[0].name
+    'strategy'
+    """
+    return click.option("--strategy", type=_Strategy("STRATEGY"), default=None, cls=LazyHelp,
                         help_from=_strategy_help,
                         help="fringe-order strategy of the method's decoder: {}")(func)
 
 
+def print_warnings(result: Any) -> None:
+    """Print a decode's warnings on stderr, one line each (``Warning: <message>``).
 
-def _show(value: Any) -> str:
-    """A default as the command line shows it: 30 rather than 30.0."""
-    return str(int(value)) if isinstance(value, float) and value.is_integer() else str(value)
+    Parameters
+    ----------
+    result : DecodeResult or AxesResult
+        The decode; of both axes, the warnings of x, then of y.
 
-
-
-def _warn(result: Any) -> None:
-    """Print a decode's warnings on stderr, one line each."""
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> print_warnings(SimpleNamespace(info={"warnings": []}))  # none: prints nothing
+    """
     infos = [result.info] if not hasattr(result, "x") else [result.x.info, result.y.info]
     for info in infos:
         for message in info.get("warnings", []):

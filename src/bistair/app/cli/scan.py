@@ -1,6 +1,7 @@
 """``bistair scan``: project a pattern set and grab it with a camera.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -9,12 +10,12 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
     Output,
-    _quiet,
-    _warn,
+    print_warnings,
+    quiet_option,
     reports_errors,
 )
 
@@ -65,7 +66,7 @@ from .cli_options import (
 @click.option("--compress-captures", is_flag=True,
               help="with --scans: deflate the captures' PNG as one scan does (files 2.2 "
               "times smaller, five times the CPU time) instead of storing them")
-@_quiet
+@quiet_option
 @reports_errors
 def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
          settle_ms: float | None, average: int, drop: int | None, exposure: float | None,
@@ -78,11 +79,11 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     Per pattern: show it, wait --settle-ms, drop the frames the camera buffered before,
     grab --average frames and average them. Esc in the window or Ctrl-C stops cleanly
     (with --scans, keeping the scans grabbed)."""
-    from .progress import Progress
+    from ..progress import Progress
 
     settings = dict(exposure=exposure, gain=gain, pixel_format=pixel_format)
     if measure_latency:
-        from .scan import measure_settle
+        from ..scan import measure_settle
 
         with Progress(quiet) as say:
             latency, path = measure_settle(display, camera, latency_file, progress=say,
@@ -110,8 +111,8 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
                 calibration, quiet, settle_ms=settle_ms, average=average, drop=drop,
                 latency_file=latency_file, compress_captures=compress_captures, **settings)
         return
-    from .jobs import parse_depth_range
-    from .scan import scan_folder
+    from ..decode import parse_depth_range
+    from ..scan import scan_folder
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     with Progress(quiet) as say:
@@ -123,7 +124,7 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
     for message in info["warnings"]:
         click.echo(f"Warning: {message}", err=True)
     if report.decoded is not None:
-        _warn(report.decoded)
+        print_warnings(report.decoded)
     if quiet:
         return
     frames = report.scan.frames
@@ -144,9 +145,9 @@ def scan(spec_path: Path | None, display: str, camera: str, out: Path | None,
 def _series(spec_path: Path, display: str, camera: str, out: Path, scans: int, decode: bool,
             backlog: int, no_previews: bool, calibration: Path | None, quiet: bool,
             **options: object) -> None:
-    """``bistair scan --scans N``: :func:`bistair.app.series.scan_series` and its summary."""
-    from .progress import Progress
-    from .series import scan_series, summary_lines
+    """``bistair scan --scans N``: :func:`bistair.app.scan_series.scan_series` and its summary."""
+    from ..progress import Progress
+    from ..scan_series import scan_series, summary_lines
 
     if calibration is not None:
         raise CliError("--calibration applies to one scan: reconstruct a series afterwards "

@@ -1,6 +1,8 @@
-"""``bistair stereo`` and ``bistair calibrate-stereo``: two cameras and a projector.
+"""``bistair stereo``: two cameras and a projector (:mod:`bistair.app.stereo`; ``stereo
+--window``: :mod:`bistair.app.stereo_stream`).
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -9,14 +11,14 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
+    CliError,
     Input,
     Output,
-    _quiet,
-    _strategy,
-    _threads,
-    board_choice,
+    quiet_option,
     reports_errors,
+    strategy_option,
+    threads_option,
 )
 
 
@@ -36,7 +38,7 @@ from .cli_options import (
               "spec (stereo phase unwrapping)")
 @click.option("--force", is_flag=True, help="keep what the checks would refuse (too few "
               "matches; the decoder's checks where it offers this), as warnings in info.json")
-@_strategy
+@strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale [default: from noise]")
 @click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
@@ -50,8 +52,8 @@ from .cli_options import (
               "needs --depth-range")
 @click.option("--starts", default=None, metavar="S,S,...",
               help="with --window: the window starts to write [default: every one]")
-@_threads
-@_quiet
+@threads_option
+@quiet_option
 @reports_errors
 def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
            depth_range: str | None, force: bool, strategy: str | None,
@@ -66,9 +68,9 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     except for a single-period spec (patterns multifreq --periods T): its fringe order comes
     from the projector's pose in the calibration and --depth-range (stereo phase
     unwrapping); pixels that stay ambiguous are left out."""
-    from .jobs import parse_depth_range
-    from .progress import Progress
-    from .stereo import stereo_folder, warnings
+    from ..decode import parse_depth_range
+    from ..progress import Progress
+    from ..stereo import stereo_folder, warnings
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if window is not None or starts is not None:
@@ -110,9 +112,8 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
                    min_modulation: float | None, quiet: bool) -> None:
     """``stereo --window``: a depth map per window of two streams
     (:mod:`bistair.app.stereo_stream`)."""
-    from .cli_options import CliError
-    from .progress import Progress
-    from .stereo_stream import stereo_stream
+    from ..progress import Progress
+    from ..stereo_stream import stereo_stream
 
     if window is None:
         raise CliError("--starts needs --window N or N+K")
@@ -130,44 +131,3 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
     click.echo(f"{len(kept)} depth maps of --window {window.strip()} at {depth[0]:g}-"
                f"{depth[1]:g} mm: {100 * min(shares):.1f}-{100 * max(shares):.1f}% of the "
                f"decoded left pixels decided, {ms:.1f} ms CPU a window; wrote {out}")
-
-
-@click.command("calibrate-stereo")
-@click.argument("poses", type=Input())
-@board_choice("POSES")
-@click.option("--out", "-o", required=True, type=Output(file=True),
-              help="stereo calibration file to write (JSON)")
-@click.option("--min-poses", type=int, default=3, show_default=True,
-              help="fewest poses with the board found in both images (3 or more)")
-@_quiet
-@reports_errors
-def calibrate_stereo(poses: Path, board: str | None, out: Path, min_poses: int,
-                     quiet: bool) -> None:
-    """Calibrate two cameras from image pairs of a board.
-
-    POSES: one folder per pose holding a left and a right image (named left/right, else in
-    name order), or left/ and right/ folders whose images pair up in name order. Poses
-    where the board is not found in both images are skipped."""
-    from .progress import Progress
-    from .stereo import calibrate_stereo_folder
-
-    with Progress(quiet) as say:
-        cal, skipped = calibrate_stereo_folder(poses, out, board, min_poses, progress=say)
-    for name in skipped:
-        click.echo(f"Warning: pose {name} skipped: the board is not found in both images",
-                   err=True)
-    if quiet:
-        return
-    click.echo(f"stereo RMS {cal.rms:.3f} px (left {cal.left.rms:.3f} px, right "
-               f"{cal.right.rms:.3f} px), baseline {cal.baseline:.2f} +/- "
-               f"{cal.uncertainty.baseline:.2f} mm, {len(cal.poses)} of {cal.poses_total} "
-               f"poses; wrote {out}")
-    for name, dev, sd in (("left", cal.left, cal.uncertainty.camera),
-                          ("right", cal.right, cal.uncertainty.projector)):
-        values = (dev.K[0, 0], dev.K[1, 1], dev.K[0, 2], dev.K[1, 2])
-        click.echo(f"  {name + ':':7s} " + ", ".join(
-            f"{key} {v:.2f} +/- {s:.2f}"
-            for key, v, s in zip(("fx", "fy", "cx", "cy"), values, sd[:4], strict=True)) + " px")
-    for pose in cal.poses:
-        click.echo(f"  {pose['name']}: {pose['features']} corners, left "
-                   f"{pose['left_rms']:.3f} px, right {pose['right_rms']:.3f} px")

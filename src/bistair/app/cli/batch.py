@@ -1,6 +1,7 @@
 """``bistair batch``: many capture sets on Dask.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -10,14 +11,14 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
     Output,
-    _force,
-    _quiet,
-    _strategy,
+    force_option,
+    quiet_option,
     reports_errors,
+    strategy_option,
 )
 
 BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batch.csv)
@@ -37,7 +38,7 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
               help="run on an existing Dask cluster instead (its workers must see the same "
               "paths)")
 @click.option("--resume", is_flag=True, help="skip sets whose outputs are complete")
-@_strategy
+@strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale, between 0 and 1 "
               "[default: from noise]")
@@ -47,8 +48,8 @@ BATCH_SETS_FAILED = 3  # the exit code when some sets failed (each a row of batc
 @click.option("--epipolar-tolerance", type=float, default=1.5, show_default=True,
               metavar="PX", help="with --calibration and specs of both axes: see "
               "'bistair reconstruct --help'")
-@_force
-@_quiet
+@force_option
+@quiet_option
 @reports_errors
 def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | None,
           workers: int | None, scheduler: str | None, resume: bool, strategy: str | None,
@@ -63,14 +64,14 @@ def batch(root: Path, out: Path, spec_path: Path | None, calibration: Path | Non
     Exit code 0 when every set decoded, 3 when some failed, 2 on bad input; after Ctrl-C
     1, after SIGTERM 143 (batch.csv lists the finished sets).
     """
-    from .batch import run_batch
-    from .jobs import parse_depth_range
+    from ..batch import run_batch
+    from ..decode import parse_depth_range
 
     if depth_range is not None and calibration is None:
         raise CliError("--depth-range applies to the reconstruction: give --calibration too")
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if calibration is not None:  # a stereo one's baseline under 10 mm: said once
-        from ..geometry.calibration import StereoCalibration, load_calibration, short_baseline
+        from ...geometry.calibration import StereoCalibration, load_calibration, short_baseline
 
         cal = load_calibration(calibration)
         if isinstance(cal, StereoCalibration) and short_baseline(cal):

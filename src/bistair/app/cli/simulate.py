@@ -1,6 +1,7 @@
 """``bistair simulate``: preset scenes, data sets and two cameras on the virtual rig.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the commands, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+commands, as there."""
 
 from __future__ import annotations
 
@@ -10,14 +11,14 @@ from typing import Any
 
 import click
 
-from .cli_options import (
+from .options import (
     CliError,
     Input,
+    LazyHelp,
     Output,
-    _LazyHelp,
-    _method_help,
-    _quiet,
-    _Size,
+    Size,
+    method_names,
+    quiet_option,
     reports_errors,
 )
 
@@ -28,7 +29,7 @@ from .cli_options import (
               "objects-on-plane, mugs-on-wall) or calibration (board captures of a 9 x 6 "
               "checkerboard in eight poses)")
 @click.option("--method", "methods", multiple=True, metavar="METHOD",
-              cls=_LazyHelp, help_from=_method_help,
+              cls=LazyHelp, help_from=method_names,
               help="method to render (repeatable): {} or all; with --spec, its method or "
               "none")
 @click.option("--spec", "spec_path", type=Input(), default=None,
@@ -38,7 +39,7 @@ from .cli_options import (
               help="output folder: OUT/<method>/ (captures and spec.json), OUT/truth/, "
               "calibration.json, scene.json; --scene calibration: board.json and pose-NN/ "
               "(OUT/<method>/ each for several methods)")
-@click.option("--camera", type=_Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
+@click.option("--camera", type=Size("WxH"), default=None, help="camera size WIDTHxHEIGHT "
               "[default: 1280x1024]")
 @click.option("--noise", type=float, default=0.01, show_default=True,
               help="read noise, fraction of full scale")
@@ -93,7 +94,7 @@ from .cli_options import (
 @click.option("--period", type=float, default=None,
               help="with --continuous: the stream's fringe period in projector pixels "
               "[default: 30]")
-@_quiet
+@quiet_option
 @reports_errors
 def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
              camera: tuple[int, int] | None, noise: float, blur: float, gamma: float,
@@ -109,14 +110,14 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
     projector between them, for 'bistair stereo'. With --spec, the set the spec describes
     (--method may then be left out). With --motion, things move between frames; with
     --frames N --continuous, a stream whose shift advances every frame."""
-    from ..codecs import REGISTRY
+    from ...codecs import REGISTRY
 
     if not methods and spec_path is None:
         raise CliError("name a --method to render (or give --spec)")
     chosen = list(REGISTRY) if "all" in methods else list(dict.fromkeys(methods))
     spec = None
     if spec_path is not None:
-        from ..io.read import load_spec
+        from ...io.read import load_spec
 
         if cameras == 2 or count is not None:
             raise CliError("--spec renders one scene with one camera: leave out --count and "
@@ -150,8 +151,8 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
                 raise CliError(f"{name} applies to a data set: give --count too")
         if scene is None:
             raise CliError("name a --scene (or give --count with --vary objects)")
-        from .progress import Progress
-        from .simulate import simulate as run
+        from ..progress import Progress
+        from ..simulate import simulate as run
 
         with Progress(quiet) as say:
             run(scene, chosen, out, camera_size=camera, compensated=compensated, seed=seed,
@@ -172,7 +173,7 @@ def simulate(scene: str | None, methods: tuple[str, ...], out: Path,
         return
     if no_white or both_axes:
         raise CliError("--no-white and --both-axes are for --scene calibration")
-    from .simulate import simulate_many
+    from ..simulate import simulate_many
 
     try:
         report = simulate_many(count, chosen, out, seed=seed, scene=scene, vary=vary or (),
@@ -202,8 +203,8 @@ def _simulate_motion(scene: str | None, methods: list[str], out: Path,
                      continuous: bool, quiet: bool, imaging: dict[str, Any],
                      stream: dict[str, Any] | None = None) -> None:
     """``bistair simulate --motion`` / ``--frames N --continuous``."""
-    from .progress import Progress
-    from .simulate_motion import simulate_motion
+    from ..progress import Progress
+    from ..simulate_motion import simulate_motion
 
     if count is not None or vary is not None:
         raise CliError("--motion and --continuous render one scene: leave out --count and "
@@ -233,8 +234,8 @@ def _simulate_stereo(scene: str | None, methods: list[str], out: Path,
                      count: int | None, baseline: float, quiet: bool,
                      imaging: dict[str, Any]) -> None:
     """``bistair simulate --cameras 2``."""
-    from .progress import Progress
-    from .stereo import simulate_stereo
+    from ..progress import Progress
+    from ..simulate import simulate_stereo
 
     if count is not None:
         raise CliError("--cameras 2 renders one scene: leave out --count")

@@ -1,6 +1,7 @@
 """``bistair bench``: every codec's decode speed on this machine against the OpenCV floor.
 
-Registered on the command group by :mod:`.cli`; imports deferred into the command, as there."""
+Registered on the command group by :mod:`bistair.app.cli`; imports deferred into the
+command, as there."""
 
 from __future__ import annotations
 
@@ -8,22 +9,22 @@ from pathlib import Path
 
 import click
 
-from .cli_options import _LazyHelp, _method_help, _quiet, _Size, _threads, reports_errors
+from .options import LazyHelp, Size, method_names, quiet_option, reports_errors, threads_option
 
 
 @click.command()
-@click.option("--camera", type=_Size("WxH"), default="1280x1024", show_default=True,
+@click.option("--camera", type=Size("WxH"), default="1280x1024", show_default=True,
               help="camera size WIDTHxHEIGHT of the rendered captures (at least 192 a side)")
-@click.option("--method", "picked", multiple=True, metavar="METHOD", cls=_LazyHelp,
-              help_from=_method_help,
+@click.option("--method", "picked", multiple=True, metavar="METHOD", cls=LazyHelp,
+              help_from=method_names,
               help="time this method only (repeatable, or joined by commas: {}) [default: "
               "all; the default decoder is always timed, the ratios are to it]")
 @click.option("--runs", type=int, default=5, show_default=True,
               help="timed decodes per codec (after a first one, not timed)")
 @click.option("--json", "json_path", type=click.Path(path_type=Path), default=None,
               metavar="FILE", help="also write the figures to FILE (JSON)")
-@_threads
-@_quiet
+@threads_option
+@quiet_option
 @reports_errors
 def bench(camera: tuple[int, int], picked: tuple[str, ...], runs: int, json_path: Path | None,
           quiet: bool) -> None:
@@ -36,8 +37,8 @@ def bench(camera: tuple[int, int], picked: tuple[str, ...], runs: int, json_path
     --runs decodes. The machine is described on the last line (cores, threads, CPU, numba's
     threading layer, load): compare the ratios, which a busy machine changes less than the
     times."""
-    from .bench import bench_lines, check_json_path, run_bench, write_bench_json
-    from .progress import Progress
+    from ..bench import bench_lines, check_json_path, run_bench, write_bench_json
+    from ..progress import Progress
 
     names = [name.strip() for item in picked for name in item.split(",") if name.strip()]
     if json_path is not None:  # refused before the work, not after it

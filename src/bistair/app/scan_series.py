@@ -67,8 +67,8 @@ from ..io.jsonfile import to_jsonable, write_json
 from ..io.read import load_spec
 from ..io.writers import save_result
 from ..spec import BaseSpec
-from .jobs import require_valid
-from .scan import DECODE_FOLDER, _check_out
+from .decode import require_valid
+from .scan import DECODE_FOLDER, check_out
 
 SERIES_FILE = "series.json"
 WRITE_BACKLOG = 8  # scans grabbed and not yet written before the grab loop waits
@@ -130,7 +130,7 @@ def scan_series(spec: BaseSpec | str | Path, display: Display | str, camera: Cam
         if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= top:
             raise BistairError(f"{name} must be a whole number from 1 to {top}, got {value!r}")
     out = check_output(out)
-    _check_out(out)
+    check_out(out)
     if not isinstance(spec, BaseSpec):
         spec = load_spec(spec)
     settings = [options.pop(k, None) for k in ("exposure", "gain", "pixel_format")]
