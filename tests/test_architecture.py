@@ -6,6 +6,8 @@ of the package, no imports hidden in functions outside the command line. And its
 from __future__ import annotations
 
 import ast
+import io
+import tokenize
 import warnings
 from pathlib import Path
 
@@ -308,3 +310,38 @@ def test_every_job_module_is_a_family_or_part_of_one():
               if p.stem not in families | APP_SHARED | {"__init__"}
               and not any(p.stem.startswith(f"{family}_") for family in families)]
     assert not strays
+
+
+#: Issue 35: a module short enough to read whole.
+MOST_LINES_OF_CODE = 450
+
+
+def lines_of_code(text: str) -> int:
+    """Lines holding code: not blank, not a comment, not a docstring.
+
+    >>> lines_of_code(chr(10).join(['"Module doc."', '', '# a note', 'x = 1', 'def f():',
+    ...                              '    "Doc."', '    return x']))
+    3
+    """
+    tree = ast.parse(text)
+    docs: set[int] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, (ast.Module, ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            body = node.body
+            if (body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
+                    and isinstance(body[0].value.value, str)):
+                docs.update(range(body[0].lineno, (body[0].end_lineno or body[0].lineno) + 1))
+    code: set[int] = set()
+    skip = (tokenize.COMMENT, tokenize.NL, tokenize.NEWLINE, tokenize.INDENT, tokenize.DEDENT,
+            tokenize.ENDMARKER)
+    for tok in tokenize.generate_tokens(io.StringIO(text).readline):
+        if tok.type not in skip:
+            code.update(n for n in range(tok.start[0], tok.end[0] + 1) if n not in docs)
+    return len(code)
+
+
+def test_no_module_is_over_450_lines_of_code():
+    """Files short enough to read whole (issue 35): split a longer module by concept."""
+    long = {str(p.relative_to(SRC)): n for p in SRC.rglob("*.py")
+            if (n := lines_of_code(p.read_text())) > MOST_LINES_OF_CODE}
+    assert not long
