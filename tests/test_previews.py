@@ -90,7 +90,9 @@ def test_height_png_has_a_colour_bar_in_mm(tmp_path, monkeypatch, capsys):
                            tmp_path / "ref" / "spec.json", "--geometry", "600,200,0.1",
                            "--out", tmp_path / "h")
     assert code == 0, err
-    assert [line.split(" (")[0] for line in err.splitlines()] == [
+    # (a stage that runs long on a loaded machine repeats its line as "still ...": not counted)
+    assert [line.split(" (")[0] for line in err.splitlines()
+            if not line.startswith("bistair: still ")] == [
         "bistair: reading the captures", f"bistair: decoding {tmp_path / 'ref' / 'stack.npy'}",
         "bistair: decoding 8 frames of 120x48", "bistair: writing height.npy and height.png"]
     heights = np.load(tmp_path / "h" / "height.npy")
