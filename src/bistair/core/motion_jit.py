@@ -4,7 +4,7 @@ over rows on every core.
 
 :func:`stream_update` gives what :class:`~bistair.core.motion.PhaseStream`'s NumPy steps
 give: the sums in float64, the phase and modulation of their float32 values by
-:func:`~bistair.core.phase_jit._phase` and ``_hypot32`` (as
+:func:`~bistair.core.phase_jit.phase32` and ``hypot32`` (as
 :func:`~bistair.core.phase_jit.phase_of_sums32`), the pairwise means across the wrap as
 :func:`~bistair.core.phase_jit.wrap_angles` and ``np.mod`` compute them in float32.
 
@@ -28,13 +28,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .jit import PI32, TWO_PI32, _numba_inline, kernel
-from .phase_jit import _hypot32, _phase, offset_parts
+from .jit import PI32, TWO_PI32, inline, kernel
+from .phase_jit import hypot32, offset_parts, phase32
 
 prange = range  # numba's prange once the first kernel of this module compiles
 
 
-@_numba_inline
+@inline
 def _wrap32(raw: np.float32) -> np.float32:
     """``(raw + pi) % 2pi - pi`` in float32, as :func:`~bistair.core.phase_jit.wrap_angles`
     computes it, for ``-3*pi <= raw < 3*pi`` (the difference of two of a stream's
@@ -46,7 +46,7 @@ def _wrap32(raw: np.float32) -> np.float32:
     return m - PI32
 
 
-@_numba_inline
+@inline
 def _mod32(a: np.float32) -> np.float32:
     """``np.mod(a, 2pi)`` of a float32 as NumPy computes it (``fmod``, then ``+ 2pi`` below
     0, one rounding) for ``-2*pi < a < 4*pi``; further out ``a - 2pi * floor(a / 2pi)``.
@@ -76,8 +76,8 @@ def _update(frame: np.ndarray, kept: np.ndarray, slot: int, full: bool, sin_k: f
             continue
         for x in range(w):
             a, b = np.float32(num[y, x]), np.float32(den[y, x])
-            phase[y, x] = _phase(a, b, off_hi, off_lo)
-            mod[y, x] = _hypot32(a, b) * scale
+            phase[y, x] = phase32(a, b, off_hi, off_lo)
+            mod[y, x] = hypot32(a, b) * scale
         for level in range(order + 1):  # phase, mod: the newest value of the level
             if level == order or level + 1 >= windows:  # (no previous window above)
                 for x in range(w):
