@@ -76,12 +76,16 @@ from .stereo import Rectification, rectify
 from .stereo_calibration import StereoCalibration
 from .unwrap import (
     EDGE,
+    GROW_SUPPORT,
     MIN_TOLERANCE,
+    REACH,
     SUPPORT,
     TOLERANCE_SIGMAS,
+    grow,
     is_single_period,
     unwrap_stereo,
 )
+from .unwrap_jit import KEPT
 from .unwrap_stream_jit import (
     confirm,
     plane_depth,
@@ -279,8 +283,8 @@ class StereoStream:
             disparity = found.disparity
             if self.previous is None:
                 self.check = found.info["range_check"]
-            info = {k: found.info[k] for k in ("no_candidate", "undecided", "not_confirmed",
-                                                "unsupported", "warnings")}
+            info = {k: found.info[k] for k in ("no_candidate", "undecided", "grown",
+                                                "not_confirmed", "unsupported", "warnings")}
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
         else:
             disparity, info = self._track(lrect, rrect)
@@ -312,16 +316,19 @@ class StereoStream:
                 self.calibration.projector.device.width)
         right_before = (self.previous_right if self.previous_right is not None
                         else _on_right(self.previous, self.rect.shift, rrect.shape[1]))
-        n_in, disparity, near = track_rows(lrect, rrect, self.previous, self.margin, lo, hi,
-                                           *args)
-        _, from_right, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
-                                      *args, from_right=True)
+        n_in, disparity, near, candidates = track_rows(
+            lrect, rrect, self.previous, self.margin, lo, hi, *args, keep=KEPT)
+        _, from_right, _, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
+                                         *args, from_right=True)
         valid = np.isfinite(lrect)
-        kept, not_confirmed, unsupported = confirm(disparity, n_in, valid, from_right,
-                                                   self.rect.shift, SUPPORT, EDGE)
+        alone, blocked, not_confirmed, unsupported = confirm(
+            disparity, n_in, valid, from_right, self.rect.shift, SUPPORT, EDGE)
+        kept = grow(alone, n_in, candidates, blocked, REACH, GROW_SUPPORT)
         self.previous, self.previous_right = disparity, from_right
+        grown = np.isfinite(kept) & np.isnan(alone)
         info = {"no_candidate": int(np.sum(valid & (n_in == 0))),
-                "undecided": int(np.sum(n_in >= 2)), "not_confirmed": not_confirmed,
+                "undecided": int(np.sum((n_in >= 2) & np.isnan(kept))),
+                "grown": int(grown.sum()), "not_confirmed": not_confirmed,
                 "unsupported": unsupported, "searched_near": int(near.sum()),
                 "searched_full": int(np.sum(valid & (near == 0))), "warnings": []}
         return kept, info
