@@ -90,7 +90,7 @@ def test_orders_and_the_full_search(sim):
     the same disparity, of the right order. Both grow decisions from two agreeing
     neighbours (:func:`~bistair.geometry.unwrap_jit.grow`); without that the tracker decided
     3.9% fewer. It now decides none the full search does not, and at most 0.5% fewer
-    (3-30 of about 6700 a window): at an occlusion edge the right grid's narrow search
+    (3-19 of about 6700 a window): at an occlusion edge the right grid's narrow search
     decides the near surface where the full search finds both surfaces (two candidates,
     undecided), and a left pixel that it contradicts is an occlusion for the tracker,
     blocking 2 pixels either side along the row. Orders off: at most 0.1% of the decided

@@ -14,9 +14,12 @@ multiply-adds a pixel; order ``K`` compensates motion). For each window:
    each pixel of both rectified grids only within :data:`MARGIN` pixels of its single
    candidate in the previous window (:func:`~.unwrap_stream_jit.track_rows`); a pixel
    without one, or whose narrow search finds no candidate or two, is searched over the
-   whole range. The decisions are confirmed as the full search's are
-   (:func:`~.unwrap_stream_jit.confirm`): by the right grid's own candidate at the match,
-   by a row above or below, and dropped beside an occlusion.
+   whole range; a right pixel whose narrow search fails is searched in full only where a
+   left pixel's single candidate lands (:func:`~.unwrap_stream_jit.match_targets`: the
+   only right pixels the confirmation reads). The decisions are confirmed as the full
+   search's are (:func:`~.unwrap_stream_jit.confirm`): by the right grid's own candidate
+   at the match, by a row above or below, and dropped beside an occlusion; then grown as
+   the full search grows them (:func:`~.unwrap_jit.grow`).
 3. The depth: the left camera's ray cut by the projector's plane of the column of the
    absolute phase (the pixel's own wrapped phase and the order its rectified neighbours
    decided; :func:`~.unwrap_stream_jit.plane_depth`). NaN where undecided.
@@ -88,6 +91,7 @@ from .unwrap import (
 from .unwrap_jit import KEPT
 from .unwrap_stream_jit import (
     confirm,
+    match_targets,
     plane_depth,
     projector_pixels,
     rectify_pair,
@@ -318,8 +322,9 @@ class StereoStream:
                         else _on_right(self.previous, self.rect.shift, rrect.shape[1]))
         n_in, disparity, near, candidates = track_rows(
             lrect, rrect, self.previous, self.margin, lo, hi, *args, keep=KEPT)
+        needed = match_targets(disparity, self.rect.shift, rrect.shape[1])
         _, from_right, _, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
-                                         *args, from_right=True)
+                                         *args, from_right=True, needed=needed)
         valid = np.isfinite(lrect)
         alone, blocked, not_confirmed, unsupported = confirm(
             disparity, n_in, valid, from_right, self.rect.shift, SUPPORT, EDGE)

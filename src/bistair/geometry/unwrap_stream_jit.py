@@ -120,9 +120,10 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
            lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
            back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
            period: float, tolerance: float, zmin: float, zmax: float, width: int,
-           from_right: bool, keep: int
+           from_right: bool, keep: int, needed: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     h, w = own.shape
+    gated = needed.shape[0] == h
     wr = other.shape[1]
     kept = np.empty((h, w, keep), np.float32)  # (only the first n_in are read)
     n_in = np.zeros((h, w), np.int16)
@@ -156,6 +157,9 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
                     disparity[y, x] = d
                     near[y, x] = 1
                     continue
+            if gated and needed[y, x] == 0:  # no pixel of the other grid reads it
+                n_in[y, x] = -2
+                continue
             count, d = _scan(own, other, y, x, a, j0, j1, lo, hi, shift, f, cx, yr, tx, back,
                              kp, dp, rp, tp, period, tolerance, zmin, zmax, width, from_right,
                              kept)
@@ -169,7 +173,8 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
                back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
                tp: np.ndarray, period: float, tolerance: float, zmin: float, zmax: float,
-               width: int, from_right: bool = False, keep: int = 0
+               width: int, from_right: bool = False, keep: int = 0,
+               needed: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The consistent candidates of each rectified pixel, searched first within
     ``margin`` of its ``previous`` disparity and over the full range ``[lo, hi]`` where
@@ -198,13 +203,18 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
         Keep the disparities of the first ``keep`` candidates of each pixel (what
         :func:`~bistair.geometry.unwrap_jit.grow` chooses among; ``KEPT`` of
         :mod:`~bistair.geometry.unwrap_jit`).
+    needed : numpy.ndarray, optional
+        ``(H, W)`` uint8: search the full range only where 1 (:func:`match_targets`: the
+        pixels whose decision the other grid's confirmation reads); a pixel of 0 whose
+        narrow search does not decide is left undecided (``n_in`` -2). By default every
+        pixel.
 
     Returns
     -------
     n_in : numpy.ndarray
         ``(H, W)`` int16 consistent candidates in the range of the search that decided
         (1 from the narrow one; else the full one's count), -1 where the full search would
-        reach past the other view.
+        reach past the other view, -2 where it was not ``needed``.
     disparity : numpy.ndarray
         ``(H, W)`` float32 the one candidate's disparity, NaN elsewhere.
     near : numpy.ndarray
@@ -239,7 +249,49 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                   float(hi), float(shift), float(f), float(cx), float(cy), float(tx),
                   arr(back, (3, 3)), arr(kp, (3, 3)), arr(dp, (5,)), arr(rp, (3, 3)),
                   arr(tp, (3,)), float(period), float(tolerance), float(zmin), float(zmax),
-                  int(width), bool(from_right), int(keep))
+                  int(width), bool(from_right), int(keep),
+                  np.zeros((0, 0), np.uint8) if needed is None
+                  else np.ascontiguousarray(needed, np.uint8))
+
+
+@kernel(parallel=True)
+def _targets(disparity: np.ndarray, shift: float, width: int) -> np.ndarray:
+    h, w = disparity.shape
+    out = np.zeros((h, width), np.uint8)
+    for y in prange(h):
+        for x in range(w):
+            d = float(disparity[y, x])
+            if d == d:
+                xr = int(np.rint(x - shift - d))
+                if 0 <= xr < width:
+                    out[y, xr] = 1
+    return out
+
+
+def match_targets(disparity: np.ndarray, shift: float, width: int) -> np.ndarray:
+    """The right grid's pixels that the left grid's single candidates match (the nearest
+    pixel, as :func:`confirm` reads them).
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 the left grid's single candidates, NaN elsewhere.
+    shift : float
+        ``cx_left - cx_right`` (px).
+    width : int
+        The right grid's width.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, width)`` uint8: 1 where some left pixel's candidate lands.
+
+    Examples
+    --------
+    >>> match_targets(np.float32([[np.nan, 1.0, 1.2, 0.4]]), -1.0, 4).tolist()
+    [[0, 1, 1, 0]]
+    """
+    return _targets(np.ascontiguousarray(disparity, np.float32), float(shift), int(width))
 
 
 @kernel(parallel=True)
@@ -318,6 +370,7 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
     column = np.full((h, w), np.nan, np.float32)
     fx, skew, cxp, fy, cyp = kp[0, 0], kp[0, 1], kp[0, 2], kp[1, 1], kp[1, 2]
     distorted = dp[0] != 0.0 or dp[1] != 0.0 or dp[2] != 0.0 or dp[3] != 0.0 or dp[4] != 0.0
+    inv_period, inv_two_pi, inv_fx, inv_fy = 1.0 / period, 1.0 / TWO_PI, 1.0 / fx, 1.0 / fy
     for y in prange(h):
         for x in range(w):
             phi = float(phase[y, x])
@@ -335,14 +388,15 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
             c, lo, hi = _corner(cols, y0 + 1, x0 + 1, fu * fv, c, lo, hi)
             if not hi - lo <= max_step:  # (NaN: a corner undecided)
                 continue
-            k = math.floor((TWO_PI * c / period - phi) / TWO_PI + 0.5)
-            xp = (phi / TWO_PI + k) * period  # the column of the absolute phase
+            # (reciprocals precomputed: no division but the plane's)
+            k = math.floor(c * inv_period - phi * inv_two_pi + 0.5)
+            xp = (phi * inv_two_pi + k) * period  # the column of the absolute phase
             yn = 0.0
             if distorted:  # the row of the sample, for the column plane's local slope
                 r = (1 - fv) * ((1 - fu) * rows[y0, x0] + fu * rows[y0, x0 + 1]) + fv * (
                     (1 - fu) * rows[y0 + 1, x0] + fu * rows[y0 + 1, x0 + 1])
-                yd = (r - cyp) / fy
-                xd = (xp - cxp - skew * yd) / fx
+                yd = (r - cyp) * inv_fy
+                xd = (xp - cxp - skew * yd) * inv_fx
                 xn, yn = xd, yd
                 for _ in range(8):  # undistort (OpenCV's iteration)
                     r2 = xn * xn + yn * yn
@@ -350,8 +404,10 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
                     dx = 2.0 * dp[2] * xn * yn + dp[3] * (r2 + 2.0 * xn * xn)
                     dy = dp[2] * (r2 + 2.0 * yn * yn) + 2.0 * dp[3] * xn * yn
                     xn, yn = (xd - dx) / radial, (yd - dy) / radial
+            elif skew != 0.0:
+                xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) * inv_fy)) * inv_fx
             else:
-                xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) / fy)) / fx
+                xn = (xp - cxp) * inv_fx
             den = float(ax[y, x]) - xn * float(az[y, x])
             if den == 0.0:
                 continue
