@@ -96,6 +96,7 @@ from .unwrap_stream_jit import (
     projector_pixels,
     rectify_pair,
     track_rows,
+    window_counts,
 )
 
 #: Half the width (rectified pixels) of a later window's search about the previous
@@ -247,8 +248,8 @@ class StereoStream:
                          self.buffers, strict=True)]
         start = self.count - n - self.order
         result = self._window(rectified[0], rectified[1], start)
-        result.grey = np.clip(states[0].mod * np.float32(255 / max(self.scale, 1e-12)), 0,
-                              255).astype(np.uint8)
+        grey = states[0].mod * np.float32(255 / max(self.scale, 1e-12))
+        result.grey = np.clip(grey, 0, 255, out=grey).astype(np.uint8)
         result.info["cpu_seconds"] = round(time.process_time() - clock, 6)
         return result
 
@@ -306,7 +307,7 @@ class StereoStream:
                 "decided_fraction": round(decided / max(valid, 1), 6), "left_decoded": valid,
                 **info, "tolerance_rad": round(float(self.tolerance or 0.0), 6),
                 "noise_rad": [round(v, 6) for v in self.noise]}
-        phase = (column * np.float32(2 * np.pi / self.period)).astype(np.float32)
+        phase = np.multiply(column, np.float32(2 * np.pi / self.period), out=column)
         return StreamDepth(start, depth, order, phase, mask, disparity,
                            np.zeros(depth.shape, np.uint8), info)
 
@@ -330,12 +331,10 @@ class StereoStream:
             disparity, n_in, valid, from_right, self.rect.shift, SUPPORT, EDGE)
         kept = grow(alone, n_in, candidates, blocked, REACH, GROW_SUPPORT)
         self.previous, self.previous_right = disparity, from_right
-        grown = np.isfinite(kept) & np.isnan(alone)
-        info = {"no_candidate": int(np.sum(valid & (n_in == 0))),
-                "undecided": int(np.sum((n_in >= 2) & np.isnan(kept))),
-                "grown": int(grown.sum()), "not_confirmed": not_confirmed,
-                "unsupported": unsupported, "searched_near": int(near.sum()),
-                "searched_full": int(np.sum(valid & (near == 0))), "warnings": []}
+        counts = window_counts(lrect, n_in, near, alone, kept)
+        info = {"no_candidate": counts[0], "undecided": counts[1], "grown": counts[2],
+                "not_confirmed": not_confirmed, "unsupported": unsupported,
+                "searched_near": counts[3], "searched_full": counts[4], "warnings": []}
         return kept, info
 
 

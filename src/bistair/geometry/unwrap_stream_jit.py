@@ -689,3 +689,56 @@ def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
     np.arctan2(b["s"], b["c"], out=b["angle"])
     _finish(b["angle"], b["v"])
     return b["phase"], b["angle"], int(count)
+
+
+@kernel(parallel=True)
+def _counts(rectified: np.ndarray, n_in: np.ndarray, near: np.ndarray, alone: np.ndarray,
+            kept: np.ndarray) -> np.ndarray:
+    h, w = rectified.shape
+    rows = np.zeros((h, 5), np.int64)
+    for y in prange(h):
+        for x in range(w):
+            if rectified[y, x] == rectified[y, x]:
+                rows[y, 0] += n_in[y, x] == 0
+                rows[y, 4] += near[y, x] == 0
+            decided = kept[y, x] == kept[y, x]
+            rows[y, 1] += n_in[y, x] >= 2 and not decided
+            rows[y, 2] += decided and alone[y, x] != alone[y, x]
+            rows[y, 3] += near[y, x]
+    return rows
+
+
+def window_counts(rectified: np.ndarray, n_in: np.ndarray, near: np.ndarray,
+                  alone: np.ndarray, kept: np.ndarray) -> list[int]:
+    """A tracked window's pixel counts in one pass.
+
+    Parameters
+    ----------
+    rectified : numpy.ndarray
+        ``(H, W)`` float32 the left grid's wrapped phase, NaN where unknown.
+    n_in, near : numpy.ndarray
+        ``(H, W)`` :func:`track_rows`' candidate counts (int16) and narrow decisions
+        (uint8).
+    alone, kept : numpy.ndarray
+        ``(H, W)`` float32 the confirmed disparities (:func:`confirm`) and those after
+        growth, NaN where undecided.
+
+    Returns
+    -------
+    list of int
+        No candidate (of the known pixels), undecided with two or more, grown, decided by
+        the narrow search, searched in full (known pixels the narrow search did not decide).
+
+    Examples
+    --------
+    >>> nan = np.nan
+    >>> window_counts(np.float32([[1, 1, 1, nan]]), np.int16([[0, 2, 1, 0]]),
+    ...               np.uint8([[0, 0, 1, 0]]), np.float32([[nan, nan, 5, nan]]),
+    ...               np.float32([[nan, 4, 5, nan]]))
+    [1, 0, 1, 1, 2]
+    """
+    rows = _counts(np.ascontiguousarray(rectified, np.float32),
+                   np.ascontiguousarray(n_in, np.int16), np.ascontiguousarray(near, np.uint8),
+                   np.ascontiguousarray(alone, np.float32),
+                   np.ascontiguousarray(kept, np.float32))
+    return [int(v) for v in rows.sum(axis=0)]
