@@ -88,7 +88,6 @@ from .unwrap import (
     is_single_period,
     unwrap_stereo,
 )
-from .unwrap_jit import KEPT
 from .unwrap_stream_jit import (
     confirm,
     match_targets,
@@ -322,10 +321,10 @@ class StereoStream:
         right_before = (self.previous_right if self.previous_right is not None
                         else _on_right(self.previous, self.rect.shift, rrect.shape[1]))
         n_in, disparity, near, candidates = track_rows(
-            lrect, rrect, self.previous, self.margin, lo, hi, *args, keep=KEPT)
+            lrect, rrect, self.previous, self.margin, lo, hi, *args)
         needed = match_targets(disparity, self.rect.shift, rrect.shape[1])
         _, from_right, _, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
-                                         *args, from_right=True, needed=needed)
+                                         *args, from_right=True, keep=0, needed=needed)
         valid = np.isfinite(lrect)
         alone, blocked, not_confirmed, unsupported = confirm(
             disparity, n_in, valid, from_right, self.rect.shift, SUPPORT, EDGE)

@@ -34,6 +34,7 @@ import cv2
 import numpy as np
 
 from ..core.jit import _numba_inline, kernel
+from .unwrap_jit import KEPT
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -173,7 +174,7 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
                back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
                tp: np.ndarray, period: float, tolerance: float, zmin: float, zmax: float,
-               width: int, from_right: bool = False, keep: int = 0,
+               width: int, from_right: bool = False, keep: int = KEPT,
                needed: np.ndarray | None = None
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The consistent candidates of each rectified pixel, searched first within
@@ -201,8 +202,8 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
         ``own`` is the right grid (the same disparity convention).
     keep : int, optional
         Keep the disparities of the first ``keep`` candidates of each pixel (what
-        :func:`~bistair.geometry.unwrap_jit.grow` chooses among; ``KEPT`` of
-        :mod:`~bistair.geometry.unwrap_jit`).
+        :func:`~bistair.geometry.unwrap_jit.grow` chooses among; by default ``KEPT`` of
+        :mod:`~bistair.geometry.unwrap_jit`, 0 keeps none).
     needed : numpy.ndarray, optional
         ``(H, W)`` uint8: search the full range only where 1 (:func:`match_targets`: the
         pixels whose decision the other grid's confirmation reads); a pixel of 0 whose
@@ -234,8 +235,7 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
     >>> none = np.full((1, 80), np.nan, np.float32)
     >>> n_in, d, near, kept = track_rows(
     ...     left, right, none, 2.0, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
-    ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000,
-    ...     keep=4)
+    ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
     >>> int(n_in[0, 50]), round(float(d[0, 50]), 4), int(near[0, 50]), int(n_in[0, 30])
     (1, 20.0, 0, -1)
     >>> round(float(kept[0, 50, 0]), 4)
