@@ -9,8 +9,13 @@ triangulates (the projector's column planes). Process CPU time, the minimum of i
 rounds, per depth map, beside two bare baselines of the same run: one ``cv2.remap`` of a
 640 x 480 float32 image and a NumPy sum of four 640 x 480 frames. Then where the time goes:
 each stage of a depth map (both cameras) timed inside the stream's steps, the minimum over
-``--frames`` depth maps (the stages' minima need not add up to the whole's). The decided
-pixels an order off are counted against the renderer's truth after the timing.
+``--frames`` depth maps (the stages' minima need not add up to the whole's): its work (CPU
+on one numba and OpenCV thread), its CPU and wall time on the machine's threads, and the
+share of its work that runs in parallel (Amdahl's law from the two). The rate a dedicated
+machine of that many cores gets is each stage's work at its parallel share (the rest of a
+depth map serial), beside the wall time measured here and the load average: other jobs on
+the cores lower the measured share and the rate. The decided pixels an order off are
+counted against the renderer's truth after the timing.
 
     python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
 """
@@ -18,6 +23,7 @@ pixels an order off are counted against the renderer's truth after the timing.
 from __future__ import annotations
 
 import argparse
+import os
 import time
 from collections import defaultdict
 from collections.abc import Callable
@@ -35,11 +41,13 @@ from bistair.sim import Imaging, expose, preset, trace
 from bistair.sim.stereo import StereoRig
 
 RANGE = (520.0, 650.0)
+WHOLE = "whole depth map"
 STAGES = {  # what each stage of a depth map calls (module or class, name)
     "running sums (PhaseStream)": [(PhaseStream, "update")],
     "resampling (rectify_pair)": [(unwrap_stream, "rectify_pair")],
     "row searches (track_rows)": [(unwrap_stream, "track_rows")],
     "confirmation (confirm)": [(unwrap_stream, "confirm")],
+    "growth (grow)": [(unwrap_stream, "grow")],
     "depth (projector_pixels, plane_depth)": [(unwrap_stream, "projector_pixels"),
                                               (unwrap_stream, "plane_depth")],
 }
@@ -72,38 +80,63 @@ def cpu(fn, repeat: int = 1) -> float:
 
 
 def stage_split(stream: StereoStream, left: np.ndarray, right: np.ndarray, first: int,
-                count: int) -> dict[str, float]:
-    """Process CPU seconds of each stage of a depth map, the minimum over ``count`` depth
-    maps (frames ``first ..``, wrapping), and of the whole ``push``."""
-    spent: dict[str, float] = defaultdict(float)
+                count: int) -> dict[str, tuple[float, float]]:
+    """Process CPU and wall seconds of each stage of a depth map, each the minimum over
+    ``count`` depth maps (frames ``first ..``, wrapping), and of the whole ``push``."""
+    spent: dict[str, list[float]] = defaultdict(lambda: [0.0, 0.0])
     saved: list[tuple[object, str, Callable]] = []
 
     def timed(stage: str, fn: Callable) -> Callable:
         def call(*args: object, **kwargs: object) -> object:
-            start = time.process_time()
+            start, clock = time.process_time(), time.perf_counter()
             try:
                 return fn(*args, **kwargs)
             finally:
-                spent[stage] += time.process_time() - start
+                spent[stage][0] += time.process_time() - start
+                spent[stage][1] += time.perf_counter() - clock
         return call
 
     for stage, places in STAGES.items():
         for owner, name in places:
             saved.append((owner, name, getattr(owner, name)))
             setattr(owner, name, timed(stage, getattr(owner, name)))
-    best = {name: float("inf") for name in (*STAGES, "whole depth map")}
+    best = {name: [float("inf"), float("inf")] for name in (*STAGES, WHOLE)}
     try:
         for i in range(first, first + count):
             spent.clear()
-            start = time.process_time()
+            start, clock = time.process_time(), time.perf_counter()
             stream.push(left[i % len(left)], right[i % len(right)])
-            spent["whole depth map"] = time.process_time() - start
+            spent[WHOLE] = [time.process_time() - start, time.perf_counter() - clock]
             for name in best:
-                best[name] = min(best[name], spent[name])
+                best[name] = [min(a, b) for a, b in zip(best[name], spent[name], strict=True)]
     finally:
         for owner, name, fn in saved:
             setattr(owner, name, fn)
-    return best
+    return {name: (v[0], v[1]) for name, v in best.items()}
+
+
+def threads(count: int) -> None:
+    """Run numba's and OpenCV's parallel loops on ``count`` threads."""
+    numba.set_num_threads(count)
+    cv2.setNumThreads(count)
+
+
+def parallel_split(stream: StereoStream, left: np.ndarray, right: np.ndarray, first: int,
+                   count: int, cores: int) -> dict[str, tuple[float, float, float]]:
+    """Each stage's work (CPU seconds on one thread), its CPU and wall seconds on
+    ``cores`` threads, and the share of its work that runs in parallel (Amdahl's law from
+    the wall time on ``cores`` threads: ``wall = work * (1 - p + p / cores)``; a loaded
+    machine lowers it)."""
+    threads(1)
+    one = stage_split(stream, left, right, first, count)
+    threads(cores)
+    many = stage_split(stream, left, right, first + count, count)
+    out = {}
+    for name in one:
+        work, (cpu_many, wall) = one[name][0], many[name]
+        share = min(max((1 - wall / max(work, 1e-12)) * cores / (cores - 1), 0.0), 1.0)
+        out[name] = (work, cpu_many, wall, share)
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -152,19 +185,34 @@ def main(argv: list[str] | None = None) -> int:
     base = best["cv2.remap 640x480 float32 (baseline)"]
     print(f"# two-masks {width}x{height}, both cameras, 4 steps, period 48, "
           f"{RANGE[0]:g}:{RANGE[1]:g} mm; min of {args.rounds} interleaved rounds; "
-          f"{numba.get_num_threads()} numba threads")
+          f"{numba.get_num_threads()} numba threads; load average "
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print("| per depth map | CPU ms | / remap | maps/s (CPU) | wall ms | maps/s (wall) |")
     print("| --- | ---: | ---: | ---: | ---: | ---: |")
     for name in tasks:
         print(f"| {name} | {1000 * best[name]:.2f} | {best[name] / base:.1f} | "
               f"{1 / best[name]:.0f} | {1000 * wall[name]:.2f} | {1 / wall[name]:.0f} |")
+    cores = max(numba.get_num_threads(), 2)
     for name, stream in streams.items():
-        split = stage_split(stream, left, right, position[name], args.frames)
-        print(f"\n| --window {name}: stage (both cameras) | CPU ms | / remap | share |")
-        print("| --- | ---: | ---: | ---: |")
-        for stage, seconds in split.items():
-            print(f"| {stage} | {1000 * seconds:.2f} | {seconds / base:.1f} | "
-                  f"{100 * seconds / split['whole depth map']:.0f}% |")
+        split = parallel_split(stream, left, right, position[name], args.frames, cores)
+        position[name] += 2 * args.frames
+        work = split.pop(WHOLE)
+        print(f"\n| --window {name}: stage (both cameras) | work ms (1 thread) | CPU ms "
+              f"({cores} threads) | wall ms ({cores} threads) | parallel share |")
+        print("| --- | ---: | ---: | ---: | ---: |")
+        dedicated = work[0] - sum(v[0] for v in split.values())  # the rest: serial
+        for stage, (one, many, wall_s, share) in split.items():
+            dedicated += one * (1 - share + share / cores)
+            print(f"| {stage} | {1000 * one:.2f} | {1000 * many:.2f} | {1000 * wall_s:.2f} "
+                  f"| {100 * share:.0f}% |")
+        share = (1 - dedicated / work[0]) * cores / (cores - 1)
+        print(f"| whole depth map | {1000 * work[0]:.2f} | {1000 * work[1]:.2f} | "
+              f"{1000 * work[2]:.2f} | {100 * share:.0f}% |")
+        print(f"--window {name}: a dedicated {cores}-core machine: {1000 * dedicated:.1f} ms "
+              f"a depth map, {1 / dedicated:.0f} maps/s (each stage's work at its parallel "
+              f"share; the rest serial); measured here: {1000 * work[2]:.1f} ms wall "
+              f"({1 / work[2]:.0f} maps/s) at load {os.getloadavg()[0]:.1f}; every stage "
+              f"wholly parallel: {cores / work[0]:.0f} maps/s")
     print()
     off = {name: [0, 0] for name in streams}
     for name, results in kept.items():  # (after the timing)

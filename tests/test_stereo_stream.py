@@ -87,13 +87,14 @@ def test_windows_against_truth(sim, tmp_path, monkeypatch, capsys):
 
 def test_orders_and_the_full_search(sim):
     """Where the tracker and the full search of the same window both decide, they decide
-    the same disparity. The tracker decides about 1% more (a ghost two fringes away lies
-    outside its margin; a single candidate the rows beside did not confirm last window is
-    searched near again), of the right order. It decides at most 5% fewer: the full search
-    grows decisions from two agreeing neighbours (:func:`~bistair.geometry.unwrap_jit.grow`),
-    which the tracker does not yet do (3.9% on this stream), and a narrow search may find one
-    candidate the right camera does not confirm where the full search found another. Orders
-    off: at most 0.1% of the decided pixels."""
+    the same disparity, of the right order. Both grow decisions from two agreeing
+    neighbours (:func:`~bistair.geometry.unwrap_jit.grow`); without that the tracker decided
+    3.9% fewer. It now decides none the full search does not, and at most 0.5% fewer
+    (3-19 of about 6700 a window): at an occlusion edge the right grid's narrow search
+    decides the near surface where the full search finds both surfaces (two candidates,
+    undecided), and a left pixel that it contradicts is an occlusion for the tracker,
+    blocking 2 pixels either side along the row. Orders off: at most 0.1% of the decided
+    pixels."""
     tracked, lag = windows(sim, 0, 6.0)
     full, _ = windows(sim, 0, 0.0)
     near = 0
@@ -101,7 +102,8 @@ def test_orders_and_the_full_search(sim):
         da, db = np.isfinite(a.disparity), np.isfinite(b.disparity)
         both = da & db
         assert np.array_equal(a.disparity[both], b.disparity[both])
-        assert np.sum(da & ~db) <= 0.02 * da.sum() and np.sum(db & ~da) <= 0.05 * db.sum()
+        assert np.sum(da & ~db) <= 0.001 * da.sum() and np.sum(db & ~da) <= 0.005 * db.sum(), (
+            np.sum(da & ~db), np.sum(db & ~da), db.sum())
         near += a.info["searched_near"]
         truth = truth_at(sim, a.start + lag, "coord_x")
         off = np.abs(a.phase - 2 * np.pi * truth / PERIOD)

@@ -14,9 +14,12 @@ multiply-adds a pixel; order ``K`` compensates motion). For each window:
    each pixel of both rectified grids only within :data:`MARGIN` pixels of its single
    candidate in the previous window (:func:`~.unwrap_stream_jit.track_rows`); a pixel
    without one, or whose narrow search finds no candidate or two, is searched over the
-   whole range. The decisions are confirmed as the full search's are
-   (:func:`~.unwrap_stream_jit.confirm`): by the right grid's own candidate at the match,
-   by a row above or below, and dropped beside an occlusion.
+   whole range; a right pixel whose narrow search fails is searched in full only where a
+   left pixel's single candidate lands (:func:`~.unwrap_stream_jit.match_targets`: the
+   only right pixels the confirmation reads). The decisions are confirmed as the full
+   search's are (:func:`~.unwrap_stream_jit.confirm`): by the right grid's own candidate
+   at the match, by a row above or below, and dropped beside an occlusion; then grown as
+   the full search grows them (:func:`~.unwrap_jit.grow`).
 3. The depth: the left camera's ray cut by the projector's plane of the column of the
    absolute phase (the pixel's own wrapped phase and the order its rectified neighbours
    decided; :func:`~.unwrap_stream_jit.plane_depth`). NaN where undecided.
@@ -76,18 +79,23 @@ from .stereo import Rectification, rectify
 from .stereo_calibration import StereoCalibration
 from .unwrap import (
     EDGE,
+    GROW_SUPPORT,
     MIN_TOLERANCE,
+    REACH,
     SUPPORT,
     TOLERANCE_SIGMAS,
+    grow,
     is_single_period,
     unwrap_stereo,
 )
 from .unwrap_stream_jit import (
     confirm,
+    match_targets,
     plane_depth,
     projector_pixels,
     rectify_pair,
     track_rows,
+    window_counts,
 )
 
 #: Half the width (rectified pixels) of a later window's search about the previous
@@ -239,8 +247,8 @@ class StereoStream:
                          self.buffers, strict=True)]
         start = self.count - n - self.order
         result = self._window(rectified[0], rectified[1], start)
-        result.grey = np.clip(states[0].mod * np.float32(255 / max(self.scale, 1e-12)), 0,
-                              255).astype(np.uint8)
+        grey = states[0].mod * np.float32(255 / max(self.scale, 1e-12))
+        result.grey = np.clip(grey, 0, 255, out=grey).astype(np.uint8)
         result.info["cpu_seconds"] = round(time.process_time() - clock, 6)
         return result
 
@@ -279,8 +287,8 @@ class StereoStream:
             disparity = found.disparity
             if self.previous is None:
                 self.check = found.info["range_check"]
-            info = {k: found.info[k] for k in ("no_candidate", "undecided", "not_confirmed",
-                                                "unsupported", "warnings")}
+            info = {k: found.info[k] for k in ("no_candidate", "undecided", "grown",
+                                                "not_confirmed", "unsupported", "warnings")}
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
         else:
             disparity, info = self._track(lrect, rrect)
@@ -298,7 +306,7 @@ class StereoStream:
                 "decided_fraction": round(decided / max(valid, 1), 6), "left_decoded": valid,
                 **info, "tolerance_rad": round(float(self.tolerance or 0.0), 6),
                 "noise_rad": [round(v, 6) for v in self.noise]}
-        phase = (column * np.float32(2 * np.pi / self.period)).astype(np.float32)
+        phase = np.multiply(column, np.float32(2 * np.pi / self.period), out=column)
         return StreamDepth(start, depth, order, phase, mask, disparity,
                            np.zeros(depth.shape, np.uint8), info)
 
@@ -312,18 +320,20 @@ class StereoStream:
                 self.calibration.projector.device.width)
         right_before = (self.previous_right if self.previous_right is not None
                         else _on_right(self.previous, self.rect.shift, rrect.shape[1]))
-        n_in, disparity, near = track_rows(lrect, rrect, self.previous, self.margin, lo, hi,
-                                           *args)
-        _, from_right, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
-                                      *args, from_right=True)
+        n_in, disparity, near, candidates = track_rows(
+            lrect, rrect, self.previous, self.margin, lo, hi, *args)
+        needed = match_targets(disparity, self.rect.shift, rrect.shape[1])
+        _, from_right, _, _ = track_rows(rrect, lrect, right_before, self.margin, lo, hi,
+                                         *args, from_right=True, keep=0, needed=needed)
         valid = np.isfinite(lrect)
-        kept, not_confirmed, unsupported = confirm(disparity, n_in, valid, from_right,
-                                                   self.rect.shift, SUPPORT, EDGE)
+        alone, blocked, not_confirmed, unsupported = confirm(
+            disparity, n_in, valid, from_right, self.rect.shift, SUPPORT, EDGE)
+        kept = grow(alone, n_in, candidates, blocked, REACH, GROW_SUPPORT)
         self.previous, self.previous_right = disparity, from_right
-        info = {"no_candidate": int(np.sum(valid & (n_in == 0))),
-                "undecided": int(np.sum(n_in >= 2)), "not_confirmed": not_confirmed,
-                "unsupported": unsupported, "searched_near": int(near.sum()),
-                "searched_full": int(np.sum(valid & (near == 0))), "warnings": []}
+        counts = window_counts(lrect, n_in, near, alone, kept)
+        info = {"no_candidate": counts[0], "undecided": counts[1], "grown": counts[2],
+                "not_confirmed": not_confirmed, "unsupported": unsupported,
+                "searched_near": counts[3], "searched_full": counts[4], "warnings": []}
         return kept, info
 
 

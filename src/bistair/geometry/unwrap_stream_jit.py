@@ -19,7 +19,7 @@ disparity of 20 px); the previous window found 19.5 px, so only 17.5-21.5 is sea
 >>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)
 >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
 >>> previous = np.full((1, 80), 19.5, np.float32)
->>> n_in, disparity, near = track_rows(
+>>> n_in, disparity, near, _ = track_rows(
 ...     left, right, previous, 2.0, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
 ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
 >>> int(n_in[0, 50]), round(float(disparity[0, 50]), 4), int(near[0, 50])
@@ -34,6 +34,7 @@ import cv2
 import numpy as np
 
 from ..core.jit import inline, kernel
+from .unwrap_jit import KEPT
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -54,10 +55,11 @@ def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int,
           lo: float, hi: float, shift: float, f: float, cx: float, yr: float, tx: float,
           back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
           period: float, tolerance: float, zmin: float, zmax: float, width: int,
-          from_right: bool) -> tuple[int, float]:
+          from_right: bool, kept: np.ndarray) -> tuple[int, float]:
     """The consistent candidates in the depth range of one pixel among the crossings of
     ``a`` on ``other``'s row between columns ``j0`` and ``j1`` (disparities ``lo..hi``):
-    their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``)."""
+    their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``); the
+    first ``kept.shape[2]`` candidates' disparities into ``kept[y, x]``."""
     wr = other.shape[1]
     count = 0
     found = math.nan
@@ -90,6 +92,8 @@ def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int,
         if zmin <= pz <= zmax:
             count += 1
             found = d if count == 1 else math.nan
+            if count <= kept.shape[2]:
+                kept[y, x, count - 1] = d
     return count, found
 
 
@@ -117,9 +121,12 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
            lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
            back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
            period: float, tolerance: float, zmin: float, zmax: float, width: int,
-           from_right: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+           from_right: bool, keep: int, needed: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     h, w = own.shape
+    gated = needed.shape[0] == h
     wr = other.shape[1]
+    kept = np.empty((h, w, keep), np.float32)  # (only the first n_in are read)
     n_in = np.zeros((h, w), np.int16)
     disparity = np.full((h, w), np.nan, np.float32)
     near = np.zeros((h, w), np.uint8)
@@ -145,26 +152,31 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
                     k0, k1 = int(math.floor(x - shift - phi)), int(math.ceil(x - shift - plo))
                 count, d = _scan(own, other, y, x, a, k0, k1, plo, phi, shift, f, cx, yr, tx,
                                  back, kp, dp, rp, tp, period, tolerance, zmin, zmax, width,
-                                 from_right)
+                                 from_right, kept)
                 if count == 1:
                     n_in[y, x] = 1
                     disparity[y, x] = d
                     near[y, x] = 1
                     continue
+            if gated and needed[y, x] == 0:  # no pixel of the other grid reads it
+                n_in[y, x] = -2
+                continue
             count, d = _scan(own, other, y, x, a, j0, j1, lo, hi, shift, f, cx, yr, tx, back,
-                             kp, dp, rp, tp, period, tolerance, zmin, zmax, width, from_right)
+                             kp, dp, rp, tp, period, tolerance, zmin, zmax, width, from_right,
+                             kept)
             n_in[y, x] = min(count, 32000)
             if count == 1:
                 disparity[y, x] = d
-    return n_in, disparity, near
+    return n_in, disparity, near, kept
 
 
 def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: float,
                lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
                back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
                tp: np.ndarray, period: float, tolerance: float, zmin: float, zmax: float,
-               width: int, from_right: bool = False
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+               width: int, from_right: bool = False, keep: int = KEPT,
+               needed: np.ndarray | None = None
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The consistent candidates of each rectified pixel, searched first within
     ``margin`` of its ``previous`` disparity and over the full range ``[lo, hi]`` where
     that finds none or two or more (or there is no previous disparity).
@@ -188,17 +200,29 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
         As for :func:`~bistair.geometry.unwrap_jit.unwrap_rows`.
     from_right : bool, optional
         ``own`` is the right grid (the same disparity convention).
+    keep : int, optional
+        Keep the disparities of the first ``keep`` candidates of each pixel (what
+        :func:`~bistair.geometry.unwrap_jit.grow` chooses among; by default ``KEPT`` of
+        :mod:`~bistair.geometry.unwrap_jit`, 0 keeps none).
+    needed : numpy.ndarray, optional
+        ``(H, W)`` uint8: search the full range only where 1 (:func:`match_targets`: the
+        pixels whose decision the other grid's confirmation reads); a pixel of 0 whose
+        narrow search does not decide is left undecided (``n_in`` -2). By default every
+        pixel.
 
     Returns
     -------
     n_in : numpy.ndarray
         ``(H, W)`` int16 consistent candidates in the range of the search that decided
         (1 from the narrow one; else the full one's count), -1 where the full search would
-        reach past the other view.
+        reach past the other view, -2 where it was not ``needed``.
     disparity : numpy.ndarray
         ``(H, W)`` float32 the one candidate's disparity, NaN elsewhere.
     near : numpy.ndarray
         ``(H, W)`` uint8 1 where the narrow search decided.
+    kept : numpy.ndarray
+        ``(H, W, keep)`` float32 the candidates' disparities in the order found by the
+        search that decided (only the first ``min(n_in, keep)`` of a pixel are set).
 
     Examples
     --------
@@ -209,11 +233,13 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
     >>> right = (2 * np.pi * (cols + 15) / 8) % (2 * np.pi)
     >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
     >>> none = np.full((1, 80), np.nan, np.float32)
-    >>> n_in, d, near = track_rows(
+    >>> n_in, d, near, kept = track_rows(
     ...     left, right, none, 2.0, 1.0, 40.0, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
     ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 0.2, 400.0, 600.0, 1000)
     >>> int(n_in[0, 50]), round(float(d[0, 50]), 4), int(near[0, 50]), int(n_in[0, 30])
     (1, 20.0, 0, -1)
+    >>> round(float(kept[0, 50, 0]), 4)
+    20.0
     """
     def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
         return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
@@ -223,7 +249,49 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                   float(hi), float(shift), float(f), float(cx), float(cy), float(tx),
                   arr(back, (3, 3)), arr(kp, (3, 3)), arr(dp, (5,)), arr(rp, (3, 3)),
                   arr(tp, (3,)), float(period), float(tolerance), float(zmin), float(zmax),
-                  int(width), bool(from_right))
+                  int(width), bool(from_right), int(keep),
+                  np.zeros((0, 0), np.uint8) if needed is None
+                  else np.ascontiguousarray(needed, np.uint8))
+
+
+@kernel(parallel=True)
+def _targets(disparity: np.ndarray, shift: float, width: int) -> np.ndarray:
+    h, w = disparity.shape
+    out = np.zeros((h, width), np.uint8)
+    for y in prange(h):
+        for x in range(w):
+            d = float(disparity[y, x])
+            if d == d:
+                xr = int(np.rint(x - shift - d))
+                if 0 <= xr < width:
+                    out[y, xr] = 1
+    return out
+
+
+def match_targets(disparity: np.ndarray, shift: float, width: int) -> np.ndarray:
+    """The right grid's pixels that the left grid's single candidates match (the nearest
+    pixel, as :func:`confirm` reads them).
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 the left grid's single candidates, NaN elsewhere.
+    shift : float
+        ``cx_left - cx_right`` (px).
+    width : int
+        The right grid's width.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, width)`` uint8: 1 where some left pixel's candidate lands.
+
+    Examples
+    --------
+    >>> match_targets(np.float32([[np.nan, 1.0, 1.2, 0.4]]), -1.0, 4).tolist()
+    [[0, 1, 1, 0]]
+    """
+    return _targets(np.ascontiguousarray(disparity, np.float32), float(shift), int(width))
 
 
 @kernel(parallel=True)
@@ -302,6 +370,7 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
     column = np.full((h, w), np.nan, np.float32)
     fx, skew, cxp, fy, cyp = kp[0, 0], kp[0, 1], kp[0, 2], kp[1, 1], kp[1, 2]
     distorted = dp[0] != 0.0 or dp[1] != 0.0 or dp[2] != 0.0 or dp[3] != 0.0 or dp[4] != 0.0
+    inv_period, inv_two_pi, inv_fx, inv_fy = 1.0 / period, 1.0 / TWO_PI, 1.0 / fx, 1.0 / fy
     for y in prange(h):
         for x in range(w):
             phi = float(phase[y, x])
@@ -319,14 +388,15 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
             c, lo, hi = _corner(cols, y0 + 1, x0 + 1, fu * fv, c, lo, hi)
             if not hi - lo <= max_step:  # (NaN: a corner undecided)
                 continue
-            k = math.floor((TWO_PI * c / period - phi) / TWO_PI + 0.5)
-            xp = (phi / TWO_PI + k) * period  # the column of the absolute phase
+            # (reciprocals precomputed: no division but the plane's)
+            k = math.floor(c * inv_period - phi * inv_two_pi + 0.5)
+            xp = (phi * inv_two_pi + k) * period  # the column of the absolute phase
             yn = 0.0
             if distorted:  # the row of the sample, for the column plane's local slope
                 r = (1 - fv) * ((1 - fu) * rows[y0, x0] + fu * rows[y0, x0 + 1]) + fv * (
                     (1 - fu) * rows[y0 + 1, x0] + fu * rows[y0 + 1, x0 + 1])
-                yd = (r - cyp) / fy
-                xd = (xp - cxp - skew * yd) / fx
+                yd = (r - cyp) * inv_fy
+                xd = (xp - cxp - skew * yd) * inv_fx
                 xn, yn = xd, yd
                 for _ in range(8):  # undistort (OpenCV's iteration)
                     r2 = xn * xn + yn * yn
@@ -334,8 +404,10 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
                     dx = 2.0 * dp[2] * xn * yn + dp[3] * (r2 + 2.0 * xn * xn)
                     dy = dp[2] * (r2 + 2.0 * yn * yn) + 2.0 * dp[3] * xn * yn
                     xn, yn = (xd - dx) / radial, (yd - dy) / radial
+            elif skew != 0.0:
+                xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) * inv_fy)) * inv_fx
             else:
-                xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) / fy)) / fx
+                xn = (xp - cxp) * inv_fx
             den = float(ax[y, x]) - xn * float(az[y, x])
             if den == 0.0:
                 continue
@@ -420,51 +492,60 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndar
 @kernel(parallel=True)
 def _confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
              shift: float, support: float, edge: int
-             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     h, w = disparity.shape
     wr = right.shape[1]
-    crossed = np.full((h, w), np.nan, np.float32)
-    occluded = np.zeros((h, w), np.uint8)
-    out = np.full((h, w), np.nan, np.float32)
+    crossed = np.empty((h, w), np.float32)
+    occluded = np.empty((h, w), np.uint8)
+    blocked = np.empty((h, w), np.bool_)
+    out = np.empty((h, w), np.float32)
     counts = np.zeros((h, 2), np.int64)  # not confirmed, unsupported
     for y in prange(h):
         for x in range(w):
             d = float(disparity[y, x])
+            crossed[y, x] = np.nan
+            contradicted = False
             if d == d:
                 xr = int(np.rint(x - shift - d))
-                if 0 <= xr < wr and abs(float(right[y, xr]) - d) <= support:
-                    crossed[y, x] = d
-            if valid[y, x] and (n_in[y, x] == 0 or (n_in[y, x] == 1 and
-                                                    crossed[y, x] != crossed[y, x])):
-                occluded[y, x] = 1
+                if 0 <= xr < wr:
+                    r = float(right[y, xr])
+                    if abs(r - d) <= support:
+                        crossed[y, x] = d
+                    elif r == r:  # the right pixel decided another point
+                        contradicted = True
+            occluded[y, x] = valid[y, x] and (n_in[y, x] == 0 or contradicted)
             if n_in[y, x] == 1 and crossed[y, x] != crossed[y, x]:
                 counts[y, 0] += 1
     for y in prange(h):
         for x in range(w):
+            near = False
+            for k in range(max(x - edge, 0), min(x + edge + 1, w)):
+                if occluded[y, k]:
+                    near = True
+                    break
+            blocked[y, x] = near
+            out[y, x] = np.nan
             c = float(crossed[y, x])
             if c != c:
                 continue
-            ok = (y > 0 and abs(c - float(crossed[y - 1, x])) <= support) or (
-                y < h - 1 and abs(c - float(crossed[y + 1, x])) <= support)
-            if ok:
-                for k in range(max(x - edge, 0), min(x + edge + 1, w)):
-                    if occluded[y, k]:
-                        ok = False
-                        break
+            ok = not near and ((y > 0 and abs(c - float(crossed[y - 1, x])) <= support) or (
+                y < h - 1 and abs(c - float(crossed[y + 1, x])) <= support))
             if ok:
                 out[y, x] = c
             else:
                 counts[y, 1] += 1
-    return out, crossed, counts[:, 0].copy(), counts[:, 1].copy()
+    return out, crossed, blocked, counts[:, 0].copy(), counts[:, 1].copy()
 
 
 def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: np.ndarray,
-            shift: float, support: float, edge: int) -> tuple[np.ndarray, int, int]:
+            shift: float, support: float, edge: int
+            ) -> tuple[np.ndarray, np.ndarray, int, int]:
     """The decided disparities that the full search would keep: confirmed by the right
     grid's decision at the match (within ``support`` px), by the row above or below
     (within ``support``), and not within ``edge`` pixels along the row of an occluded pixel
-    (a valid one with no candidate, or with one the right grid does not confirm); what
-    :func:`~bistair.geometry.unwrap.unwrap_stereo` does after its search, in one pass.
+    (a valid one with no candidate, or whose match the right grid decided as another
+    point); what :func:`~bistair.geometry.unwrap.unwrap_stereo` does after its search and
+    before its growth, in one pass.
 
     Parameters
     ----------
@@ -485,6 +566,9 @@ def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: n
     -------
     kept : numpy.ndarray
         ``(H, W)`` float32 the confirmed disparities, NaN elsewhere.
+    blocked : numpy.ndarray
+        ``(H, W)`` bool: within ``edge`` pixels along the row of an occluded pixel (never
+        grown into: :func:`~bistair.geometry.unwrap_jit.grow`).
     not_confirmed : int
         Single candidates the right grid does not confirm.
     unsupported : int
@@ -496,16 +580,22 @@ def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: n
     >>> n = np.ones((2, 4), np.int16)
     >>> right = np.full((2, 4), 5.0, np.float32)
     >>> right[0, 1] = np.nan
-    >>> kept, nc, un = confirm(d, n, np.ones((2, 4), bool), right, -3.0, 1.0, 0)
+    >>> kept, blocked, nc, un = confirm(d, n, np.ones((2, 4), bool), right, -3.0, 1.0, 0)
     >>> kept.tolist(), nc, un  # left x matches right x - 2: 0 and 1 beyond, (0, 3) unknown
     ([[nan, nan, 5.0, nan], [nan, nan, 5.0, nan]], 5, 1)
+    >>> bool(blocked.any())
+    False
+    >>> right[0, 1] = 9.0  # the right pixel decided another point: (0, 3) occluded
+    >>> blocked = confirm(d, n, np.ones((2, 4), bool), right, -3.0, 1.0, 0)[1]
+    >>> blocked.astype(int).tolist()
+    [[0, 0, 0, 1], [0, 0, 0, 0]]
     """
-    out, _, nc, un = _confirm(np.ascontiguousarray(disparity, np.float32),
-                              np.ascontiguousarray(n_in, np.int16),
-                              np.ascontiguousarray(valid, np.bool_),
-                              np.ascontiguousarray(right, np.float32), float(shift),
-                              float(support), int(edge))
-    return out, int(nc.sum()), int(un.sum())
+    out, _, blocked, nc, un = _confirm(np.ascontiguousarray(disparity, np.float32),
+                                       np.ascontiguousarray(n_in, np.int16),
+                                       np.ascontiguousarray(valid, np.bool_),
+                                       np.ascontiguousarray(right, np.float32), float(shift),
+                                       float(support), int(edge))
+    return out, blocked, int(nc.sum()), int(un.sum())
 
 
 @kernel(parallel=True)
@@ -599,3 +689,56 @@ def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
     np.arctan2(b["s"], b["c"], out=b["angle"])
     _finish(b["angle"], b["v"])
     return b["phase"], b["angle"], int(count)
+
+
+@kernel(parallel=True)
+def _counts(rectified: np.ndarray, n_in: np.ndarray, near: np.ndarray, alone: np.ndarray,
+            kept: np.ndarray) -> np.ndarray:
+    h, w = rectified.shape
+    rows = np.zeros((h, 5), np.int64)
+    for y in prange(h):
+        for x in range(w):
+            if rectified[y, x] == rectified[y, x]:
+                rows[y, 0] += n_in[y, x] == 0
+                rows[y, 4] += near[y, x] == 0
+            decided = kept[y, x] == kept[y, x]
+            rows[y, 1] += n_in[y, x] >= 2 and not decided
+            rows[y, 2] += decided and alone[y, x] != alone[y, x]
+            rows[y, 3] += near[y, x]
+    return rows
+
+
+def window_counts(rectified: np.ndarray, n_in: np.ndarray, near: np.ndarray,
+                  alone: np.ndarray, kept: np.ndarray) -> list[int]:
+    """A tracked window's pixel counts in one pass.
+
+    Parameters
+    ----------
+    rectified : numpy.ndarray
+        ``(H, W)`` float32 the left grid's wrapped phase, NaN where unknown.
+    n_in, near : numpy.ndarray
+        ``(H, W)`` :func:`track_rows`' candidate counts (int16) and narrow decisions
+        (uint8).
+    alone, kept : numpy.ndarray
+        ``(H, W)`` float32 the confirmed disparities (:func:`confirm`) and those after
+        growth, NaN where undecided.
+
+    Returns
+    -------
+    list of int
+        No candidate (of the known pixels), undecided with two or more, grown, decided by
+        the narrow search, searched in full (known pixels the narrow search did not decide).
+
+    Examples
+    --------
+    >>> nan = np.nan
+    >>> window_counts(np.float32([[1, 1, 1, nan]]), np.int16([[0, 2, 1, 0]]),
+    ...               np.uint8([[0, 0, 1, 0]]), np.float32([[nan, nan, 5, nan]]),
+    ...               np.float32([[nan, 4, 5, nan]]))
+    [1, 0, 1, 1, 2]
+    """
+    rows = _counts(np.ascontiguousarray(rectified, np.float32),
+                   np.ascontiguousarray(n_in, np.int16), np.ascontiguousarray(near, np.uint8),
+                   np.ascontiguousarray(alone, np.float32),
+                   np.ascontiguousarray(kept, np.float32))
+    return [int(v) for v in rows.sum(axis=0)]
