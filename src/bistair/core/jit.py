@@ -710,7 +710,6 @@ def called(fn: Callable) -> Callable:
     return fn
 
 
-_numba_inline = inline  # the old name, for geometry/'s twins until they import inline
 
 
 def chunk_count(n: int) -> int:
