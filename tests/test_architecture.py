@@ -299,6 +299,8 @@ def test_each_command_module_has_its_job_module(graph):
 
 # app/ modules that are no command's job: what every job shares
 APP_SHARED = {"engine", "progress", "kernels"}
+# ... and the old module names issue 35 moved, kept one release as aliases (2026-11-28)
+APP_ALIASES = {"jobs", "stream", "series"}
 
 
 def test_every_job_module_is_a_family_or_part_of_one():
@@ -307,7 +309,7 @@ def test_every_job_module_is_a_family_or_part_of_one():
     the modules every job shares."""
     families = {p.stem for p in (SRC / "app" / "cli").glob("*.py")} - {"__init__", "options"}
     strays = [p.name for p in (SRC / "app").glob("*.py")
-              if p.stem not in families | APP_SHARED | {"__init__"}
+              if p.stem not in families | APP_SHARED | APP_ALIASES | {"__init__"}
               and not any(p.stem.startswith(f"{family}_") for family in families)]
     assert not strays
 
@@ -345,3 +347,20 @@ def test_no_module_is_over_450_lines_of_code():
     long = {str(p.relative_to(SRC)): n for p in SRC.rglob("*.py")
             if (n := lines_of_code(p.read_text())) > MOST_LINES_OF_CODE}
     assert not long
+
+
+def test_the_old_app_module_names_read_on():
+    """Issue 35 moved app/'s jobs by command; the old module names stay one release, each
+    name the same object as in its new home."""
+    from bistair.app import calibrate, decode, decode_stream, jobs, patterns, scan_series, series
+    from bistair.app import stream as old_stream
+
+    assert jobs.decode_folder is decode.decode_folder
+    assert jobs.save_patterns is patterns.save_patterns
+    assert jobs.import_projection_matrices is calibrate.import_projection_matrices
+    assert old_stream.decode_stream is decode_stream.decode_stream
+    assert series.scan_series is scan_series.scan_series
+    assert set(jobs.__all__) == {
+        "save_patterns", "save_ramp", "measure_gamma", "read_gamma", "decode_folder",
+        "require_valid", "height_folder", "reconstruct_folder", "import_calibration",
+        "import_projection_matrices", "parse_size", "parse_keys", "parse_depth_range"}
