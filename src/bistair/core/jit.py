@@ -369,19 +369,27 @@ def _dispatcher(fn: Callable, parallel: bool) -> Any:
     return compiled
 
 
+#: Held while a module's helpers are made numba's: two threads (a stereo pair's decodes side
+#: by side) may meet a module's first kernels at once, and the second must not compile its
+#: kernel while the helpers are still plain Python ("Untyped global name").
+_HELPERS_LOCK = threading.RLock()
+
+
 def _compile_helpers(module: dict[str, Any], numba: Any) -> None:
-    """On a module's first kernel: its ``prange`` made numba's and its helpers (marked with
-    :func:`inline` or :func:`called`) compiled, once; a helper imported from
-    another module is compiled after that module's own helpers, which it may call."""
-    if module.get("prange") is not range:
-        return
-    module["prange"] = numba.prange
-    for name, value in list(module.items()):
-        how = getattr(value, "_inline", None)
-        if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
-            if value.__globals__ is not module:
-                _compile_helpers(value.__globals__, numba)
-            module[name] = numba.njit(cache=True, inline=how)(value)
+    """On a module's first kernel: its helpers (marked with :func:`inline` or
+    :func:`called`) compiled, once, then its ``prange`` made numba's (the mark that the
+    module is done); a helper imported from another module is compiled after that module's
+    own helpers, which it may call. A second thread waits until the first is done."""
+    with _HELPERS_LOCK:
+        if module.get("prange") is not range:
+            return
+        for name, value in list(module.items()):
+            how = getattr(value, "_inline", None)
+            if how is not None and not hasattr(value, "py_func"):  # (not compiled already)
+                if value.__globals__ is not module:
+                    _compile_helpers(value.__globals__, numba)
+                module[name] = numba.njit(cache=True, inline=how)(value)
+        module["prange"] = numba.prange
 
 
 def _record(path: str) -> None:
