@@ -14,7 +14,17 @@ import numpy as np
 import pytest
 from support import stereo_before
 
-from bistair.geometry.match_jit import (
+from bistair.geometry.stereo_checks import projector_misfits
+from bistair.geometry.stereo_jit import (
+    cloud_points,
+    depth_counts,
+    grid_depth,
+    grid_points,
+    pick_finite,
+    rectified_positions,
+    remap_valid,
+)
+from bistair.geometry.stereo_match_jit import (
     ALONE,
     AMBIGUOUS,
     INCONSISTENT,
@@ -26,16 +36,6 @@ from bistair.geometry.match_jit import (
     match_pair,
     smooth_runs,
     supported,
-)
-from bistair.geometry.stereo_checks import projector_misfits
-from bistair.geometry.stereo_jit import (
-    cloud_points,
-    depth_counts,
-    grid_depth,
-    grid_points,
-    pick_finite,
-    rectified_positions,
-    remap_valid,
 )
 
 

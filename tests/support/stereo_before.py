@@ -1,5 +1,5 @@
 """Passes of the binocular matching before issue 32's stereo work (1b3e4f3), kept as the
-oracle of their replacements in bistair.geometry.match_jit and stereo_checks: the kinks
+oracle of their replacements in bistair.geometry.stereo_match_jit and stereo_checks: the kinks
 dropped (``drop_kinks``) and both maps negated before the smoothing within runs (two
 full-image copies, then ``smooth_runs`` along the rows and down the columns in strips),
 the misfit check's sample (``np.nonzero`` of every point, then evenly spaced picks), the
@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from bistair.geometry.match_jit import line_coefficients
 from bistair.geometry.stereo_checks import MISFIT_PX, MISFIT_SAMPLE, _dlt
+from bistair.geometry.stereo_match_jit import line_coefficients
 
 
 def drop_kinks(values: np.ndarray, limit: float, reach: int) -> np.ndarray:

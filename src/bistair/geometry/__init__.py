@@ -34,7 +34,7 @@ module                        what it holds
                               ``StereoResult``; its twin: ``remap_valid``,
                               ``rectified_positions``, ``grid_depth``, ``depth_counts``,
                               ``pick_finite``, ``grid_points``, ``cloud_points``
-``match.py`` (+ ``_jit``)     the row search between them: ``match``, ``Matched``; its twin:
+``stereo_match.py`` (+ ``_jit``)     the row search between them: ``match``, ``Matched``; its twin:
                               ``drop_kinks``, ``line_coefficients``, ``smooth_runs``,
                               ``match_pair``, ``supported``, ``count_status``
 ``stereo_checks.py``          do the two cameras' inputs fit each other: ``same_captures``,

@@ -12,11 +12,11 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    bilinearly, never between two surfaces (:func:`~.stereo_jit.remap_valid`: four valid
    neighbours whose spread is that of a surface).
 2. Before matching, the kinks of each rectified row are dropped
-   (:func:`~.match_jit.drop_kinks`: second differences over four times the measured noise,
+   (:func:`~.stereo_match_jit.drop_kinks`: second differences over four times the measured noise,
    the blurred step between two surfaces whose pixels mix both), and with ``smooth`` both
-   maps are smoothed within each surface (:func:`~.match_jit.smooth_runs`, which does
+   maps are smoothed within each surface (:func:`~.stereo_match_jit.smooth_runs`, which does
    both, and turns a falling coordinate round, in one pass).
-3. Matching (:func:`~.match_jit.match_pair`): for each valid left pixel, the right pixel
+3. Matching (:func:`~.stereo_match_jit.match_pair`): for each valid left pixel, the right pixel
    of equal projector coordinate on the same rectified row, interpolated between the two
    valid neighbours that bracket it (a line through four samples where it crosses once),
    only where the coordinate rises along the row (up to ``wiggle`` px of noise) without a
@@ -25,7 +25,7 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    other carries nothing along a row); with both projector axes decoded, the other must
    agree too. The same value searched back on the left row must come back within
    ``tolerance`` px of the pixel, and a disparity must be confirmed by the row above or
-   below (:func:`~.match_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
+   below (:func:`~.stereo_match_jit.supported`). ``wiggle``, ``tolerance`` and ``support`` grow
    with the measured noise (four, three and 5.7 times it, as a position along the row).
    Occlusions and mismatches are NaN, never a guess.
 4. Points (:func:`~.stereo_jit.grid_depth`; :func:`~.stereo_jit.depth_counts` counts the
@@ -34,7 +34,7 @@ calibration at all: only the two cameras' (:class:`StereoCalibration`).
    right camera's x in the rectified frame), then turned back into the left camera's
    frame: its depth ``z``, and the point ``z`` times the pixel's ray. Depth and points are
    on the left camera's own (distorted) image grid. The resampling and steps 2 to 4 are
-   :func:`~.match.match`.
+   :func:`~.stereo_match.match`.
 5. Checks of the inputs against each other (:mod:`.stereo_checks`): too few matches,
    projector rows that disagree (both axes), points that one projector explains only with
    the cameras exchanged or the right images upside down.
@@ -71,7 +71,6 @@ from .calibration import (
     load_calibration,
     short_baseline,
 )
-from .match import Matched, match
 from .stereo_checks import (
     MIN_MATCHED,
     MISFIT_SAMPLE,
@@ -81,7 +80,14 @@ from .stereo_checks import (
     projector_misfits,
     same_captures,
 )
-from .stereo_jit import cloud_points, grid_points, pick_finite, rectified_positions
+from .stereo_jit import (  # depth_counts: the face's for unwrap.py
+    cloud_points,
+    depth_counts,  # noqa: F401
+    grid_points,
+    pick_finite,
+    rectified_positions,
+)
+from .stereo_match import Matched, match
 from .triangulate import check_depth_range
 
 _UNDISTORT = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
@@ -285,7 +291,7 @@ def reconstruct_stereo(left: DecodeResult | AxesResult, right: DecodeResult | Ax
         confirm it).
     smooth : float, optional
         Gaussian sigma (px) of a smoothing of both cameras' projector coordinates on the
-        rectified grids before matching (:func:`~.match_jit.smooth_runs`: never across
+        rectified grids before matching (:func:`~.stereo_match_jit.smooth_runs`: never across
         two surfaces; the default, 1 px); 0 matches the decoded values as they are. Smoothing
         trades lateral resolution for depth noise (sigma 1 px: about a third of it).
     offset : float, optional

@@ -4,7 +4,7 @@ on the left camera's own grid (depth, counts per row, points and the cloud).
 
 Each runs over image rows on every core; none has a NumPy twin, so
 ``tests/test_stereo_jit.py`` checks them against exact answers. The row search between
-them is :mod:`bistair.geometry.match_jit`.
+them is :mod:`bistair.geometry.stereo_match_jit`.
 
 Examples
 --------

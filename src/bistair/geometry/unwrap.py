@@ -54,11 +54,16 @@ from ..core.captures import prepare
 from ..core.measure import FringeSet, measure
 from ..core.result import make_result
 from ..errors import BistairError
-from .calibration import Calibration
+from .calibration import Calibration, StereoCalibration
 from .projection_matrices import with_pixel_origin
-from .stereo import Rectification, StereoResult, grey_image, rectify
-from .stereo_calibration import StereoCalibration
-from .stereo_jit import depth_counts, grid_points
+from .stereo import (
+    Rectification,
+    StereoResult,
+    depth_counts,
+    grey_image,
+    grid_points,
+    rectify,
+)
 from .triangulate import check_depth_range, triangulate
 from .unwrap_jit import grow, unwrap_candidates
 

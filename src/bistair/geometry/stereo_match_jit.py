@@ -1,4 +1,4 @@
-"""Compiled passes of row matching (:mod:`bistair.geometry.match`): each rectified row's
+"""Compiled passes of row matching (:mod:`bistair.geometry.stereo_match`): each rectified row's
 kinks dropped and its runs smoothed within one surface, the row search for equal phase with
 the left-right check, a disparity kept only where the row above or below confirms it, and
 the count of each outcome.

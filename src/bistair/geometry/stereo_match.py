@@ -2,7 +2,7 @@
 onto their rectified grids, kinks dropped and runs smoothed, equal phase found along each
 row and checked back, confirmed by a neighbouring row, and triangulated on the left
 camera's grid (steps 2-4 of :mod:`bistair.geometry.stereo`; the compiled passes in
-:mod:`bistair.geometry.match_jit`). The thresholds grow with the measured noise.
+:mod:`bistair.geometry.stereo_match_jit`). The thresholds grow with the measured noise.
 
 Examples
 --------
@@ -19,7 +19,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import BistairError
-from .match_jit import (
+from .stereo_jit import depth_counts, remap_valid
+from .stereo_match_jit import (
     ALONE,
     AMBIGUOUS,
     INCONSISTENT,
@@ -32,7 +33,6 @@ from .match_jit import (
     smooth_runs,
     supported,
 )
-from .stereo_jit import depth_counts, remap_valid
 
 if TYPE_CHECKING:
     from .stereo import Rectification
