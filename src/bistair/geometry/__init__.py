@@ -34,9 +34,9 @@ module                        what it holds
                               ``StereoResult``; its twin: ``remap_valid``,
                               ``rectified_positions``, ``grid_depth``, ``depth_counts``,
                               ``pick_finite``, ``grid_points``, ``cloud_points``
-``stereo_match.py`` (+ ``_jit``)     the row search between them: ``match``, ``Matched``; its twin:
-                              ``drop_kinks``, ``line_coefficients``, ``smooth_runs``,
-                              ``match_pair``, ``supported``, ``count_status``
+``stereo_match.py``           the row search between them: ``match``, ``Matched``; its twin
+                              ``stereo_match_jit.py``: ``drop_kinks``, ``line_coefficients``,
+                              ``smooth_runs``, ``match_pair``, ``supported``, ``count_status``
 ``stereo_checks.py``          do the two cameras' inputs fit each other: ``same_captures``,
                               ``other_axis_share``, ``other_readings``, ``check_matches``,
                               ``projector_misfits``
