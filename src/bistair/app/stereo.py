@@ -50,8 +50,6 @@ from .progress import Say, silent
 SIDES = (("L", "R"), ("left", "right"))  # the folders of a stereo capture set
 
 
-
-
 # -- reconstruct -----------------------------------------------------------------------------
 def stereo_folder(left: Any, right: Any, out: str | Path,
                   calibration: StereoCalibration | str | Path,

@@ -42,7 +42,6 @@ def _code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.nda
     return out
 
 
-
 def code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndarray,
               inverse: bool = False) -> np.ndarray:
     """The code word of ``bits`` binary frames ``start ..`` of a raw capture stack (each
@@ -83,7 +82,6 @@ def code_bits(raw: np.ndarray, start: int, bits: int, scale: float, avg: np.ndar
                       np.asarray(avg, np.float32), bool(inverse))
 
 
-
 @inline
 def _binary(g: np.int32) -> np.int32:
     """Gray code to binary: the XOR of all the right shifts of ``g``."""
@@ -92,7 +90,6 @@ def _binary(g: np.int32) -> np.int32:
         g = g ^ (g >> shift)
         shift <<= 1
     return g
-
 
 
 @kernel(parallel=True)

@@ -718,8 +718,6 @@ def called(fn: Callable) -> Callable:
     return fn
 
 
-
-
 def chunk_count(n: int) -> int:
     """How many chunks a flat pass over ``n`` pixels runs in: enough for the threads, each
     a few thousand pixels.

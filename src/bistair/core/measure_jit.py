@@ -94,7 +94,6 @@ def keep_coherent(labels: np.ndarray, roots: np.ndarray, size: np.ndarray,
     return out
 
 
-
 def fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
                         phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
                         shifts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -142,7 +141,6 @@ def fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
                                 np.asarray(shifts, np.float32))
 
 
-
 @kernel(parallel=True)
 def _fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
                          phi: np.ndarray, avg: np.ndarray, mod: np.ndarray,
@@ -175,7 +173,6 @@ def _fit_residual_energy(raw: np.ndarray, start: int, steps: int, scale: float,
     return energy, ok
 
 
-
 @kernel(parallel=True)
 def _phase_noise(mod: np.ndarray, noise: float, factor: float, chunks: int) -> np.ndarray:
     n = mod.size
@@ -190,7 +187,6 @@ def _phase_noise(mod: np.ndarray, noise: float, factor: float, chunks: int) -> n
                 m = floor32
             out[i] = np.float32(noise / (np.float64(m) * factor))
     return out
-
 
 
 def phase_noise(mod: np.ndarray, noise: float, steps: int) -> np.ndarray:

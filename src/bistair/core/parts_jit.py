@@ -50,7 +50,6 @@ def pixel_orders(labels: np.ndarray, region_order: np.ndarray) -> np.ndarray:
     return out
 
 
-
 @kernel()
 def dense_tile(bad: np.ndarray, decided: np.ndarray, share: float, block: int) -> bool:
     """Whether some ``block`` x ``block`` tile (from the top left; the last ones cut by the
@@ -92,7 +91,6 @@ def dense_tile(bad: np.ndarray, decided: np.ndarray, share: float, block: int) -
     return False
 
 
-
 @inline
 def _reflect(i: int, n: int) -> int:
     """Index ``i`` reflected into ``0..n-1`` (d c b a | a b c d | d c b a), for
@@ -102,7 +100,6 @@ def _reflect(i: int, n: int) -> int:
     if i >= n:
         return 2 * n - i - 1
     return i
-
 
 
 @kernel()

@@ -71,7 +71,6 @@ def _clip(x: float, lo: float, hi: float) -> float:
     return x if x < hi else hi
 
 
-
 @kernel()
 def pass_messages(evidence: np.ndarray, src: np.ndarray, dst: np.ndarray, step: np.ndarray,
                   strength: np.ndarray, reverse: np.ndarray, iterations: int,

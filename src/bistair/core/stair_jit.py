@@ -132,7 +132,6 @@ def _pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
     return theta, mod
 
 
-
 def pair_phase(raw: np.ndarray, first: int, scale: float, avg: np.ndarray
                ) -> tuple[np.ndarray, np.ndarray]:
     """The stair phase (``tests/support/reference.py:stair_phase``) of frames ``first``

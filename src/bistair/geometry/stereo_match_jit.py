@@ -360,7 +360,6 @@ def _along(row: np.ndarray, x: float) -> float:
     return float(row[x0])
 
 
-
 @inline
 def _bridged(xs: np.ndarray, vs: np.ndarray, k: int, e: int, n: int) -> bool:
     """Whether samples ``e - 1`` and ``e`` (``k``: the run's first) may be joined across the

@@ -116,7 +116,6 @@ def write_image(path: str | Path, image: np.ndarray, *, compress: bool = True) -
 _GREY = (np.dtype(np.uint8), np.dtype(np.uint16))
 
 
-
 def slug(label: str) -> str:
     """A file name for a label: every run of characters other than letters, digits, ``.``,
     ``_`` and ``-`` becomes one ``-`` (no spaces, parentheses or slashes in names).
@@ -215,9 +214,7 @@ def check_output(out: str | Path, captures: Captures | None = None, *,
     return out
 
 
-
 TEMP_PREFIX = ".bistair-"  # the names of every temporary beside an output
-
 
 
 @contextlib.contextmanager
@@ -298,7 +295,6 @@ def output_folder(out: str | Path, prefix: str | None = None) -> Iterator[Path]:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-
 @contextlib.contextmanager
 def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]:
     """Yield a temporary folder beside ``out`` that replaces ``out`` as a whole on success.
@@ -365,7 +361,6 @@ def replace_folder(out: str | Path, prefix: str = TEMP_PREFIX) -> Iterator[Path]
             shutil.rmtree(old, ignore_errors=True)
 
 
-
 def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Path]:
     """Delete the temporaries named ``prefix*`` directly inside ``folder`` (left behind by a
     process killed while writing).
@@ -411,7 +406,6 @@ def remove_temporaries(folder: str | Path, prefix: str = TEMP_PREFIX) -> list[Pa
             with contextlib.suppress(OSError):
                 path.unlink()
     return found
-
 
 
 @contextlib.contextmanager
@@ -474,11 +468,9 @@ def output_file(path: str | Path, prefix: str | None = None) -> Iterator[Path]:
         tmp.unlink(missing_ok=True)
 
 
-
 def _prefix() -> str:
     """Temporary outputs are named ``.bistair-<pid>-...``: whose they are stays known."""
     return f".bistair-{os.getpid()}-"
-
 
 
 def remove_stale(folder: str | Path) -> int:
@@ -518,7 +510,6 @@ def remove_stale(folder: str | Path) -> int:
     return removed
 
 
-
 def _running(pid: int) -> bool:
     try:
         os.kill(pid, 0)
@@ -527,7 +518,6 @@ def _running(pid: int) -> bool:
     except (PermissionError, OverflowError):
         return pid < 2**22  # someone else's process, or no process at all
     return True
-
 
 
 def _umask() -> int:

@@ -105,7 +105,6 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
                f"in the right camera{within}, {rejected} rejected by the checks); wrote {out}")
 
 
-
 def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: Path,
                    out: Path, depth: tuple[float, float], window: str | None,
                    starts: str | None, force: bool, strategy: str | None,

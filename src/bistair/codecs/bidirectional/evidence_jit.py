@@ -141,14 +141,12 @@ def band_evidence(region: np.ndarray, uid: np.ndarray, weight: np.ndarray,
     return ev
 
 
-
 @inline
 def _minimum(a: float, b: float) -> float:
     """``np.minimum``: NaN if either is."""
     if a != a or b != b:
         return np.nan
     return a if a <= b else b
-
 
 
 @inline
@@ -168,13 +166,11 @@ def _two_heaviest(uid: np.ndarray, lo: int, hi: int, cls_w: np.ndarray) -> tuple
     return x, y
 
 
-
 @inline
 def _quantize(theta: float, levels: int) -> int:
     """:func:`bistair.core.stair.quantize` of one phase."""
     two_pi = 2.0 * math.pi
     return int(math.floor(((theta + math.pi) % two_pi) * levels / two_pi)) % levels
-
 
 
 @inline
@@ -185,7 +181,6 @@ def _level_misfit(theta: float, level: int, levels: int) -> float:
     phase = -math.pi + math.pi / levels + two_pi * level / levels
     d = (theta - phase + math.pi) % two_pi
     return ((d - math.pi) / (math.pi / levels)) ** 2
-
 
 
 @inline
@@ -223,7 +218,6 @@ def _together(reg: np.ndarray, solid: np.ndarray, first: int, second: int,
     if not (0 <= second < n and reg[second] == reg[first] and solid[second]):
         return False
     return third == -2 or (0 <= third < n and reg[third] == reg[first] and solid[third])
-
 
 
 @kernel()

@@ -30,7 +30,6 @@ class RowProfiles:
     col_sum: np.ndarray  # sum of the pixels' column indices
 
 
-
 def stair_values(theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray) -> np.ndarray:
     """The per-pixel values :func:`row_profiles` sums: ``weight*cos(theta)``,
     ``weight*sin(theta)``, ``weight``, ``ratio`` and the column index, (5, H, W) float32.
@@ -66,7 +65,6 @@ def stair_values(theta: np.ndarray, weight: np.ndarray, ratio: np.ndarray) -> np
     return out
 
 
-
 def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
     """Sum each region's pixels row by row (sorted by region, then row); ``values`` from
     :func:`stair_values`.
@@ -100,7 +98,6 @@ def row_profiles(labels: np.ndarray, values: np.ndarray) -> RowProfiles:
     (96, [1, 1], [0, 1], [8, 8])
     """
     return _profiles(labels.shape[0], *label_row_sums(labels, values, int(labels.max())))
-
 
 
 def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
@@ -140,7 +137,6 @@ def stair_row_profiles(labels: np.ndarray, phi: np.ndarray, theta: np.ndarray,
     """
     return _profiles(labels.shape[0], *label_stair_sums(labels, phi, theta, stair_mod, mod,
                                                         int(labels.max())))
-
 
 
 def relabel_stair_profiles(labels: np.ndarray, roots: np.ndarray, remap: np.ndarray,
@@ -192,7 +188,6 @@ def _profiles(h: int, keys: np.ndarray, count: np.ndarray, sums: np.ndarray) -> 
     c, s, wsum, rsum, cols = sums
     return RowProfiles(keys // h, keys % h, c, s, wsum, rsum / np.maximum(count, 1), count,
                        cols)
-
 
 
 def profile_centroids(prof: RowProfiles, n_regions: int) -> np.ndarray:

@@ -102,7 +102,6 @@ def stair_fit(fs: FringeSet, theta: np.ndarray, stair_mod: np.ndarray, order: np
     return float(np.mean(~inside | (own > near + np.maximum(0.05, 2.0 * sigma))))
 
 
-
 def grid_sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
     """Flat indices of at most ``samples`` decoded pixels (valid, order >= 0) on a fixed
     grid, never a scan of the image to find them: every ``m``-th pixel in raster order
@@ -218,7 +217,6 @@ def stair_edges(phi: np.ndarray, theta: np.ndarray, valid: np.ndarray, noise: np
     x0, x1 = max(xs[0] - 4, 0), min(xs[-1] + 5, w - 1)
     edge[y0:y1, x0:x1] = edge_runs(edge[y0:y1, x0:x1], reach)
     return np.zeros((h - 1, w), bool), edge
-
 
 
 def edge_runs(edge: np.ndarray, reach: int) -> np.ndarray:

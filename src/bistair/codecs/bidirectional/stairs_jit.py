@@ -114,7 +114,6 @@ def _sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
     return out
 
 
-
 def decoded_sample(valid: np.ndarray, order: np.ndarray, samples: int) -> np.ndarray:
     """Flat indices of about ``samples`` decoded pixels (valid, order >= 0): every
     ``max(1, count // samples)``-th of them in raster order, as
@@ -172,7 +171,6 @@ def _agreement(levels: np.ndarray, theta: np.ndarray, order: np.ndarray, stairs:
                 # Python's floor division and modulo, as NumPy's
                 out[y, x] = levels[y, x] == k % stairs or q % partitions == k // stairs
     return out
-
 
 
 def stair_agreement(levels: np.ndarray, theta: np.ndarray, order: np.ndarray, stairs: int,
