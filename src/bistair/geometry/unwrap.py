@@ -539,6 +539,15 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         tolerance = max(MIN_TOLERANCE, TOLERANCE_SIGMAS * math.hypot(*noise))
     if not tolerance > 0:
         raise BistairError(f"the phase tolerance must be positive, got {tolerance}")
+    if depth_from not in ("projector", "cameras"):
+        raise BistairError(f"depth_from must be 'projector' or 'cameras', got {depth_from!r}")
+    origin: dict[str, Any] = {}  # the cameras' pixel origin first: the range is judged on it
+    if pixel_origin is not None:
+        origin = _origin_check(left_phase, right_phase, calibration, period, tolerance,
+                               min_depth, max_depth, pixel_origin)
+        if origin["pixel_origin"] != pixel_origin:
+            calibration = with_pixel_origin(calibration, origin["pixel_origin"] - pixel_origin)
+            rectification = None  # (the given grids are the other origin's)
     rect = rectification or rectify(calibration)
     lrect = rectified_phase(left_phase, rect.maps_left)
     rrect = rectified_phase(right_phase, rect.maps_right)
@@ -550,17 +559,6 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                           max_depth, (0.5 * min_depth, 2.0 * max_depth))
         if far[2] is not None and far[0] > MOST_OUTSIDE_WIDE:
             (share, points, depths), limit = far, MOST_OUTSIDE_WIDE
-    if depth_from not in ("projector", "cameras"):
-        raise BistairError(f"depth_from must be 'projector' or 'cameras', got {depth_from!r}")
-    origin: dict[str, Any] = {}
-    if pixel_origin is not None:
-        origin = _origin_check(left_phase, right_phase, calibration, period, tolerance,
-                               min_depth, max_depth, pixel_origin)
-        if origin["pixel_origin"] != pixel_origin:
-            calibration = with_pixel_origin(calibration, origin["pixel_origin"] - pixel_origin)
-            rect = rectify(calibration)
-            lrect = rectified_phase(left_phase, rect.maps_left)
-            rrect = rectified_phase(right_phase, rect.maps_right)
     n_in, crossed, alone, disparity, depth, mask, per_row, valid = _decide(
         lrect, rrect, left_phase, rect, calibration, period, tolerance, min_depth, max_depth,
         propagate)
