@@ -81,7 +81,7 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
                            "cameras' calibration (bistair calibrate-stereo)")
     recorded = None
     if not isinstance(calibration, StereoCalibration):
-        recorded = _recorded_origin(calibration)
+        recorded = recorded_file_origin(calibration)
         calibration = load_calibration(calibration, STEREO)
     spec = find_spec(left, spec) if spec is not None else one_spec(left, right)
     stacks = []
@@ -134,7 +134,7 @@ def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
                          pixel_origin=options.get("pixel_origin"))
 
 
-def _recorded_origin(path: str | Path) -> int | None:
+def recorded_file_origin(path: str | Path) -> int | None:
     """The cameras' pixel origin a calibration file records (``"pixel_origin"``, written by
     ``import-calibration --projection-matrices``), ``None`` when it records none."""
     try:

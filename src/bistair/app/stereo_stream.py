@@ -55,7 +55,7 @@ from .decode_stream import (
     remove_other_windows,
     shown_window,
 )
-from .stereo import one_spec, same_place
+from .stereo import one_spec, recorded_file_origin, same_place
 
 
 def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
@@ -122,7 +122,9 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
+    recorded = None  # the cameras' pixel origin import-calibration recorded: checked
     if not isinstance(calibration, StereoCalibration):
+        recorded = recorded_file_origin(calibration)
         calibration = load_stereo_calibration(calibration)
     spec = check_stream_spec(find_spec(left, spec) if spec is not None
                              else one_spec(left, right))
@@ -148,7 +150,7 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
         if stack.dtype.kind == "f" and not np.isfinite(stack).all():
             raise BistairError(f"{name}: captures contain NaN or infinite values")
     stream = StereoStream(calibration, spec, min_depth, max_depth, win.order, min_modulation,
-                          force=force)
+                          force=force, pixel_origin=recorded)
     say(f"unwrapping {last - win.frames + 1} windows of {shown_window(win)} frames "
         f"({stacks[0].shape[2]}x{stacks[0].shape[1]}, both cameras) at "
         f"{min_depth:g}-{max_depth:g} mm")
@@ -214,6 +216,7 @@ def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: W
         "decided": info["decided"], "decided_fraction": info["decided_fraction"],
         "left_decoded": info.get("left_decoded", 0), "pixels": int(result.depth.size),
         "range_check": stream.check,
+        **({} if stream.pixel_origin is None else {"pixel_origin": stream.pixel_origin}),
         **{k: v for k, v in info.items() if k not in ("decided", "decided_fraction",
                                                          "left_decoded", "start")}}
     write_json(folder / "info.json", info_out)

@@ -75,6 +75,7 @@ from ..core.captures import prepare
 from ..core.measure import measure
 from ..core.motion import PhaseStream
 from ..errors import BistairError
+from .projection_matrices import with_pixel_origin
 from .stereo import Rectification, rectify
 from .stereo_calibration import StereoCalibration
 from .unwrap import (
@@ -145,6 +146,10 @@ class StereoStream:
         Keep the first window when its depth range check would refuse it (a warning).
     tolerance : float, optional
         The phase tolerance (radians); by default as :func:`~.unwrap.unwrap_stereo`'s.
+    pixel_origin : int, optional
+        The cameras' pixel origin the calibration records (``import-calibration
+        --projection-matrices``): the first window checks it as
+        :func:`~.unwrap.unwrap_stereo` does, and every window uses the origin it settles on.
 
     Examples
     --------
@@ -154,7 +159,7 @@ class StereoStream:
     def __init__(self, calibration: StereoCalibration, spec: Any, min_depth: float,
                  max_depth: float, order: int = 0, min_modulation: float | None = None,
                  margin: float = MARGIN, force: bool = False,
-                 tolerance: float | None = None) -> None:
+                 tolerance: float | None = None, pixel_origin: int | None = None) -> None:
         if not is_single_period(spec) or spec.orientation != "columns":
             raise BistairError("stereo phase unwrapping needs one N-step set of one period "
                                "coding the projector columns (bistair patterns multifreq "
@@ -173,6 +178,7 @@ class StereoStream:
         self.range = (float(min_depth), float(max_depth))
         self.order, self.margin, self.force = order, float(margin), force
         self.min_modulation, self.tolerance = min_modulation, tolerance
+        self.pixel_origin = pixel_origin
         self.streams = [PhaseStream(spec.steps, order, spec.shift_sign, spec.phase_offset)
                         for _ in range(2)]
         self.count = 0
@@ -280,13 +286,16 @@ class StereoStream:
         info: dict[str, Any]
         tracked = not (self.previous is None or self.margin == 0)
         if not tracked:
+            first = self.previous is None
             found = unwrap_stereo(lphase, rphase, self.calibration, self.period,
                                   *self.range, self.noise, self.tolerance,
-                                  rectification=rect, force=self.force,
-                                  check=self.previous is None)
+                                  rectification=rect, force=self.force, check=first,
+                                  pixel_origin=self.pixel_origin if first else None)
             disparity = found.disparity
-            if self.previous is None:
+            if first:
                 self.check = found.info["range_check"]
+                self._settle_origin(found.info.get("pixel_origin", self.pixel_origin))
+                rect = self.rect
             info = {k: found.info[k] for k in ("no_candidate", "undecided", "grown",
                                                 "not_confirmed", "unsupported", "warnings")}
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
@@ -309,6 +318,16 @@ class StereoStream:
         phase = np.multiply(column, np.float32(2 * np.pi / self.period), out=column)
         return StreamDepth(start, depth, order, phase, mask, disparity,
                            np.zeros(depth.shape, np.uint8), info)
+
+    def _settle_origin(self, used: int | None) -> None:
+        """The first window found the cameras' pixels fit the other origin
+        (:func:`~.unwrap.unwrap_stereo` unwrapped it so, with a warning): every later window
+        uses that calibration and its rectified grids."""
+        if self.pixel_origin is None or used is None or used == self.pixel_origin:
+            return
+        self.calibration = with_pixel_origin(self.calibration, used - self.pixel_origin)
+        self.pixel_origin = used
+        self._setup()
 
     def _track(self, lrect: np.ndarray, rrect: np.ndarray
                ) -> tuple[np.ndarray, dict[str, Any]]:
