@@ -195,7 +195,8 @@ def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: W
     >>> info = {"decided": 1, "decided_fraction": 0.5, "left_decoded": 2, "warnings": []}
     >>> res = StreamDepth(3, depth, np.zeros(depth.shape, np.int32), depth, np.isfinite(depth),
     ...                   depth, np.zeros(depth.shape, np.uint8), info)
-    >>> fake = SimpleNamespace(range=(400.0, 600.0), check=None, rect=rectify(_toy_stereo()))
+    >>> fake = SimpleNamespace(range=(400.0, 600.0), check=None, rect=rectify(_toy_stereo()),
+    ...                        pixel_origin=None)
     >>> folder = Path(tempfile.mkdtemp()) / "0003"
     >>> write_window(folder, res, fake, Window(4, 1))
     >>> sorted(p.name for p in folder.iterdir())
