@@ -100,6 +100,14 @@ CHECK_POINTS, CHECK_SHARE = 100, 0.005
 #: benchmarks/stereo_unwrap.py's 24 cases at 320 x 240: at most 0.752 (a 20-mm range on
 #: the plane with 16-px fringes, repeats every 29 mm), wrong ones caught there 0.917-1.0.
 MOST_OUTSIDE_WIDE = 0.9
+#: :func:`mixed_pixels`: a decided pixel's depth steps the same way to both its neighbours
+#: along a row, column or diagonal by more than this many footprints (``z / f`` mm a
+#: pixel: a surface turned over 72 degrees from the ray, where the truth has none), and
+#: more than :data:`EDGE_SIGMAS` times the two depths' noise: a pixel mixing a near and a
+#: far surface (the cameras' blur across a depth step). Or it differs from every decided
+#: 8-neighbour by that much: a spike. Never more than half the depth step of one order.
+GRAZING = 3.0
+EDGE_SIGMAS = 4.0
 
 
 @dataclass
@@ -360,6 +368,90 @@ def projector_depth(depth: np.ndarray, mask: np.ndarray, phase: np.ndarray,
     return out, np.isfinite(out), u - column
 
 
+def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibration,
+                 period: float, noise: float, rays: tuple[np.ndarray, np.ndarray]
+                 ) -> np.ndarray:
+    """The decided left pixels whose depth is no surface's: mixed pixels at a depth step
+    and spikes (:data:`GRAZING`), to be left undecided.
+
+    A left pixel across a depth step mixes the near and the far surface's phase; its depth
+    lands between them, and with the cameras' blur a band of such pixels ramps from one
+    to the other. The pixel is in such a ramp when its depth steps the same way to both
+    its neighbours along a row, column or diagonal, each step over the limit; a spike
+    differs from every decided 8-neighbour by more. The limit comes from the rig:
+    :data:`GRAZING` footprints (``z / f``), at least :data:`EDGE_SIGMAS` times the noise
+    of two depths (the projector's depth step per column times the phase noise in
+    columns), at most half the depth step of one order (an order off is always a spike).
+
+    Parameters
+    ----------
+    depth, mask : numpy.ndarray
+        ``(H, W)`` float32 ``z`` (mm) of the left camera's pixels and where decided.
+    calibration : StereoCalibration
+        The cameras and the projector.
+    period : float
+        The fringe period (projector pixels).
+    noise : float
+        The left camera's phase noise (radians, a typical pixel's standard deviation).
+    rays : tuple of numpy.ndarray
+        The left pixels' undistorted rays ``x / z``, ``y / z`` (:class:`~.stereo.
+        Rectification` ``rays``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` bool: the decided pixels to leave undecided.
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo import rectify
+    >>> from bistair.sim import preset, trace
+    >>> from bistair.sim.stereo import StereoRig
+    >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
+    >>> srig = StereoRig.default(camera_size=(80, 60), projector_size=rig.projector.size)
+    >>> cal = StereoCalibration.from_rig(srig)
+    >>> truth = trace(srig.rig("left"), scene).truth
+    >>> z = truth.depth.astype(np.float32)
+    >>> float(600.0 / cal.left.K[0, 0])  # mm: the footprint; the limit three of them
+    4.0
+    >>> z[30, 20:23] = [630.0, 660.0, 690.0]  # a ramp to a step 120 mm behind
+    >>> z[30, 23:], z[40, 40] = 720.0, 630.0  # (a wall) and a spike
+    >>> np.argwhere(mixed_pixels(z, truth.mask, cal, 48.0, 0.03, rectify(cal).rays)).tolist()
+    [[30, 20], [30, 21], [30, 22], [40, 40]]
+    """
+    rows, cols = np.nonzero(mask)
+    points = grid_points(np.where(mask, depth, np.nan).astype(np.float32), *rays)[rows, cols]
+    proj = calibration.projector
+    u = proj.project(points)[:, 0]
+    pair = Calibration(calibration.left, proj.device, proj.R, proj.T)
+    pixels = np.column_stack([cols, rows]).astype(np.float64)
+    per_column = np.abs(triangulate(pixels, u + 1.0, pair)[:, 2] - points[:, 2])
+    z = np.where(mask, depth, np.nan).astype(np.float64)
+    footprint = np.full(z.shape, np.nan)
+    footprint[rows, cols] = points[:, 2] / calibration.left.K[0, 0]
+    floor = np.zeros(z.shape)
+    floor[rows, cols] = EDGE_SIGMAS * math.sqrt(2) * per_column * noise * period / (2 * np.pi)
+    cap = np.full(z.shape, np.inf)
+    cap[rows, cols] = 0.5 * per_column * period
+    h, w = z.shape
+    padded = np.pad(z, 1, constant_values=np.nan)
+    ramp = np.zeros(z.shape, bool)
+    near = np.zeros(z.shape, np.int8)
+    neighbours = np.zeros(z.shape, np.int8)
+    with np.errstate(invalid="ignore"):
+        for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            limit = np.minimum(np.maximum(GRAZING * footprint * math.hypot(dy, dx), floor),
+                               cap)
+            ahead = padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] - z
+            behind = z - padded[1 - dy:1 - dy + h, 1 - dx:1 - dx + w]
+            ramp |= ((np.sign(ahead) == np.sign(behind)) & (np.abs(ahead) > limit)
+                     & (np.abs(behind) > limit))
+            for step in (ahead, behind):
+                neighbours += np.isfinite(step)
+                near += np.abs(step) <= limit
+    return mask & (ramp | ((neighbours > 0) & (near == 0)))
+
+
 def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
                 calibration: StereoCalibration, period: float, tolerance: float,
                 low: float, high: float, wide: tuple[float, float] | None = None
@@ -444,7 +536,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   max_depth: float, noise: tuple[float, float] = (0.0, 0.0),
                   tolerance: float | None = None, rectification: Rectification | None = None,
                   force: bool = False, check: bool = True, depth_from: str = "projector",
-                  propagate: bool = True, pixel_origin: int | None = None) -> Unwrapped:
+                  propagate: bool = True, pixel_origin: int | None = None,
+                  drop_mixed: bool = True) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -488,6 +581,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         (:func:`~.projection_matrices.recorded_origin`): checked against the data
         (:func:`_origin_check`), and the other used, with a warning, when it explains the
         data clearly better. ``None``: not checked.
+    drop_mixed : bool, optional
+        Leave undecided the pixels :func:`mixed_pixels` finds (mixed pixels at depth steps,
+        spikes; ``info["mixed"]`` counts them).
 
     Returns
     -------
@@ -559,25 +655,35 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                           max_depth, (0.5 * min_depth, 2.0 * max_depth))
         if far[2] is not None and far[0] > MOST_OUTSIDE_WIDE:
             (share, points, depths), limit = far, MOST_OUTSIDE_WIDE
-    n_in, crossed, alone, disparity, depth, mask, per_row, valid = _decide(
+    n_in, crossed, alone, disparity, depth, mask, _, valid = _decide(
         lrect, rrect, left_phase, rect, calibration, period, tolerance, min_depth, max_depth,
         propagate)
     pdepth, pmask, residual = projector_depth(depth, mask, left_phase, calibration, period,
                                               rect.rays)
     if depth_from == "projector":
         depth, mask = pdepth, pmask
+    mixed = (mixed_pixels(depth, mask, calibration, period, noise[0], rect.rays)
+             if drop_mixed else np.zeros(mask.shape, bool))
+    kept = disparity
+    if mixed.any():
+        depth, mask = np.where(mixed, np.float32(np.nan), depth), mask & ~mixed
+        u, v = (np.rint(p[mixed]).astype(np.int64) for p in rect.positions)
+        inside = (u >= 0) & (u < disparity.shape[1]) & (v >= 0) & (v < disparity.shape[0])
+        kept = disparity.copy()
+        kept[v[inside], u[inside]] = np.nan
     rectified_valid = int(np.isfinite(lrect).sum())
     info: dict[str, Any] = {
         "unwrapping": "stereo", "period": period, "depth_range": [min_depth, max_depth],
         "depth_from": depth_from,
-        "left_decoded": int(valid), "decided": int(per_row.sum()),
-        "decided_fraction": round(float(per_row.sum() / max(valid, 1)), 6),
+        "left_decoded": int(valid), "decided": int(mask.sum()),
+        "decided_fraction": round(float(mask.sum() / max(valid, 1)), 6),
         "rectified_valid": rectified_valid,
         "no_candidate": int(np.sum(np.isfinite(lrect) & (n_in == 0))),
         "undecided": int(np.sum((n_in >= 2) & np.isnan(disparity))),
         "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone))),
         "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed) & np.isnan(disparity))),
         "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
+        "mixed": int(mixed.sum()),
         "tolerance_rad": round(float(tolerance), 6),
         "noise_rad": [round(float(n), 6) for n in noise],
         "range_check": None if not check else {
@@ -597,7 +703,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         if not force:
             raise BistairError(message)
         info["warnings"].append(message)
-    return Unwrapped(disparity, depth, mask, n_in, rect, info)
+    return Unwrapped(kept, depth, mask, n_in, rect, info)
 
 
 def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
