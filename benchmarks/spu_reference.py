@@ -22,7 +22,10 @@ continuous phase: large ones kept, small ones shifted by whole orders to agree w
 neighbours; points more than 2 mm from a 9x9 median of z removed.
 
 Reported: bistair's points against the reference's, the median nearest-point distance
-(mm) and the share over 2 mm (scipy cKDTree), and both against the truth.
+(mm) and the share over 2 mm (scipy cKDTree), and both against the truth (the nearest
+truth point; ``ours_same_pixel_truth``: bistair's share within 2 mm of the truth's depth at
+the same pixel), and the decided pixels bistair left undecided as mixed (``mixed``:
+:func:`bistair.geometry.unwrap.mixed_pixels`).
 
     python benchmarks/spu_reference.py [--camera 320x240] [--scenes two-masks,plane]
         [--projector-at 0.5,0.3] [--motion 0,1]
@@ -35,6 +38,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import json
 import math
 import tempfile
 import warnings
@@ -298,6 +302,9 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
         if res.exit_code != 0:
             raise SystemExit(f"bistair {' '.join(args[:2])}: {res.output}")
     ours = read_ply(folder / "out" / "cloud.ply")
+    depth = np.load(folder / "out" / "depth.npy")
+    decided = np.isfinite(depth)
+    mixed = json.loads((folder / "out" / "info.json").read_text())["mixed"]
     truth_points = truth.points[truth.mask]
     near = cKDTree(ref).query(ours)[0]
     out = {"reference": len(ref), "bistair": len(ours), "ratio": len(ours) / max(len(ref), 1),
@@ -313,6 +320,12 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
             near > 2.0) else 0.0
         out["ref_off_truth"] = float(np.mean(ref_to_truth > 2.0))
         out["ours_off_truth"] = float(np.mean(to_truth > 2.0))
+        # at the same pixel (the truth's depth is on the left camera's grid), and the
+        # decided pixels left undecided as mixed (geometry.unwrap.mixed_pixels)
+        with np.errstate(invalid="ignore"):
+            same = np.abs(depth[decided] - truth.depth[decided]) <= 2.0
+        out["ours_same_pixel_truth"] = float(np.mean(same)) if same.size else 0.0
+        out["mixed"] = mixed
     return out
 
 
@@ -330,6 +343,7 @@ def main() -> None:
             with tempfile.TemporaryDirectory() as tmp:
                 r = run(scene, camera, at, Path(tmp), motion=moving)
             extra = "".join(f", {k} {v:.3f}" for k, v in r.items() if "truth" in k)
+            extra += f", mixed {r.get('mixed', 0)}"
             print(f"{scene:16s} at {at} moving {moving:g} mm/frame: reference "
                   f"{r['reference']} points, bistair {r['bistair']} "
                   f"({100 * r['ratio']:.1f}%), median distance "

@@ -6,8 +6,9 @@ gamma 2.2 compensated) with one four-step set of one period, the projector halfw
 the cameras (the rig's default) or at 0.3 of the baseline. The depth range is the truth's
 depths +-10 mm; the share of the valid left pixels decided, and of those an order off
 (absolute phase more than pi off the truth, or no truth there: pixels at an object's
-silhouette), and the same on the truth's mask (bistair's score), the range check's
-share of points outside (over 0.5 refuses), and three wrong ranges (just beyond, just
+silhouette), and the same on the truth's mask (bistair's score), the decided pixels left
+undecided as mixed at depth steps (:func:`bistair.geometry.unwrap.mixed_pixels`), the
+range check's share of points outside (over 0.5 refuses), and three wrong ranges (just beyond, just
 before, far beyond): their check share, points, decided share and order errors. Time: process CPU of
 :func:`bistair.geometry.unwrap.unwrap_stereo` (min of three rounds) and its ratio to the
 wrapped-phase measurement of both cameras in the same run.
@@ -94,7 +95,9 @@ def case(scene: str, camera: tuple[int, int], projector_at: float, period: float
         others.append(f"{lo}:{hi} {wc['outside']:.3f}/{wc['points']} "
                       f"{100 * wdec / valid:.1f}% {wwrong}")
     return (f"{scene:17s} at {projector_at} T {period:g} {low}:{high} decided "
-            f"{100 * decided / valid:5.1f}% wrong {wrong} ({100 * wrong / max(decided, 1):.3f}%;"
+            f"{100 * decided / valid:5.1f}% (mixed {info['mixed']}: "
+            f"{100 * (decided + info['mixed']) / valid:.1f}% with them) wrong {wrong} "
+            f"({100 * wrong / max(decided, 1):.3f}%;"
             f" on the truth's mask {wrong_on} of {on}, {100 * wrong_on / max(on, 1):.3f}%)"
             f" check {check['outside']:.3f}/{check['points']} cpu {cpu:.3f} s "
             f"(x{cpu / base:.0f}) | wrong ranges: " + "; ".join(others))
