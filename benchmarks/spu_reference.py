@@ -24,7 +24,8 @@ neighbours; points more than 2 mm from a 9x9 median of z removed.
 Reported: bistair's points against the reference's, the median nearest-point distance
 (mm) and the share over 2 mm (scipy cKDTree), and both against the truth (the nearest
 truth point; ``ours_same_pixel_truth``: bistair's share within 2 mm of the truth's depth at
-the same pixel), and the decided pixels bistair left undecided as mixed (``mixed``:
+the same pixel, ``ours_same_pixel_over_5mm`` over 5 mm off it or where it has none), and
+the decided pixels bistair left undecided as mixed (``mixed``:
 :func:`bistair.geometry.unwrap.mixed_pixels`).
 
     python benchmarks/spu_reference.py [--camera 320x240] [--scenes two-masks,plane]
@@ -324,7 +325,9 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
         # decided pixels left undecided as mixed (geometry.unwrap.mixed_pixels)
         with np.errstate(invalid="ignore"):
             same = np.abs(depth[decided] - truth.depth[decided]) <= 2.0
+            over = ~(np.abs(depth[decided] - truth.depth[decided]) <= 5.0)
         out["ours_same_pixel_truth"] = float(np.mean(same)) if same.size else 0.0
+        out["ours_same_pixel_over_5mm"] = float(np.mean(over)) if over.size else 0.0
         out["mixed"] = mixed
     return out
 
