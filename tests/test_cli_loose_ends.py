@@ -135,7 +135,8 @@ def test_quiet_patterns_print_nothing_and_write_the_set(tmp_path, monkeypatch, c
     assert code == 0 and printed == "" and err == "" and (tmp_path / "ramp" / "ramp.json").is_file()
 
 
-def test_the_calibration_carries_the_pixel_origin_its_file_records(sim, tmp_path):
+def test_the_calibration_carries_the_pixel_origin_its_file_records(sim, tmp_path, monkeypatch,
+                                                                   capsys):
     """``pixel_origin`` is a field of :class:`StereoCalibration` that save and load keep;
     files written before (none recorded, or recorded by ``save_matrix_calibration``) load
     as they did. A loaded calibration given to ``stereo`` as an object is checked as its
@@ -168,3 +169,9 @@ def test_the_calibration_carries_the_pixel_origin_its_file_records(sim, tmp_path
                              previews=False)
         info = json.loads((tmp_path / "stream" / "0000" / "info.json").read_text())
         assert info.get("pixel_origin") == 0 and len(kept) == 1, type(given).__name__
+    # the command says so on stderr, as one set's does (quiet too); before, only info.json
+    code, printed, err = cli_run(monkeypatch, capsys, *_stream_args(sim, tmp_path / "cli")[:4],
+                                 tmp_path / "old.json", "--depth-range", RANGE, "--window",
+                                 "4", "--starts", "0,2", "--out", tmp_path / "cli", "-q")
+    assert code == 0 and printed == "", err
+    assert err.count("Warning: ") == 1 and "pixel origin 0, " in err and "used 0" in err, err

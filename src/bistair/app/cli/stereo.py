@@ -131,6 +131,8 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
         kept = stereo_stream(left, right, out, calibration, spec_path, window, starts,
                              *depth, force=force, min_modulation=min_modulation,
                              previews=previews, progress=say)
+    for message in dict.fromkeys(w for r in kept for w in r.info.get("warnings", [])):
+        click.echo(f"Warning: {message}", err=True)  # (as one set's; also when quiet)
     if quiet:
         return
     shares = [r.info["decided_fraction"] for r in kept]
