@@ -150,5 +150,5 @@ def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path, quiet: bool) 
 
     fit = measure_gamma(list(captures), out, ramp)
     if not quiet:
-            click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
-                       f"{len(fit.levels)} levels, {fit.pixels} pixels); wrote {out}")
+        click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
+                   f"{len(fit.levels)} levels, {fit.pixels} pixels); wrote {out}")
