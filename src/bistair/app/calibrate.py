@@ -386,7 +386,6 @@ def import_projection_matrices(files: Sequence[str | Path] | str, out: str | Pat
         sizes.append(parse_size(size, name) if isinstance(size, str) else size)
     cal = import_matrices(tuple(files), *sizes, pixel_origin=pixel_origin)
     origin = default_origin(files) if pixel_origin is None else int(pixel_origin)
-    cal = cal.replace(pixel_origin=origin)  # (recorded in the file, checked by stereo)
     save_matrix_calibration(cal, origin, out)
     return cal, origin
 
