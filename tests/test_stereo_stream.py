@@ -68,7 +68,7 @@ def test_windows_against_truth(sim, tmp_path, monkeypatch, capsys):
     assert [p.name for p in folders] == [f"{s:04d}" for s in range(7)]
     for folder in folders:
         assert sorted(p.name for p in folder.iterdir()) == ["cloud.ply", "depth.npy",
-                                                            "info.json"]
+                                                            "depth.png", "info.json"]
         info = json.loads((folder / "info.json").read_text())
         depth = np.load(folder / "depth.npy")
         decided = np.isfinite(depth)

@@ -116,7 +116,7 @@ def simulate_motion(scene: str, methods: Sequence[str], out: str | Path,
         specs = {m: s for m, (s, _) in chosen.items()}
         sets = {m: encode(s) for m, s in specs.items()}
     first = next(iter(specs.values()))
-    moving = parse_motion(motion or "0,0,0mm", _coded(first).orientation,
+    moving = parse_motion("0,0,0mm" if motion is None else motion, _coded(first).orientation,
                           whole=moves == "scene")
     if cameras == 2:
         srig = StereoRig.default(camera_size=rig.camera.size, projector_size=rig.projector.size,

@@ -20,7 +20,6 @@ leaves nothing behind.
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -33,7 +32,6 @@ from ..geometry.calibration import (
     StereoCalibration,
     load_calibration,
 )
-from ..geometry.projection_matrices import recorded_origin
 from ..geometry.stereo import StereoResult, stereo
 from ..geometry.unwrap import is_single_period, stereo_unwrap
 from ..io.atomic import check_output, output_folder
@@ -54,7 +52,8 @@ SIDES = (("L", "R"), ("left", "right"))  # the folders of a stereo capture set
 def stereo_folder(left: Any, right: Any, out: str | Path,
                   calibration: StereoCalibration | str | Path,
                   spec: BaseSpec | str | Path | None = None, min_depth: float = 0.0,
-                  max_depth: float = np.inf, force: bool = False, smooth: float = 1.0,
+                  max_depth: float = np.inf, force: bool = False,
+                  smooth: float | None = None,
                   previews: bool = True, progress: Say | None = None,
                   **options: Any) -> StereoResult:
     """Decode two cameras' captures (each a folder, image files, a glob pattern or a ``.npy``
@@ -67,8 +66,9 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     not be the same path. ``calibration`` must be a stereo calibration (``"kind":
     "stereo"``). ``force`` goes to
     the decoder when it takes it and keeps a reconstruction with few matches; ``smooth``:
-    see :func:`~bistair.geometry.stereo.reconstruct_stereo`. ``options`` are decoder
-    options. Nothing is written on error.
+    see :func:`~bistair.geometry.stereo.reconstruct_stereo` (``None``: its default, 1 px;
+    a single-period spec, unwrapped by the projector, matches no projector coordinates and
+    refuses one). ``options`` are decoder options. Nothing is written on error.
     """
     say = progress or silent
     for side in (left, right):
@@ -79,10 +79,9 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
-    recorded = None
     if not isinstance(calibration, StereoCalibration):
-        recorded = recorded_file_origin(calibration)
         calibration = load_calibration(calibration, STEREO)
+    recorded = calibration.pixel_origin  # import-calibration --projection-matrices's
     spec = find_spec(left, spec) if spec is not None else one_spec(left, right)
     stacks = []
     for name, captures in (("left", left), ("right", right)):
@@ -95,7 +94,11 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     if is_single_period(used):
         say(f"unwrapping 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
             f"by the projector at {min_depth:g}-{max_depth:g} mm")
-        if recorded is not None:  # import-calibration --projection-matrices's: checked
+        if smooth is not None:
+            raise BistairError("--smooth does not apply to a single-period spec: stereo "
+                               "phase unwrapping takes each pixel's depth from the projector "
+                               "column of its phase, with no smoothing")
+        if recorded is not None:  # checked against the data
             options = {"pixel_origin": recorded, **options}
         result = _unwrapped(lstack, rstack, used, calibration, min_depth, max_depth, force,
                             options)
@@ -103,7 +106,8 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
         say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
             f"({used.method}) and matching")
         result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
-                        max_depth=max_depth, force=force, smooth=smooth, **options)
+                        max_depth=max_depth, force=force,
+                        **({} if smooth is None else {"smooth": smooth}), **options)
     say(f"writing {int(result.mask.sum())} points")
     with output_folder(out) as tmp:
         write_stereo(result, tmp, previews)
@@ -132,18 +136,6 @@ def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
     return stereo_unwrap(lstack, rstack, spec, calibration, min_depth, max_depth, force,
                          options.get("min_modulation"),
                          pixel_origin=options.get("pixel_origin"))
-
-
-def recorded_file_origin(path: str | Path) -> int | None:
-    """The cameras' pixel origin a calibration file records (``"pixel_origin"``, written by
-    ``import-calibration --projection-matrices``), ``None`` when it records none."""
-    try:
-        data = json.loads(Path(path).read_text())
-    except (OSError, ValueError):
-        return None  # load_stereo_calibration says what is wrong with the file
-    if not isinstance(data, dict) or "pixel_origin" not in data:
-        return None
-    return recorded_origin(data)
 
 
 def same_place(left: Any, right: Any) -> bool:

@@ -12,6 +12,8 @@ by default) it writes::
 
     OUT/<start, 4 digits>/depth.npy   float32 z (mm) on the left camera's own grid, NaN
                                       where unknown
+    OUT/<start, 4 digits>/depth.png   its preview, as the one-set ``stereo`` writes it
+                                      (not with ``--no-previews``)
     OUT/<start, 4 digits>/cloud.ply   x, y, z (mm, left camera frame), grey from the
                                       left camera's modulation
     OUT/<start, 4 digits>/info.json   start, frames used, window, order, lag, time, the
@@ -37,14 +39,13 @@ from typing import Any
 import numpy as np
 
 from ..errors import BistairError
-from ..geometry.calibration import Calibration
+from ..geometry.calibration import STEREO, Calibration, StereoCalibration, load_calibration
 from ..geometry.stereo import cloud_points
-from ..geometry.stereo_calibration import StereoCalibration, load_stereo_calibration
 from ..geometry.unwrap_stream import StereoStream, StreamDepth
 from ..io.atomic import check_output, output_folder
 from ..io.jsonfile import write_json
 from ..io.read import capture_files, find_spec, read_captures
-from ..io.writers import write_ply
+from ..io.writers import write_depth, write_ply
 from ..spec import BaseSpec
 from .decode_stream import (
     Window,
@@ -55,14 +56,14 @@ from .decode_stream import (
     remove_other_windows,
     shown_window,
 )
-from .stereo import one_spec, recorded_file_origin, same_place
+from .stereo import one_spec, same_place
 
 
 def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
                   calibration: StereoCalibration | str | Path, spec: BaseSpec | str | Path | None,
                   window: str, starts: str | None = None, min_depth: float = 0.0,
                   max_depth: float = math.inf, force: bool = False,
-                  min_modulation: float | None = None,
+                  min_modulation: float | None = None, previews: bool = True,
                   progress: Callable[[str], None] | None = None) -> list[StreamDepth]:
     """Depth maps of a two-camera stream, window by window, into ``OUT/<start>/`` (module
     docstring).
@@ -87,6 +88,8 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
         Keep the first window when its depth range check would refuse it (a warning).
     min_modulation : float, optional
         The modulation a valid pixel needs (fraction of full scale; default from noise).
+    previews : bool, optional
+        Write each window's ``depth.png`` (default ``True``).
     progress : callable, optional
         Called with each stage's name.
 
@@ -122,10 +125,8 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
     if isinstance(calibration, Calibration):
         raise BistairError("a camera-projector calibration was given: stereo needs the two "
                            "cameras' calibration (bistair calibrate-stereo)")
-    recorded = None  # the cameras' pixel origin import-calibration recorded: checked
     if not isinstance(calibration, StereoCalibration):
-        recorded = recorded_file_origin(calibration)
-        calibration = load_stereo_calibration(calibration)
+        calibration = load_calibration(calibration, STEREO)
     spec = check_stream_spec(find_spec(left, spec) if spec is not None
                              else one_spec(left, right))
     win = parse_window(window, spec.steps)
@@ -150,7 +151,7 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
         if stack.dtype.kind == "f" and not np.isfinite(stack).all():
             raise BistairError(f"{name}: captures contain NaN or infinite values")
     stream = StereoStream(calibration, spec, min_depth, max_depth, win.order, min_modulation,
-                          force=force, pixel_origin=recorded)
+                          force=force, pixel_origin=calibration.pixel_origin)  # checked
     say(f"unwrapping {last - win.frames + 1} windows of {shown_window(win)} frames "
         f"({stacks[0].shape[2]}x{stacks[0].shape[1]}, both cameras) at "
         f"{min_depth:g}-{max_depth:g} mm")
@@ -160,15 +161,16 @@ def stereo_stream(left: str | Path, right: str | Path, out: str | Path,
             result = stream.push(stacks[0][i], stacks[1][i])
             if result is None or result.start not in wanted:
                 continue
-            write_window(tmp / f"{result.start:04d}", result, stream, win)
+            write_window(tmp / f"{result.start:04d}", result, stream, win, previews)
             kept.append(result)
     remove_other_windows(Path(out), {f"{s:04d}" for s in chosen})
     return kept
 
 
-def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: Window) -> None:
-    """Write one window's ``depth.npy``, ``cloud.ply`` and ``info.json`` into ``folder``
-    (made here).
+def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: Window,
+                 previews: bool = True) -> None:
+    """Write one window's ``depth.npy``, ``depth.png`` (with ``previews``), ``cloud.ply``
+    and ``info.json`` into ``folder`` (made here).
 
     Parameters
     ----------
@@ -180,6 +182,8 @@ def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: W
         The stream it came from (the depth range, the first window's check).
     win : Window
         ``--window``.
+    previews : bool, optional
+        Also write ``depth.png`` (:func:`~bistair.io.writers.write_depth`).
 
     Returns
     -------
@@ -200,12 +204,15 @@ def write_window(folder: Path, result: StreamDepth, stream: StereoStream, win: W
     >>> folder = Path(tempfile.mkdtemp()) / "0003"
     >>> write_window(folder, res, fake, Window(4, 1))
     >>> sorted(p.name for p in folder.iterdir())
-    ['cloud.ply', 'depth.npy', 'info.json']
+    ['cloud.ply', 'depth.npy', 'depth.png', 'info.json']
     >>> json.loads((folder / "info.json").read_text())["frames"]
     [3, 7]
     """
     folder.mkdir()
-    np.save(folder / "depth.npy", result.depth.astype(np.float32))
+    if previews:
+        write_depth(result.depth, folder)  # depth.npy (float32) and depth.png
+    else:
+        np.save(folder / "depth.npy", result.depth.astype(np.float32))
     write_ply(folder / "cloud.ply", *cloud_points(result.depth, *stream.rect.rays,
                                                   result.grey, result.mask))
     info = result.info

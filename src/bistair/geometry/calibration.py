@@ -42,9 +42,13 @@ with its pose in the left camera's frame, ``X_projector = R @ X_left + T``
      "uncertainty": {"rotation_deg": [...], "T": [...], "baseline": mm,
                      "noise": {"left": px, "right": px}, "left": {"fx": ..., ...},
                      "right": {...}},
-     "projector": {"width": W, "height": H, "K": 3x3, "dist": [...], "R": 3x3, "T": [3]}}
+     "projector": {"width": W, "height": H, "K": 3x3, "dist": [...], "R": 3x3, "T": [3]},
+     "pixel_origin": 0 or 1}
 
-``"projector"`` is absent (or ``null``) in a calibration of the two cameras alone. A reader
+``"projector"`` is absent (or ``null``) in a calibration of the two cameras alone.
+``"pixel_origin"``, written by ``import-calibration --projection-matrices``, is the cameras'
+pixel origin in the matrices the file was made from (its ``K`` are 0-based either way;
+``stereo`` checks it against the data); absent in other files (``None``). A reader
 that needs one kind (``load_calibration(path, kind)``) refuses the other with one line.
 
 The right camera is the one at ``+x`` of the left camera (to the right in its image): its
@@ -71,6 +75,10 @@ Examples
 >>> data = pair.to_dict()
 >>> data["kind"], data["baseline"], StereoCalibration.from_dict(data).right.size
 ('stereo', 120.0, (640, 480))
+>>> "pixel_origin" in data, StereoCalibration.from_dict(data).pixel_origin
+(False, None)
+>>> StereoCalibration.from_dict({**data, "pixel_origin": 1}).pixel_origin
+1
 """
 
 from __future__ import annotations
@@ -409,7 +417,9 @@ class StereoCalibration:
     """Two calibrated cameras; ``X_right = R @ X_left + T`` (mm). ``uncertainty`` holds one
     standard deviation of every quantity (its ``left`` and ``right`` cameras; ``camera``
     and ``projector``, their old names, still read them). ``projector``: the projector and
-    its pose in the left camera's frame, when known (stereo phase unwrapping needs it)."""
+    its pose in the left camera's frame, when known (stereo phase unwrapping needs it).
+    ``pixel_origin``: the cameras' pixel origin (0 or 1) of the matrices it was imported
+    from, when recorded (module docstring)."""
 
     kind: ClassVar[str] = STEREO
     left: Device
@@ -422,10 +432,16 @@ class StereoCalibration:
     poses_total: int | None = None
     uncertainty: Uncertainty | None = None
     projector: ProjectorPose | None = None
+    pixel_origin: int | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "R", np.asarray(self.R, float).reshape(3, 3))
         object.__setattr__(self, "T", np.asarray(self.T, float).reshape(3))
+        if self.pixel_origin is not None:
+            if self.pixel_origin not in (0, 1):
+                raise BistairError(f"calibration field 'pixel_origin' must be 0 or 1, got "
+                                   f"{self.pixel_origin!r}")
+            object.__setattr__(self, "pixel_origin", int(self.pixel_origin))
         check_pair(self.R, self.T)
         _name_devices(self)
 
@@ -471,6 +487,8 @@ class StereoCalibration:
                 "poses_total": self.poses_total, "board": self.board, "uncertainty": sigma}
         if self.projector is not None:
             data["projector"] = self.projector.to_dict()
+        if self.pixel_origin is not None:
+            data["pixel_origin"] = self.pixel_origin
         return data
 
     @classmethod
@@ -498,7 +516,7 @@ class StereoCalibration:
         return cls(*devices, rot, _array(data, "T", ((3,),)),
                    float(rms) if isinstance(rms, int | float) and math.isfinite(rms) else None,
                    tuple(data.get("poses") or ()), data.get("board"), data.get("poses_total"),
-                   sigma, projector)
+                   sigma, projector, data.get("pixel_origin"))
 
 
 def right_centre(R: np.ndarray, T: np.ndarray) -> np.ndarray:

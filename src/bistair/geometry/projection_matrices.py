@@ -398,7 +398,8 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     -------
     StereoCalibration
         The cameras' intrinsics, the right camera's ``R, T`` (``X_right = R X_left + T``,
-        world units) and the ``projector`` pose the same way, all without distortion.
+        world units) and the ``projector`` pose the same way, all without distortion; its
+        ``pixel_origin`` records ``pixel_origin`` (``stereo`` checks it against the data).
 
     Raises
     ------
@@ -414,6 +415,8 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     ([-200.0, 0.0, 0.0], [-100.0, 0.0, 0.0])
     >>> rig_from_matrices(P, (640, 480), (640, 480), pixel_origin=1).left.K[:2, 2].tolist()
     [318.5, 238.5]
+    >>> rig_from_matrices(P, (640, 480), (640, 480), pixel_origin=1).pixel_origin  # recorded
+    1
     """
     if pixel_origin not in PIXEL_ORIGINS:
         raise BistairError(f"the pixel origin must be 0 (OpenCV) or 1 (MATLAB), got "
@@ -431,7 +434,7 @@ def rig_from_matrices(matrices: tuple[np.ndarray, np.ndarray, np.ndarray],
     Rp, Tp = relative(rp, tp)
     cal = StereoCalibration(Device(cw, ch, kl), Device(cw, ch, kr), R, T,
                             projector=ProjectorPose(Device(pw, ph, kp), Rp, Tp))
-    return with_pixel_origin(cal, pixel_origin)
+    return with_pixel_origin(cal, pixel_origin).replace(pixel_origin=int(pixel_origin))
 
 
 def import_matrices(files: tuple[str | Path, str | Path, str | Path],

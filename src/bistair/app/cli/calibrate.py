@@ -83,10 +83,11 @@ def calibrate(captures: Path, out: Path, board: str | None, spec_path: Path | No
 @click.option("--pixel-origin", "pixel_origin", type=click.IntRange(0, 1), default=None,
               help="with --projection-matrices: the cameras' pixel origin in the matrices, "
               "0 (OpenCV) or 1 (MATLAB) [default: 1 for .mat files, 0 otherwise]")
+@quiet_option
 @reports_errors
 def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str | None,
                        camera_size: str | None, keys: str | None, stereo: bool,
-                       matrices: str | None, pixel_origin: int | None) -> None:
+                       matrices: str | None, pixel_origin: int | None, quiet: bool) -> None:
     """Convert an OpenCV FileStorage calibration (YAML or XML, e.g. stereo_calib's
     intrinsics.yml and extrinsics.yml, camera as device 1) into a bistair calibration file.
     R, T map the camera frame to the projector frame; T in millimetres. With --stereo, two
@@ -101,6 +102,8 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
             raise CliError("--projection-matrices takes no FILES, --stereo or --keys")
         rig, origin = import_projection_matrices(matrices, out, camera_size, projector_size,
                                                  pixel_origin)
+        if quiet:
+            return
         click.echo(f"cameras {rig.left.width}x{rig.left.height} (pixel origin {origin}), "
                    f"baseline {rig.baseline:.2f} mm, projector {rig.projector.device.width}x"
                    f"{rig.projector.device.height} at "
@@ -119,14 +122,17 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
             raise CliError("--projector-size does not apply to a stereo calibration (two "
                            "cameras)")
         pair = import_stereo_calibration(files, out, camera_size, keys)
-        click.echo(f"cameras {pair.left.width}x{pair.left.height}, baseline "
-                   f"{pair.baseline:.2f} mm; wrote {out}")
+        if not quiet:
+            click.echo(f"cameras {pair.left.width}x{pair.left.height}, baseline "
+                       f"{pair.baseline:.2f} mm; wrote {out}")
         if short_baseline(pair):
             click.echo(f"Warning: {short_baseline(pair)}", err=True)
         return
     from ..calibrate import import_calibration as run
 
     cal = run(files, out, projector_size, camera_size, keys)
+    if quiet:
+        return
     click.echo(f"camera {cal.camera.width}x{cal.camera.height}, projector "
                f"{cal.projector.width}x{cal.projector.height}, baseline {cal.baseline:.2f} mm; "
                f"wrote {out}")

@@ -18,6 +18,7 @@ from .options import (
     Input,
     Output,
     Text,
+    quiet_option,
     reports_errors,
 )
 
@@ -82,9 +83,10 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
                                "measured projector gamma (instead of --gamma)"))
     params.append(click.Option(["--out", "-o"], required=True, type=Output(),
                                help="output folder"))
+    params += quiet_option(lambda quiet: None).__click_params__  # (as the other commands')
 
     @reports_errors
-    def callback(out: Path, gamma_file: Path | None, **values: Any) -> None:
+    def callback(out: Path, gamma_file: Path | None, quiet: bool, **values: Any) -> None:
         from ..patterns import read_gamma, save_patterns
 
         values = {key: coerce_field(fields[key], value) for key, value in values.items()}
@@ -97,7 +99,8 @@ def _spec_command(name: str, spec_class: type[BaseSpec], summary: str) -> click.
             values["gamma"] = read_gamma(gamma_file)
         spec = spec_class(**values)
         save_patterns(spec, out)
-        click.echo(f"wrote {spec.frame_count} {name} patterns and spec.json to {out}")
+        if not quiet:
+            click.echo(f"wrote {spec.frame_count} {name} patterns and spec.json to {out}")
 
     return click.Command(name, params=params, callback=callback, help=summary)
 
@@ -121,13 +124,16 @@ def _show(value: Any) -> str:
 @click.option("--bits", type=click.Choice(["8", "16"]), default="8", show_default=True,
               help="bit depth of the frames")
 @click.option("--out", "-o", required=True, type=Output(), help="output folder")
+@quiet_option
 @reports_errors
-def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -> None:
+def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path,
+                   quiet: bool) -> None:
     """A ramp of uniform grey frames (NN.png and ramp.json) for 'bistair gamma'."""
     from ..patterns import save_ramp
 
     save_ramp(width, height, levels, int(bits), out)
-    click.echo(f"wrote {levels} grey frames and ramp.json to {out}")
+    if not quiet:
+        click.echo(f"wrote {levels} grey frames and ramp.json to {out}")
 
 
 @click.command()
@@ -136,11 +142,13 @@ def patterns_gamma(width: int, height: int, levels: int, bits: str, out: Path) -
               help="ramp.json of the grey frames [default: ramp.json in the captures' folder]")
 @click.option("--out", "-o", required=True, type=Output(file=True),
               help="gamma file to write (JSON)")
+@quiet_option
 @reports_errors
-def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path) -> None:
+def gamma(captures: tuple[str, ...], ramp: Path | None, out: Path, quiet: bool) -> None:
     """Measure the projector's gamma from captures of 'bistair patterns gamma'."""
     from ..patterns import measure_gamma
 
     fit = measure_gamma(list(captures), out, ramp)
-    click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
-               f"{len(fit.levels)} levels, {fit.pixels} pixels); wrote {out}")
+    if not quiet:
+        click.echo(f"projector gamma {fit.gamma:.3f} (RMS misfit {fit.rms:.4f} over "
+                   f"{len(fit.levels)} levels, {fit.pixels} pixels); wrote {out}")

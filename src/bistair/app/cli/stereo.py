@@ -41,10 +41,13 @@ from .options import (
 @strategy_option
 @click.option("--min-modulation", type=float, default=None,
               help="modulation threshold as a fraction of full scale [default: from noise]")
-@click.option("--smooth", type=float, default=1.0, show_default=True, metavar="PX",
+@click.option("--smooth", type=float, default=None, metavar="PX",
               help="Gaussian sigma of a smoothing of the projector coordinates before "
-              "matching (never across surfaces): less depth noise, less lateral detail; 0: none")
-@click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews")
+              "matching (never across surfaces): less depth noise, less lateral detail; 0: "
+              "none [default: 1; not for a single-period spec or --window, which match no "
+              "projector coordinates]")
+@click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews (with "
+              "--window: each window's depth.png)")
 @click.option("--window", default=None, metavar="N|N+K",
               help="two streams of one single-period N-step set whose shift advances one "
               "step per frame: a depth map for every window of N frames (N+K: motion "
@@ -57,7 +60,7 @@ from .options import (
 @reports_errors
 def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
            depth_range: str | None, force: bool, strategy: str | None,
-           min_modulation: float | None, smooth: float, no_previews: bool,
+           min_modulation: float | None, smooth: float | None, no_previews: bool,
            window: str | None, starts: str | None, quiet: bool) -> None:
     """Two cameras and a projector: decode both cameras' captures of one pattern set, match
     equal absolute phase along rectified rows, triangulate.
@@ -75,7 +78,7 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if window is not None or starts is not None:
         _stereo_stream(left, right, spec_path, calibration, out, (low, high), window, starts,
-                       force, strategy, min_modulation, quiet)
+                       force, strategy, min_modulation, smooth, not no_previews, quiet)
         return
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
@@ -108,7 +111,8 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
 def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: Path,
                    out: Path, depth: tuple[float, float], window: str | None,
                    starts: str | None, force: bool, strategy: str | None,
-                   min_modulation: float | None, quiet: bool) -> None:
+                   min_modulation: float | None, smooth: float | None, previews: bool,
+                   quiet: bool) -> None:
     """``stereo --window``: a depth map per window of two streams
     (:mod:`bistair.app.stereo_stream`)."""
     from ..progress import Progress
@@ -119,10 +123,16 @@ def _stereo_stream(left: str, right: str, spec_path: Path | None, calibration: P
     if strategy is not None:
         raise CliError("--strategy does not apply to a stream (--window): stereo phase "
                        "unwrapping decodes it")
+    if smooth is not None:
+        raise CliError("--smooth does not apply to a stream (--window): stereo phase "
+                       "unwrapping takes each pixel's depth from the projector column of its "
+                       "phase, with no smoothing")
     with Progress(quiet) as say:
         kept = stereo_stream(left, right, out, calibration, spec_path, window, starts,
                              *depth, force=force, min_modulation=min_modulation,
-                             progress=say)
+                             previews=previews, progress=say)
+    for message in dict.fromkeys(w for r in kept for w in r.info.get("warnings", [])):
+        click.echo(f"Warning: {message}", err=True)  # (as one set's; also when quiet)
     if quiet:
         return
     shares = [r.info["decided_fraction"] for r in kept]
