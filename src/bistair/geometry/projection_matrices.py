@@ -197,7 +197,9 @@ def with_pixel_origin(calibration: StereoCalibration, shift: float) -> StereoCal
     Returns
     -------
     StereoCalibration
-        A copy; ``shift`` 0 returns ``calibration`` itself.
+        A copy; ``shift`` 0 returns ``calibration`` itself. A recorded ``pixel_origin``
+        (the origin its file was read with) moves with it: the model read from origin
+        ``o`` is the one read from origin ``o + shift``.
 
     Examples
     --------
@@ -207,6 +209,8 @@ def with_pixel_origin(calibration: StereoCalibration, shift: float) -> StereoCal
     >>> moved = with_pixel_origin(cal, 1)
     >>> moved.left.K[:2, 2].tolist(), moved.right.K[:2, 2].tolist()
     ([319.5, 239.5], [319.5, 239.5])
+    >>> with_pixel_origin(cal.replace(pixel_origin=1), -1).pixel_origin  # read as 0-based
+    0
     """
     if shift == 0:
         return calibration
@@ -217,7 +221,10 @@ def with_pixel_origin(calibration: StereoCalibration, shift: float) -> StereoCal
         K[1, 2] -= shift
         return dataclasses.replace(dev, K=K)
 
-    return calibration.replace(left=moved(calibration.left), right=moved(calibration.right))
+    read = calibration.pixel_origin  # the origin the file was read with, if recorded
+    read = None if read is None or read + shift not in (0, 1) else int(read + shift)
+    return calibration.replace(left=moved(calibration.left), right=moved(calibration.right),
+                               pixel_origin=read)
 
 
 def registration(calibration: StereoCalibration, left: np.ndarray, right: np.ndarray,
