@@ -14,8 +14,9 @@ branches (float32, :data:`SLACK` for its rounding) keeps the intervals where the
 most the step (about one a pixel in a search 12 px wide, against 13); only those are
 tested as before, in float64: the same candidates in the same order. The candidate's
 projector column takes one division (the point's coordinates times its disparity; the
-full search's takes four): the same test to rounding (``unwrap_rows``' decisions, bit for
-bit, on the test stream).
+full search's takes four), and without distortion comes from coefficients of the row
+linear in the pixel and the disparity (:func:`_row_plane`): the same test to rounding
+(``unwrap_rows``' decisions, bit for bit, on the test stream).
 
 Examples
 --------
@@ -84,8 +85,8 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
           x: int, a: float, j0: int, j1: int, lo: float, hi: float, shift: float, f: float,
           cx: float, yr: float, tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
           rp: np.ndarray, tp: np.ndarray, period: float, tolerance: float, zmin: float,
-          zmax: float, width: int, from_right: bool, skip: bool, kept: np.ndarray
-          ) -> tuple[int, float]:
+          zmax: float, width: int, from_right: bool, skip: bool, kept: np.ndarray,
+          plane: np.ndarray) -> tuple[int, float]:
     """The consistent candidates in the depth range of one pixel among the crossings of
     ``a`` on ``other``'s row between columns ``j0`` and ``j1`` (disparities ``lo..hi``):
     their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``); the
@@ -121,7 +122,13 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
         if not (lo <= d <= hi and k * d > 0.0):  # (k * d: the depth k / d beyond 0)
             continue
         xl = ((xs if from_right else x) - cx) * inv_f
-        u, pzd = _column(xl, yr, d, k, back, kp, dp, rp, tp)
+        if plane[7] != 0.0:  # no distortion: the column of the row's coefficients (_row_plane)
+            z = plane[3] * xl + plane[4] + tp[2] * d
+            u = (plane[0] * xl + plane[1] + plane[2] * d) / z + kp[0, 2] if z * d > 0.0 \
+                else math.nan
+            pzd = plane[5] * xl + plane[6]
+        else:
+            u, pzd = _column(xl, yr, d, k, back, kp, dp, rp, tp)
         if not (-0.5 <= u <= width - 0.5):
             continue
         miss = u * per_column - a
@@ -135,6 +142,29 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
             if count <= kept.shape[2]:
                 kept[y, x, count - 1] = d
     return count, found
+
+
+@inline
+def _row_plane(yr: float, k: float, back: np.ndarray, kp: np.ndarray, rp: np.ndarray,
+               tp: np.ndarray, plane: np.ndarray) -> None:
+    """The coefficients of :func:`_column` without distortion on the rectified row ``yr``,
+    linear in the point's ``xl`` and ``d``: the projector's ``(K X)_x`` (``plane[0] * xl +
+    plane[1] + plane[2] * d``), ``Z`` (``plane[3] * xl + plane[4] + tp[2] * d``) and the
+    left camera's depth (``plane[5] * xl + plane[6]``), each times ``d``."""
+    a0, a1, a2 = back[0, 0], back[1, 0], back[2, 0]  # q = a * xl + b: the ray
+    b0 = back[0, 1] * yr + back[0, 2]
+    b1 = back[1, 1] * yr + back[1, 2]
+    b2 = back[2, 1] * yr + back[2, 2]
+    ax = k * (rp[0, 0] * a0 + rp[0, 1] * a1 + rp[0, 2] * a2)
+    bx = k * (rp[0, 0] * b0 + rp[0, 1] * b1 + rp[0, 2] * b2)
+    ay = k * (rp[1, 0] * a0 + rp[1, 1] * a1 + rp[1, 2] * a2)
+    by = k * (rp[1, 0] * b0 + rp[1, 1] * b1 + rp[1, 2] * b2)
+    plane[0] = kp[0, 0] * ax + kp[0, 1] * ay
+    plane[1] = kp[0, 0] * bx + kp[0, 1] * by
+    plane[2] = kp[0, 0] * tp[0] + kp[0, 1] * tp[1]
+    plane[3] = k * (rp[2, 0] * a0 + rp[2, 1] * a1 + rp[2, 2] * a2)
+    plane[4] = k * (rp[2, 0] * b0 + rp[2, 1] * b1 + rp[2, 2] * b2)
+    plane[5], plane[6], plane[7] = k * a2, k * b2, 1.0
 
 
 @inline
@@ -185,7 +215,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
            lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
            back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
            period: float, tolerance: float, zmin: float, zmax: float, width: int,
-           from_right: bool, keep: int, needed: np.ndarray, skip: bool
+           from_right: bool, keep: int, needed: np.ndarray, skip: bool, plain: bool
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     h, w = own.shape
     gated = needed.shape[0] == h
@@ -198,6 +228,9 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
         yr = (y - cy) / f
         steps = np.empty(wr, np.float32)
         index = np.empty(wr, np.int64)
+        plane = np.zeros(8, np.float64)  # (plane[7]: 1 without distortion)
+        if plain:
+            _row_plane(yr, -f * tx, back, kp, rp, tp, plane)
         if skip:
             _steps(other, y, steps)
         for x in range(w):
@@ -220,7 +253,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
                     k0, k1 = int(math.floor(x - shift - phi)), int(math.ceil(x - shift - plo))
                 count, d = _scan(own, other, steps, index, y, x, a, k0, k1, plo, phi, shift,
                                  f, cx, yr, tx, back, kp, dp, rp, tp, period, tolerance, zmin,
-                                 zmax, width, from_right, skip, kept)
+                                 zmax, width, from_right, skip, kept, plane)
                 if count == 1:
                     n_in[y, x] = 1
                     disparity[y, x] = d
@@ -231,7 +264,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
                 continue
             count, d = _scan(own, other, steps, index, y, x, a, j0, j1, lo, hi, shift, f, cx,
                              yr, tx, back, kp, dp, rp, tp, period, tolerance, zmin, zmax,
-                             width, from_right, skip, kept)
+                             width, from_right, skip, kept, plane)
             n_in[y, x] = min(count, 32000)
             if count == 1:
                 disparity[y, x] = d
@@ -322,7 +355,8 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                   arr(tp, (3,)), float(period), float(tolerance), float(zmin), float(zmax),
                   int(width), bool(from_right), int(keep),
                   np.zeros((0, 0), np.uint8) if needed is None
-                  else np.ascontiguousarray(needed, np.uint8), bool(skip))
+                  else np.ascontiguousarray(needed, np.uint8), bool(skip),
+                  bool(skip and not np.any(np.asarray(dp, np.float64)[:5])))
 
 
 @kernel(parallel=True)
