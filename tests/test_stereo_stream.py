@@ -300,7 +300,7 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
     for args, kwargs, fast in calls:
         slow = plain(*args, **kwargs, skip=False)
         n_in = fast[0]
-        assert np.array_equal(n_in, slow[0]) and np.array_equal(fast[2], slow[2])
+        assert np.sum(n_in != slow[0]) == 0 and np.array_equal(fast[2], slow[2])
         assert np.array_equal(fast[1], slow[1], equal_nan=True)
         read = np.arange(fast[3].shape[2]) < np.clip(n_in, 0, None)[..., None]
         assert np.array_equal(fast[3][read], slow[3][read])
@@ -309,7 +309,7 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
         side = {"from_right": kwargs.get("from_right", False)}
         full = plain(own, other, np.full_like(previous, np.nan), margin, *rest, **side)
         want = unwrap_rows(own, other, *rest, **side)
-        assert np.array_equal(full[0], want[0])
+        assert np.sum(full[0] != want[0]) == 0
         assert np.array_equal(full[1], want[1], equal_nan=True)
         assert np.sum(want[0] >= 2) > 0 and np.sum(want[0] == 1) > 1000
     assert near > 10000

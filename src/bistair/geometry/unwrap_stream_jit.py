@@ -13,10 +13,9 @@ has ``e_j = near(o_j - a)`` and ``e_(j+1)`` of opposite signs less than pi apart
 branches (float32, :data:`SLACK` for its rounding) keeps the intervals where the sum is at
 most the step (about one a pixel in a search 12 px wide, against 13); only those are
 tested as before, in float64: the same candidates in the same order. The candidate's
-projector column takes one division (the point's coordinates times its disparity; the
-full search's takes four), and without distortion comes from coefficients of the row
-linear in the pixel and the disparity (:func:`_row_plane`): the same test to rounding
-(``unwrap_rows``' decisions, bit for bit, on the test stream).
+projector column comes, without distortion, from coefficients of the row linear in the
+pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
+same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
 
 Examples
 --------
@@ -127,8 +126,14 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
             u = (plane[0] * xl + plane[1] + plane[2] * d) / z + kp[0, 2] if z * d > 0.0 \
                 else math.nan
             pzd = plane[5] * xl + plane[6]
-        else:
-            u, pzd = _column(xl, yr, d, k, back, kp, dp, rp, tp)
+        else:  # distortion: the point (as the full search finds it), then its projection
+            zr = k / d
+            qx, qy = xl * zr, yr * zr
+            pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
+            u = _project(back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr,
+                         back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr, pz, kp, dp, rp,
+                         tp)[0]
+            pzd = pz * d
         if not (-0.5 <= u <= width - 0.5):
             continue
         miss = u * per_column - a
@@ -147,10 +152,11 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
 @inline
 def _row_plane(yr: float, k: float, back: np.ndarray, kp: np.ndarray, rp: np.ndarray,
                tp: np.ndarray, plane: np.ndarray) -> None:
-    """The coefficients of :func:`_column` without distortion on the rectified row ``yr``,
-    linear in the point's ``xl`` and ``d``: the projector's ``(K X)_x`` (``plane[0] * xl +
-    plane[1] + plane[2] * d``), ``Z`` (``plane[3] * xl + plane[4] + tp[2] * d``) and the
-    left camera's depth (``plane[5] * xl + plane[6]``), each times ``d``."""
+    """The coefficients of a candidate's projector column without distortion on the
+    rectified row ``yr``, linear in the point's ``xl`` and ``d`` (the point is ``(xl, yr,
+    1) * k / d``): the projector's ``(K X)_x`` (``plane[0] * xl + plane[1] + plane[2] * d``),
+    ``Z`` (``plane[3] * xl + plane[4] + tp[2] * d``) and the left camera's depth
+    (``plane[5] * xl + plane[6]``), each times ``d``; ``plane[7]`` 1."""
     a0, a1, a2 = back[0, 0], back[1, 0], back[2, 0]  # q = a * xl + b: the ray
     b0 = back[0, 1] * yr + back[0, 2]
     b1 = back[1, 1] * yr + back[1, 2]
@@ -165,30 +171,6 @@ def _row_plane(yr: float, k: float, back: np.ndarray, kp: np.ndarray, rp: np.nda
     plane[3] = k * (rp[2, 0] * a0 + rp[2, 1] * a1 + rp[2, 2] * a2)
     plane[4] = k * (rp[2, 0] * b0 + rp[2, 1] * b1 + rp[2, 2] * b2)
     plane[5], plane[6], plane[7] = k * a2, k * b2, 1.0
-
-
-@inline
-def _column(xl: float, yr: float, d: float, k: float, back: np.ndarray, kp: np.ndarray,
-            dp: np.ndarray, rp: np.ndarray, tp: np.ndarray) -> tuple[float, float]:
-    """The projector column of the point ``(xl, yr, 1) * k / d`` of the rectified left frame
-    (:func:`_project`'s, in one division: the point's coordinates times ``d``), NaN
-    behind the projector, and the point's depth in the left camera's frame times ``d``."""
-    qx = back[0, 0] * xl + back[0, 1] * yr + back[0, 2]
-    qy = back[1, 0] * xl + back[1, 1] * yr + back[1, 2]
-    qz = back[2, 0] * xl + back[2, 1] * yr + back[2, 2]
-    x = k * (rp[0, 0] * qx + rp[0, 1] * qy + rp[0, 2] * qz) + tp[0] * d
-    y = k * (rp[1, 0] * qx + rp[1, 1] * qy + rp[1, 2] * qz) + tp[1] * d
-    z = k * (rp[2, 0] * qx + rp[2, 1] * qy + rp[2, 2] * qz) + tp[2] * d
-    if not z * d > 0.0:
-        return math.nan, k * qz
-    inv = 1.0 / z
-    x *= inv
-    y *= inv
-    r2 = x * x + y * y
-    radial = 1.0 + r2 * (dp[0] + r2 * (dp[1] + r2 * dp[4]))
-    xd = x * radial + 2.0 * dp[2] * x * y + dp[3] * (r2 + 2.0 * x * x)
-    yd = y * radial + dp[2] * (r2 + 2.0 * y * y) + 2.0 * dp[3] * x * y
-    return kp[0, 0] * xd + kp[0, 1] * yd + kp[0, 2], k * qz
 
 
 @inline
