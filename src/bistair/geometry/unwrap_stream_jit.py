@@ -110,9 +110,14 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
             n += before + after <= steps[j]
     k = -f * tx  # the depth times the disparity
     inv_f, per_column = 1.0 / f, TWO_PI / period
+    e1 = _near(float(other[y, first]) - a)
     for q in range(n):
-        j = index[q] if skip else first + q
-        e0 = _near(float(other[y, j]) - a)
+        if skip:
+            j = index[q]
+            e0 = _near(float(other[y, j]) - a)
+        else:  # (every interval: the last one's end)
+            j = first + q
+            e0 = e1
         e1 = _near(float(other[y, j + 1]) - a)
         if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
             continue
