@@ -91,9 +91,10 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
     their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``); the
     first ``kept.shape[2]`` candidates' disparities into ``kept[y, x]``.
 
-    With ``skip``, only the intervals whose left end lies within a phase step of ``a``
-    (``steps``: :func:`_steps`) are tested: a crossing needs it (the module's docstring);
-    the same candidates, in the same order."""
+    With ``skip``, only the intervals whose ends' phase distances to ``a`` add up to at
+    most the step between them (``steps``: :func:`_steps`) are tested: a crossing needs it
+    (the module's docstring); the same candidates, in the same order. ``plane``:
+    :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector is distorted)."""
     count = 0
     found = math.nan
     first = max(j0, 0)
