@@ -290,7 +290,7 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
     def recorded(*args, **kwargs):
         copies = [np.copy(a) if isinstance(a, np.ndarray) else a for a in args]
         out = plain(*args, **kwargs)
-        calls.append((copies, kwargs, [np.copy(a) for a in out]))  # (the stream grows them)
+        calls.append((copies, kwargs, [np.copy(a) for a in out]))  # (its buffers are reused)
         return out
 
     monkeypatch.setattr(unwrap_stream, "track_rows", recorded)
