@@ -14,8 +14,11 @@ on one numba and OpenCV thread), its CPU and wall time on the machine's threads,
 share of its work that runs in parallel (Amdahl's law from the two). The rate a dedicated
 machine of that many cores gets is each stage's work at its parallel share (the rest of a
 depth map serial), beside the wall time measured here and the load average: other jobs on
-the cores lower the measured share and the rate. The decided pixels an order off are
-counted against the renderer's truth after the timing.
+the cores lower the measured share and the rate. The row searches of one depth map (both
+grids, one thread) are timed again as they were before the fast path: every interval of a
+search tested and each candidate projected as the full search does (``track_rows(...,
+skip=False)``, the same result). The decided pixels an
+order off are counted against the renderer's truth after the timing.
 
     python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
 """
@@ -139,6 +142,34 @@ def parallel_split(stream: StereoStream, left: np.ndarray, right: np.ndarray, fi
     return out
 
 
+def search_split(stream: StereoStream, left: np.ndarray, right: np.ndarray, first: int,
+                 rounds: int) -> dict[str, float]:
+    """CPU seconds (one thread) of one depth map's row searches, both grids, with the fast
+    path and with every interval tested: the minimum of ``rounds`` interleaved rounds on
+    the arguments of the window of frame ``first``."""
+    calls: list[tuple[tuple, dict]] = []
+    plain = unwrap_stream.track_rows
+
+    def recorded(*args: object, **kwargs: object) -> object:
+        calls.append((args, kwargs))
+        return plain(*args, **kwargs)
+
+    unwrap_stream.track_rows = recorded
+    try:
+        stream.push(left[first % len(left)], right[first % len(right)])
+    finally:
+        unwrap_stream.track_rows = plain
+    before = numba.get_num_threads()
+    threads(1)
+    best = {"fast": float("inf"), "every interval": float("inf")}
+    for _ in range(rounds):
+        for name, skip in (("fast", True), ("every interval", False)):
+            best[name] = min(best[name], cpu(lambda skip=skip: [
+                plain(*args, **kwargs, skip=skip) for args, kwargs in calls]))
+    threads(before)
+    return best
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--camera", default="640x480")
@@ -213,6 +244,13 @@ def main(argv: list[str] | None = None) -> int:
               f"share; the rest serial); measured here: {1000 * work[2]:.1f} ms wall "
               f"({1 / work[2]:.0f} maps/s) at load {os.getloadavg()[0]:.1f}; every stage "
               f"wholly parallel: {cores / work[0]:.0f} maps/s")
+    searches = search_split(streams["4"], left, right, position["4"], args.rounds)
+    position["4"] += 1
+    print(f"\nrow searches of a depth map (--window 4, both grids, 1 thread): "
+          f"{1000 * searches['fast']:.2f} ms; every interval tested: "
+          f"{1000 * searches['every interval']:.2f} ms "
+          f"({searches['every interval'] / searches['fast']:.2f}x); / remap: "
+          f"{searches['fast'] / base:.1f} and {searches['every interval'] / base:.1f}")
     print()
     off = {name: [0, 0] for name in streams}
     for name, results in kept.items():  # (after the timing)

@@ -272,3 +272,44 @@ def test_the_first_window_settles_the_pixel_origin(sim):
         seen = decided & np.isfinite(truth)
         assert seen.sum() > 0.5 * np.isfinite(truth).sum()
         assert np.median(np.abs(result.depth[seen] - truth[seen])) < 1.0
+
+
+def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
+    """:func:`~bistair.geometry.unwrap_stream_jit.track_rows` tests only the intervals whose
+    two ends lie within a phase step of the pixel's phase (a crossing needs it) and its
+    candidates' projector column in one division: on every tracked window of the test
+    stream, both grids, it gives what the plain scan gives (every interval), and its full
+    search (no previous disparity) what :func:`~bistair.geometry.unwrap_jit.unwrap_rows`
+    gives, bit for bit."""
+    from bistair.geometry import unwrap_stream
+    from bistair.geometry.unwrap_jit import unwrap_rows
+
+    calls = []
+    plain = unwrap_stream.track_rows
+
+    def recorded(*args, **kwargs):
+        copies = [np.copy(a) if isinstance(a, np.ndarray) else a for a in args]
+        out = plain(*args, **kwargs)
+        calls.append((copies, kwargs, [np.copy(a) for a in out]))  # (its buffers are reused)
+        return out
+
+    monkeypatch.setattr(unwrap_stream, "track_rows", recorded)
+    windows(sim, 0, 6.0)
+    assert len(calls) == 12  # six tracked windows, two grids each
+    near = 0
+    for args, kwargs, fast in calls:
+        slow = plain(*args, **kwargs, skip=False)
+        n_in = fast[0]
+        assert np.sum(n_in != slow[0]) == 0 and np.array_equal(fast[2], slow[2])
+        assert np.array_equal(fast[1], slow[1], equal_nan=True)
+        read = np.arange(fast[3].shape[2]) < np.clip(n_in, 0, None)[..., None]
+        assert np.array_equal(fast[3][read], slow[3][read])
+        near += int(fast[2].sum())
+        own, other, previous, margin, *rest = args
+        side = {"from_right": kwargs.get("from_right", False)}
+        full = plain(own, other, np.full_like(previous, np.nan), margin, *rest, **side)
+        want = unwrap_rows(own, other, *rest, **side)
+        assert np.sum(full[0] != want[0]) == 0
+        assert np.array_equal(full[1], want[1], equal_nan=True)
+        assert np.sum(want[0] >= 2) > 0 and np.sum(want[0] == 1) > 1000
+    assert near > 10000

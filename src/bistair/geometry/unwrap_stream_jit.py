@@ -7,6 +7,16 @@ They run over rows on every core and have no NumPy twin (the row search has no o
 NumPy form); ``tests/test_stereo_stream.py`` checks them against the renderer's truth and
 against :func:`~bistair.geometry.unwrap.unwrap_stereo`'s full search.
 
+The row search tests few intervals: a crossing of ``a`` between columns ``j`` and ``j + 1``
+has ``e_j = near(o_j - a)`` and ``e_(j+1)`` of opposite signs less than pi apart, so
+``|e_j| + |e_(j+1)|`` is the phase step ``|near(o_(j+1) - o_j)|``. One pass without
+branches (float32, :data:`SLACK` for its rounding) keeps the intervals where the sum is at
+most the step (about one a pixel in a search 12 px wide, against 13); only those are
+tested as before, in float64: the same candidates in the same order. The candidate's
+projector column comes, without distortion, from coefficients of the row linear in the
+pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
+same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
+
 Examples
 --------
 The rig of :mod:`bistair.geometry.unwrap_jit` (``f`` = 100 px, cameras 100 mm apart, a
@@ -38,6 +48,10 @@ from .unwrap_jit import KEPT
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
+INV_TWO_PI = 1.0 / TWO_PI
+PI32, TWO_PI32 = np.float32(math.pi), np.float32(TWO_PI)
+#: What the skip leaves for rounding (radians; float32's own is below 1e-6).
+SLACK = np.float32(1e-4)
 
 
 @inline
@@ -51,50 +65,118 @@ def _near(difference: float) -> float:
 
 
 @inline
-def _scan(own: np.ndarray, other: np.ndarray, y: int, x: int, a: float, j0: int, j1: int,
-          lo: float, hi: float, shift: float, f: float, cx: float, yr: float, tx: float,
-          back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
-          period: float, tolerance: float, zmin: float, zmax: float, width: int,
-          from_right: bool, kept: np.ndarray) -> tuple[int, float]:
+def _near32(difference: np.float32) -> np.float32:
+    """:func:`_near` in float32, by selects (so that its loops vectorise)."""
+    d = difference - TWO_PI32 if difference >= PI32 else difference
+    return d + TWO_PI32 if difference < -PI32 else d
+
+
+@inline
+def _steps(other: np.ndarray, y: int, steps: np.ndarray) -> None:
+    """``steps[j]``: the phase step from column ``j`` to ``j + 1`` of ``other``'s row ``y``
+    (``|_near|`` of their difference, in float32) plus :data:`SLACK`; NaN beside a NaN."""
+    for j in range(other.shape[1] - 1):
+        steps[j] = abs(_near32(other[y, j + 1] - other[y, j])) + SLACK
+
+
+@inline
+def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarray, y: int,
+          x: int, a: float, j0: int, j1: int, lo: float, hi: float, shift: float, f: float,
+          cx: float, yr: float, tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
+          rp: np.ndarray, tp: np.ndarray, period: float, tolerance: float, zmin: float,
+          zmax: float, width: int, from_right: bool, skip: bool, kept: np.ndarray,
+          plane: np.ndarray) -> tuple[int, float]:
     """The consistent candidates in the depth range of one pixel among the crossings of
     ``a`` on ``other``'s row between columns ``j0`` and ``j1`` (disparities ``lo..hi``):
     their count and, for one, its disparity (the test of ``unwrap_jit._unwrap``); the
-    first ``kept.shape[2]`` candidates' disparities into ``kept[y, x]``."""
-    wr = other.shape[1]
+    first ``kept.shape[2]`` candidates' disparities into ``kept[y, x]``.
+
+    With ``skip``, only the intervals whose ends' phase distances to ``a`` add up to at
+    most the step between them (``steps``: :func:`_steps`) are tested: a crossing needs it
+    (the module's docstring); the same candidates, in the same order. ``plane``:
+    :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector is distorted)."""
     count = 0
     found = math.nan
     first = max(j0, 0)
+    end = min(j1, other.shape[1] - 1)
+    n = end - first
+    if skip:  # (one pass without branches)
+        a32 = np.float32(a)
+        n = 0
+        after = abs(_near32(other[y, first] - a32))
+        for j in range(first, end):
+            before = after
+            after = abs(_near32(other[y, j + 1] - a32))
+            index[n] = j
+            n += before + after <= steps[j]
+    k = -f * tx  # the depth times the disparity
+    inv_f, per_column = 1.0 / f, TWO_PI / period
     e1 = _near(float(other[y, first]) - a)
-    for j in range(first, min(j1, wr - 1)):
-        e0 = e1
+    for q in range(n):
+        if skip:
+            j = index[q]
+            e0 = _near(float(other[y, j]) - a)
+        else:  # (every interval: the last one's end)
+            j = first + q
+            e0 = e1
         e1 = _near(float(other[y, j + 1]) - a)
         if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
             continue
         xs = j + e0 / (e0 - e1)
         d = xs - x - shift if from_right else x - xs - shift
-        if not (lo <= d <= hi):
+        if not (lo <= d <= hi and k * d > 0.0):  # (k * d: the depth k / d beyond 0)
             continue
-        zr = -f * tx / d
-        if not zr > 0.0:
-            continue
-        xl = ((xs if from_right else x) - cx) / f
-        qx, qy = xl * zr, yr * zr
-        px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
-        py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
-        pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
-        u, _ = _project(px, py, pz, kp, dp, rp, tp)
+        xl = ((xs if from_right else x) - cx) * inv_f
+        if plane[7] != 0.0:  # no distortion: the column of the row's coefficients (_row_plane)
+            z = plane[3] * xl + plane[4] + tp[2] * d
+            u = (plane[0] * xl + plane[1] + plane[2] * d) / z + kp[0, 2] if z * d > 0.0 \
+                else math.nan
+            pzd = plane[5] * xl + plane[6]
+        else:  # distortion: the point (as the full search finds it), then its projection
+            zr = k / d
+            qx, qy = xl * zr, yr * zr
+            pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
+            u = _project(back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr,
+                         back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr, pz, kp, dp, rp,
+                         tp)[0]
+            pzd = pz * d
         if not (-0.5 <= u <= width - 0.5):
             continue
-        miss = TWO_PI * u / period - a
-        miss = abs(miss - TWO_PI * math.floor((miss + math.pi) / TWO_PI))
+        miss = u * per_column - a
+        miss = abs(miss - TWO_PI * math.floor(miss * INV_TWO_PI + 0.5))
         if miss > tolerance:
             continue
-        if zmin <= pz <= zmax:
+        near_z, far_z = (zmin * d, zmax * d) if d > 0.0 else (zmax * d, zmin * d)
+        if near_z <= pzd <= far_z:  # (the depth k / d in the range)
             count += 1
             found = d if count == 1 else math.nan
             if count <= kept.shape[2]:
                 kept[y, x, count - 1] = d
     return count, found
+
+
+@inline
+def _row_plane(yr: float, k: float, back: np.ndarray, kp: np.ndarray, rp: np.ndarray,
+               tp: np.ndarray, plane: np.ndarray) -> None:
+    """The coefficients of a candidate's projector column without distortion on the
+    rectified row ``yr``, linear in the point's ``xl`` and ``d`` (the point is ``(xl, yr,
+    1) * k / d``): the projector's ``(K X)_x`` (``plane[0] * xl + plane[1] + plane[2] * d``),
+    ``Z`` (``plane[3] * xl + plane[4] + tp[2] * d``) and the left camera's depth
+    (``plane[5] * xl + plane[6]``), each times ``d``; ``plane[7]`` 1."""
+    a0, a1, a2 = back[0, 0], back[1, 0], back[2, 0]  # q = a * xl + b: the ray
+    b0 = back[0, 1] * yr + back[0, 2]
+    b1 = back[1, 1] * yr + back[1, 2]
+    b2 = back[2, 1] * yr + back[2, 2]
+    ax = k * (rp[0, 0] * a0 + rp[0, 1] * a1 + rp[0, 2] * a2)
+    bx = k * (rp[0, 0] * b0 + rp[0, 1] * b1 + rp[0, 2] * b2)
+    ay = k * (rp[1, 0] * a0 + rp[1, 1] * a1 + rp[1, 2] * a2)
+    by = k * (rp[1, 0] * b0 + rp[1, 1] * b1 + rp[1, 2] * b2)
+    plane[0] = kp[0, 0] * ax + kp[0, 1] * ay
+    plane[1] = kp[0, 0] * bx + kp[0, 1] * by
+    plane[2] = kp[0, 0] * tp[0] + kp[0, 1] * tp[1]
+    plane[3] = k * (rp[2, 0] * a0 + rp[2, 1] * a1 + rp[2, 2] * a2)
+    plane[4] = k * (rp[2, 0] * b0 + rp[2, 1] * b1 + rp[2, 2] * b2)
+    plane[5], plane[6], plane[7] = k * a2, k * b2, 1.0
 
 
 @inline
@@ -121,7 +203,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
            lo: float, hi: float, shift: float, f: float, cx: float, cy: float, tx: float,
            back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray, tp: np.ndarray,
            period: float, tolerance: float, zmin: float, zmax: float, width: int,
-           from_right: bool, keep: int, needed: np.ndarray
+           from_right: bool, keep: int, needed: np.ndarray, skip: bool, plain: bool
            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     h, w = own.shape
     gated = needed.shape[0] == h
@@ -132,6 +214,13 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
     near = np.zeros((h, w), np.uint8)
     for y in prange(h):
         yr = (y - cy) / f
+        steps = np.empty(wr, np.float32)
+        index = np.empty(wr, np.int64)
+        plane = np.zeros(8, np.float64)  # (plane[7]: 1 without distortion)
+        if plain:
+            _row_plane(yr, -f * tx, back, kp, rp, tp, plane)
+        if skip:
+            _steps(other, y, steps)
         for x in range(w):
             a = float(own[y, x])
             if a != a:
@@ -150,9 +239,9 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
                     k0, k1 = int(math.floor(x + shift + plo)), int(math.ceil(x + shift + phi))
                 else:
                     k0, k1 = int(math.floor(x - shift - phi)), int(math.ceil(x - shift - plo))
-                count, d = _scan(own, other, y, x, a, k0, k1, plo, phi, shift, f, cx, yr, tx,
-                                 back, kp, dp, rp, tp, period, tolerance, zmin, zmax, width,
-                                 from_right, kept)
+                count, d = _scan(own, other, steps, index, y, x, a, k0, k1, plo, phi, shift,
+                                 f, cx, yr, tx, back, kp, dp, rp, tp, period, tolerance, zmin,
+                                 zmax, width, from_right, skip, kept, plane)
                 if count == 1:
                     n_in[y, x] = 1
                     disparity[y, x] = d
@@ -161,9 +250,9 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
             if gated and needed[y, x] == 0:  # no pixel of the other grid reads it
                 n_in[y, x] = -2
                 continue
-            count, d = _scan(own, other, y, x, a, j0, j1, lo, hi, shift, f, cx, yr, tx, back,
-                             kp, dp, rp, tp, period, tolerance, zmin, zmax, width, from_right,
-                             kept)
+            count, d = _scan(own, other, steps, index, y, x, a, j0, j1, lo, hi, shift, f, cx,
+                             yr, tx, back, kp, dp, rp, tp, period, tolerance, zmin, zmax,
+                             width, from_right, skip, kept, plane)
             n_in[y, x] = min(count, 32000)
             if count == 1:
                 disparity[y, x] = d
@@ -175,7 +264,7 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
                tp: np.ndarray, period: float, tolerance: float, zmin: float, zmax: float,
                width: int, from_right: bool = False, keep: int = KEPT,
-               needed: np.ndarray | None = None
+               needed: np.ndarray | None = None, skip: bool = True
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The consistent candidates of each rectified pixel, searched first within
     ``margin`` of its ``previous`` disparity and over the full range ``[lo, hi]`` where
@@ -209,6 +298,9 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
         pixels whose decision the other grid's confirmation reads); a pixel of 0 whose
         narrow search does not decide is left undecided (``n_in`` -2). By default every
         pixel.
+    skip : bool, optional
+        Test only the intervals where a crossing can lie (the module's docstring; the same
+        result); ``False`` tests every interval of the search.
 
     Returns
     -------
@@ -251,7 +343,8 @@ def track_rows(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin:
                   arr(tp, (3,)), float(period), float(tolerance), float(zmin), float(zmax),
                   int(width), bool(from_right), int(keep),
                   np.zeros((0, 0), np.uint8) if needed is None
-                  else np.ascontiguousarray(needed, np.uint8))
+                  else np.ascontiguousarray(needed, np.uint8), bool(skip),
+                  bool(skip and not np.any(np.asarray(dp, np.float64)[:5])))
 
 
 @kernel(parallel=True)
