@@ -313,3 +313,29 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
         assert np.array_equal(full[1], want[1], equal_nan=True)
         assert np.sum(want[0] >= 2) > 0 and np.sum(want[0] == 1) > 1000
     assert near > 10000
+
+
+def test_every_window_leaves_mixed_pixels_undecided(sim, monkeypatch):
+    """Every window, tracked or searched in full, leaves undecided the pixels
+    :func:`~bistair.geometry.unwrap.mixed_pixels` finds in its depth (ramps across depth
+    steps, spikes), as the one-set ``stereo`` does: NaN depth and phase, order -1, and
+    ``info["mixed"]`` counts them. This stream has none (smooth masks at 160 x 120): the
+    check here also flags every 50th decided pixel, to see the stream honour what it
+    returns (without the stream's call, the tracked windows kept them)."""
+    from bistair.geometry import unwrap_stream
+
+    found, real = [], unwrap_stream.mixed_pixels
+
+    def recorded(depth, mask, *args):
+        flagged = real(depth, mask, *args)
+        flagged.ravel()[np.flatnonzero(mask)[::50]] = True
+        found.append(flagged & mask)
+        return found[-1]
+
+    monkeypatch.setattr(unwrap_stream, "mixed_pixels", recorded)
+    tracked, _ = windows(sim, 0, 6.0)
+    assert len(found) == len(tracked) and all(m.sum() > 50 for m in found)
+    for result, mixed in zip(tracked, found, strict=True):
+        assert result.info["mixed"] == mixed.sum()
+        assert np.isnan(result.depth[mixed]).all() and np.isnan(result.phase[mixed]).all()
+        assert (result.order[mixed] == -1).all() and not result.mask[mixed].any()

@@ -10,7 +10,10 @@ code in src calls them; issue 35 moved them here from the concept modules):
 * :func:`period_jumps`: the links a fringe period jump cuts
   (``bistair.core.regions_jit.link_bits``);
 * :func:`mode_by_label`: the most frequent value per label
-  (``bistair.codecs.bidirectional.paper_jit.run_label_modes``).
+  (``bistair.codecs.bidirectional.paper_jit.run_label_modes``);
+* :func:`mixed_pixels`: the decided pixels of a stereo depth map in a ramp or a spike
+  (``bistair.geometry.unwrap_jit.mixed_mask``, which ``unwrap.mixed_pixels`` runs), with
+  the projector's own model (distortion and all) for the depth one column moves.
 """
 
 from __future__ import annotations
@@ -256,3 +259,45 @@ def mode_by_label(labels: np.ndarray, values: np.ndarray, n_labels: int, n_value
     support = counts.max(axis=1)
     mode[support <= 0] = -1
     return mode.astype(np.int64), support
+
+
+def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration, period: float,
+                 noise: float, rays: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """NumPy reference of :func:`bistair.geometry.unwrap.mixed_pixels` (as first written:
+    the depth one column moves by triangulating the next column, distortion included)."""
+    from bistair.geometry.calibration import Calibration
+    from bistair.geometry.stereo import grid_points
+    from bistair.geometry.triangulate import triangulate
+    from bistair.geometry.unwrap import EDGE_SIGMAS, GRAZING
+
+    rows, cols = np.nonzero(mask)
+    points = grid_points(np.where(mask, depth, np.nan).astype(np.float32), *rays)[rows, cols]
+    proj = calibration.projector
+    u = proj.project(points)[:, 0]
+    pair = Calibration(calibration.left, proj.device, proj.R, proj.T)
+    pixels = np.column_stack([cols, rows]).astype(np.float64)
+    per_column = np.abs(triangulate(pixels, u + 1.0, pair)[:, 2] - points[:, 2])
+    z = np.where(mask, depth, np.nan).astype(np.float64)
+    footprint = np.full(z.shape, np.nan)
+    footprint[rows, cols] = points[:, 2] / calibration.left.K[0, 0]
+    floor = np.zeros(z.shape)
+    floor[rows, cols] = EDGE_SIGMAS * math.sqrt(2) * per_column * noise * period / (2 * np.pi)
+    cap = np.full(z.shape, np.inf)
+    cap[rows, cols] = 0.5 * per_column * period
+    h, w = z.shape
+    padded = np.pad(z, 1, constant_values=np.nan)
+    ramp = np.zeros(z.shape, bool)
+    near = np.zeros(z.shape, np.int8)
+    neighbours = np.zeros(z.shape, np.int8)
+    with np.errstate(invalid="ignore"):
+        for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):
+            limit = np.minimum(np.maximum(GRAZING * footprint * math.hypot(dy, dx), floor),
+                               cap)
+            ahead = padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] - z
+            behind = z - padded[1 - dy:1 - dy + h, 1 - dx:1 - dx + w]
+            ramp |= ((np.sign(ahead) == np.sign(behind)) & (np.abs(ahead) > limit)
+                     & (np.abs(behind) > limit))
+            for step in (ahead, behind):
+                neighbours += np.isfinite(step)
+                near += np.abs(step) <= limit
+    return mask & (ramp | ((neighbours > 0) & (near == 0)))

@@ -65,7 +65,7 @@ from .stereo import (
     rectify,
 )
 from .triangulate import check_depth_range, triangulate
-from .unwrap_jit import grow, unwrap_candidates
+from .unwrap_jit import grow, mixed_mask, unwrap_candidates
 
 #: The tolerance on the projector's phase is this many times the phase noise of the two
 #: cameras together (at least :data:`MIN_TOLERANCE` radians).
@@ -385,7 +385,9 @@ def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibra
     differs from every decided 8-neighbour by more. The limit comes from the rig:
     :data:`GRAZING` footprints (``z / f``), at least :data:`EDGE_SIGMAS` times the noise
     of two depths (the projector's depth step per column times the phase noise in
-    columns), at most half the depth step of one order (an order off is always a spike).
+    columns), at most half the depth step of one order (an order off is always a spike);
+    the depth a column moves from the projector's pinhole model (its distortion changes it
+    little). One compiled pass (:func:`~.unwrap_jit.mixed_mask`).
 
     Parameters
     ----------
@@ -423,37 +425,9 @@ def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibra
     >>> np.argwhere(mixed_pixels(z, truth.mask, cal, 48.0, 0.03, rectify(cal).rays)).tolist()
     [[30, 20], [30, 21], [30, 22], [40, 40]]
     """
-    rows, cols = np.nonzero(mask)
-    points = grid_points(np.where(mask, depth, np.nan).astype(np.float32), *rays)[rows, cols]
     proj = calibration.projector
-    u = proj.project(points)[:, 0]
-    pair = Calibration(calibration.left, proj.device, proj.R, proj.T)
-    pixels = np.column_stack([cols, rows]).astype(np.float64)
-    per_column = np.abs(triangulate(pixels, u + 1.0, pair)[:, 2] - points[:, 2])
-    z = np.where(mask, depth, np.nan).astype(np.float64)
-    footprint = np.full(z.shape, np.nan)
-    footprint[rows, cols] = points[:, 2] / calibration.left.K[0, 0]
-    floor = np.zeros(z.shape)
-    floor[rows, cols] = EDGE_SIGMAS * math.sqrt(2) * per_column * noise * period / (2 * np.pi)
-    cap = np.full(z.shape, np.inf)
-    cap[rows, cols] = 0.5 * per_column * period
-    h, w = z.shape
-    padded = np.pad(z, 1, constant_values=np.nan)
-    ramp = np.zeros(z.shape, bool)
-    near = np.zeros(z.shape, np.int8)
-    neighbours = np.zeros(z.shape, np.int8)
-    with np.errstate(invalid="ignore"):
-        for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):
-            limit = np.minimum(np.maximum(GRAZING * footprint * math.hypot(dy, dx), floor),
-                               cap)
-            ahead = padded[1 + dy:1 + dy + h, 1 + dx:1 + dx + w] - z
-            behind = z - padded[1 - dy:1 - dy + h, 1 - dx:1 - dx + w]
-            ramp |= ((np.sign(ahead) == np.sign(behind)) & (np.abs(ahead) > limit)
-                     & (np.abs(behind) > limit))
-            for step in (ahead, behind):
-                neighbours += np.isfinite(step)
-                near += np.abs(step) <= limit
-    return mask & (ramp | ((neighbours > 0) & (near == 0)))
+    return mixed_mask(depth, mask, rays, proj.R, proj.T, proj.device.K[0, 0],
+                      calibration.left.K[0, 0], noise, period, GRAZING, EDGE_SIGMAS)
 
 
 def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,

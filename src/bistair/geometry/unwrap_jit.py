@@ -388,3 +388,100 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
                  np.ascontiguousarray(n_in, np.int16),
                  np.ascontiguousarray(kept, np.float32),
                  np.ascontiguousarray(blocked, np.bool_), float(reach), int(support))
+
+
+@kernel(parallel=True)
+def _mixed(depth: np.ndarray, mask: np.ndarray, rx: np.ndarray, ry: np.ndarray,
+           rp: np.ndarray, tp: np.ndarray, fx: float, f_left: float, noise: float,
+           period: float, grazing: float, sigmas: float) -> np.ndarray:
+    h, w = depth.shape
+    dys, dxs = np.array([0, 1, 1, 1]), np.array([1, 0, 1, -1])
+    out = np.zeros((h, w), np.bool_)
+    for y in prange(h):
+        for x in range(w):
+            z = np.float64(depth[y, x])
+            if not mask[y, x] or z != z:
+                continue
+            # the depth one projector column moves along this pixel's ray (pinhole model)
+            ax = rp[0, 0] * rx[y, x] + rp[0, 1] * ry[y, x] + rp[0, 2]
+            az = rp[2, 0] * rx[y, x] + rp[2, 1] * ry[y, x] + rp[2, 2]
+            qx, qz = z * ax + tp[0], z * az + tp[2]
+            du = fx * (ax * qz - qx * az) / (qz * qz)
+            per_column = 1.0 / abs(du) if du != 0.0 else math.inf
+            floor = sigmas * math.sqrt(2.0) * per_column * noise * period / TWO_PI
+            cap = 0.5 * per_column * period
+            straight = min(max(grazing * z / f_left, floor), cap)
+            diagonal = min(max(grazing * z / f_left * math.sqrt(2.0), floor), cap)
+            ramp, seen, near = False, 0, 0
+            for k in range(4):
+                dy, dx = dys[k], dxs[k]
+                limit = straight if k < 2 else diagonal
+                ahead, behind = math.nan, math.nan
+                if 0 <= y + dy < h and 0 <= x + dx < w and mask[y + dy, x + dx]:
+                    ahead = depth[y + dy, x + dx] - z
+                if ahead == ahead:
+                    seen += 1
+                    near += abs(ahead) <= limit
+                if 0 <= y - dy < h and 0 <= x - dx < w and mask[y - dy, x - dx]:
+                    behind = z - depth[y - dy, x - dx]
+                if behind == behind:
+                    seen += 1
+                    near += abs(behind) <= limit
+                if (abs(ahead) > limit and abs(behind) > limit
+                        and (ahead > 0.0) == (behind > 0.0)):
+                    ramp = True
+            out[y, x] = ramp or (seen > 0 and near == 0)
+    return out
+
+
+def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.ndarray],
+               rotation: np.ndarray, translation: np.ndarray, fx: float, f_left: float,
+               noise: float, period: float, grazing: float, sigmas: float) -> np.ndarray:
+    """The decided pixels of a depth map that are no surface's: in a ramp (the depth steps
+    the same way to both neighbours along a row, column or diagonal, each step over the
+    limit) or a spike (over the limit from every decided 8-neighbour), the compiled pass of
+    :func:`~bistair.geometry.unwrap.mixed_pixels` (one pass, parallel over rows).
+
+    The limit of a pixel: ``grazing`` footprints (``z / f_left`` mm, times the step's
+    length), at least ``sigmas * sqrt(2)`` times the depth noise (the depth one projector
+    column moves along the pixel's ray, from the projector's pinhole model, times
+    ``noise * period / (2*pi)`` columns), at most half the depth of one fringe period.
+
+    Parameters
+    ----------
+    depth, mask : numpy.ndarray
+        ``(H, W)`` ``z`` (mm) of the left camera's pixels and where decided.
+    rays : tuple of numpy.ndarray
+        The left pixels' undistorted rays ``x / z``, ``y / z`` (each ``(H, W)``).
+    rotation, translation : numpy.ndarray
+        The projector's pose (``X_p = R X + T``, the left camera's frame).
+    fx, f_left : float
+        The projector's and the left camera's focal lengths (pixels).
+    noise, period : float
+        The phase noise (radians) and the fringe period (projector pixels).
+    grazing, sigmas : float
+        The limit's footprints and noise multiples.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` bool.
+
+    Examples
+    --------
+    >>> z = np.full((5, 9), 600.0, np.float32)
+    >>> z[2, 3:6] = [630.0, 660.0, 690.0]  # a ramp up to a wall 120 mm behind
+    >>> z[2, 6:] = 720.0
+    >>> rays = (np.zeros((5, 9), np.float32), np.zeros((5, 9), np.float32))
+    >>> pose = (np.eye(3), np.array([-100.0, 0.0, 0.0]))
+    >>> m = mixed_mask(z, np.ones(z.shape, bool), rays, *pose, 2000.0, 150.0, 0.03, 48.0,
+    ...                4.0, 4.0)
+    >>> np.argwhere(m).tolist()
+    [[2, 3], [2, 4], [2, 5]]
+    """
+    return _mixed(np.ascontiguousarray(depth, np.float32), np.ascontiguousarray(mask, bool),
+                  np.ascontiguousarray(rays[0], np.float32),
+                  np.ascontiguousarray(rays[1], np.float32),
+                  np.ascontiguousarray(rotation, np.float64),
+                  np.ascontiguousarray(translation, np.float64).ravel(), float(fx),
+                  float(f_left), float(noise), float(period), float(grazing), float(sigmas))

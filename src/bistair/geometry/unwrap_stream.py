@@ -22,7 +22,9 @@ multiply-adds a pixel; order ``K`` compensates motion). For each window:
    the full search grows them (:func:`~.unwrap_jit.grow`).
 3. The depth: the left camera's ray cut by the projector's plane of the column of the
    absolute phase (the pixel's own wrapped phase and the order its rectified neighbours
-   decided; :func:`~.unwrap_stream_jit.plane_depth`). NaN where undecided.
+   decided; :func:`~.unwrap_stream_jit.plane_depth`). NaN where undecided, and where
+   :func:`~.unwrap.mixed_pixels` finds a ramp across a depth step or a spike (every
+   window, the first too; ``info["mixed"]`` counts them).
 
 Everything that does not change between frames (the rectification, the rays in the
 projector's frame, the disparity bounds) is computed once.
@@ -87,6 +89,7 @@ from .unwrap import (
     TOLERANCE_SIGMAS,
     grow,
     is_single_period,
+    mixed_pixels,
     unwrap_stereo,
 )
 from .unwrap_stream_jit import (
@@ -310,10 +313,15 @@ class StereoStream:
         if not tracked:  # (a tracked window keeps its single candidates: _track)
             self.previous, self.previous_right = disparity, None
         mask = np.isfinite(depth)
+        mixed = mixed_pixels(depth, mask, self.calibration, self.period, self.noise[0],
+                             rect.rays)  # (as unwrap_stereo: ramps at depth steps, spikes)
+        if mixed.any():
+            depth[mixed], order[mixed], column[mixed], mask[mixed] = np.nan, -1, np.nan, False
         decided = int(mask.sum())
         info = {"start": start, "decided": decided,
                 "decided_fraction": round(decided / max(valid, 1), 6), "left_decoded": valid,
-                **info, "tolerance_rad": round(float(self.tolerance or 0.0), 6),
+                **info, "mixed": int(mixed.sum()),
+                "tolerance_rad": round(float(self.tolerance or 0.0), 6),
                 "noise_rad": [round(v, 6) for v in self.noise]}
         phase = np.multiply(column, np.float32(2 * np.pi / self.period), out=column)
         return StreamDepth(start, depth, order, phase, mask, disparity,
