@@ -65,6 +65,7 @@ from .stereo import (
     rectify,
 )
 from .triangulate import check_depth_range, triangulate
+from .unwrap_fill import continue_unseen
 from .unwrap_jit import grow, unwrap_candidates
 
 #: The tolerance on the projector's phase is this many times the phase noise of the two
@@ -541,7 +542,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   tolerance: float | None = None, rectification: Rectification | None = None,
                   force: bool = False, check: bool = True, depth_from: str = "projector",
                   propagate: bool = True, pixel_origin: int | None = None,
-                  drop_mixed: bool = True) -> Unwrapped:
+                  drop_mixed: bool = True, continue_unseen: bool = True) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -588,6 +589,11 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     drop_mixed : bool, optional
         Leave undecided the pixels :func:`mixed_pixels` finds (mixed pixels at depth steps,
         spikes; ``info["mixed"]`` counts them).
+    continue_unseen : bool, optional
+        Continue the decided pixels into the left pixels the right camera cannot see (no
+        candidate: off its view or hidden there by a nearer surface) by the left camera's
+        own phase (:func:`~.unwrap_fill.continue_unseen`; ``info["continued"]`` counts
+        the left pixels decided so).
 
     Returns
     -------
@@ -659,9 +665,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                           max_depth, (0.5 * min_depth, 2.0 * max_depth))
         if far[2] is not None and far[0] > MOST_OUTSIDE_WIDE:
             (share, points, depths), limit = far, MOST_OUTSIDE_WIDE
-    n_in, crossed, alone, disparity, depth, mask, _, valid = _decide(
+    n_in, crossed, alone, disparity, depth, mask, continued, valid = _decide(
         lrect, rrect, left_phase, rect, calibration, period, tolerance, min_depth, max_depth,
-        propagate)
+        propagate, noise[0] if continue_unseen else None)
     pdepth, pmask, residual = projector_depth(depth, mask, left_phase, calibration, period,
                                               rect.rays)
     if depth_from == "projector":
@@ -684,7 +690,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         "rectified_valid": rectified_valid,
         "no_candidate": int(np.sum(np.isfinite(lrect) & (n_in == 0))),
         "undecided": int(np.sum((n_in >= 2) & np.isnan(disparity))),
-        "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone))),
+        "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone) & ~continued)),
+        "continued": _left_count(mask, continued, rect),
         "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed) & np.isnan(disparity))),
         "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
         "mixed": int(mixed.sum()),
@@ -710,12 +717,20 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     return Unwrapped(kept, depth, mask, n_in, rect, info)
 
 
+def _left_count(mask: np.ndarray, rectified: np.ndarray, rect: Rectification) -> int:
+    """The left pixels of ``mask`` whose nearest rectified pixel is in ``rectified``."""
+    u, v = (np.rint(p[mask]).astype(np.int64) for p in rect.positions)
+    inside = (u >= 0) & (u < rectified.shape[1]) & (v >= 0) & (v < rectified.shape[0])
+    return int(rectified[v[inside], u[inside]].sum())
+
+
 def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
             rect: Rectification, calibration: StereoCalibration, period: float,
-            tolerance: float, min_depth: float, max_depth: float, propagate: bool
-            ) -> tuple[Any, ...]:
-    """The search both ways, the cross-check, the support, the growth and the pair's depth
-    (:func:`unwrap_stereo`'s steps 2-3)."""
+            tolerance: float, min_depth: float, max_depth: float, propagate: bool,
+            fill_noise: float | None = None) -> tuple[Any, ...]:
+    """The search both ways, the cross-check, the support, the growth, the continuation
+    into the pixels the right camera cannot see (unless ``fill_noise`` is ``None``) and the
+    pair's depth (:func:`unwrap_stereo`'s steps 2-4)."""
     n_in, disparity, _, _, kept = _search(lrect, rrect, rect, calibration, period,
                                           tolerance, min_depth, max_depth,
                                           (min_depth, max_depth), everything=True)
@@ -727,11 +742,16 @@ def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
         disparity, from_right, rect.shift, SUPPORT, contradicted=True)), EDGE)
     alone = np.where(near, np.float32(np.nan), _supported(crossed, SUPPORT))
     disparity = grow(alone, n_in, kept, near, REACH, GROW_SUPPORT) if propagate else alone
+    continued = np.zeros(disparity.shape, bool)
+    if fill_noise is not None:
+        disparity, continued = continue_unseen(lrect, rrect, disparity, n_in, rect,
+                                               calibration, period, fill_noise, tolerance,
+                                               min_depth, max_depth, REACH)
     decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
-    depth, mask, _, per_row, valid = depth_counts(
+    depth, mask, _, _, valid = depth_counts(
         disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
         min_depth, max_depth)
-    return n_in, crossed, alone, disparity, depth, mask, per_row, valid
+    return n_in, crossed, alone, disparity, depth, mask, continued, valid
 
 
 def consistent_share(left_phase: np.ndarray, right_phase: np.ndarray,

@@ -59,7 +59,7 @@ def _near(difference: float) -> float:
 
 
 @inline
-def _projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
+def projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
                       rp: np.ndarray, tp: np.ndarray) -> float:
     """The projector column (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of the
     point ``(px, py, pz)`` of the left camera's frame; NaN behind the projector."""
@@ -129,7 +129,7 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
                 py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
                 pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
-                u = _projector_column(px, py, pz, kp, dp, rp, tp)
+                u = projector_column(px, py, pz, kp, dp, rp, tp)
                 if not (-0.5 <= u <= width - 0.5):
                     continue
                 miss = abs(_wrapped(TWO_PI * u / period - a))
