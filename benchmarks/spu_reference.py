@@ -349,7 +349,13 @@ def main() -> None:
     parser.add_argument("--scenes", default="two-masks,sphere-on-plane,plane")
     parser.add_argument("--projector-at", default="0.5,0.3")
     parser.add_argument("--motion", default="0", help="mm per frame along x, e.g. 0,1")
+    parser.add_argument("--without-continuation", action="store_true",
+                        help="bistair without unwrap_fill's step (for the comparison)")
     args = parser.parse_args()
+    if args.without_continuation:
+        import bistair.geometry.unwrap as unwrap
+
+        unwrap.continue_unseen = lambda lrect, rrect, d, *rest: (d, np.zeros(d.shape, bool))
     camera = tuple(int(v) for v in args.camera.split("x"))
     for scene in args.scenes.split(","):
         for at, moving in ((float(a), float(m)) for a in args.projector_at.split(",")
