@@ -411,7 +411,7 @@ def _toy_fill(disparity, n_in, phase=None):
     return continue_rows(phase.astype(np.float32), blank, disparity.astype(np.float32),
                          n_in.astype(np.int16), blank, 0.0, 100.0, 0.0, 0.0, -100.0,
                          np.eye(3), k, np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0,
-                         1000, 100.0, 600.0, 1.0, 1.0, 2.0, 0.2)
+                         1000, 100.0, 600.0, 1.0, 0.3, 1.0, 2.0, 0.2)
 
 
 def test_a_lone_decided_pixel_is_not_continued():
@@ -434,7 +434,7 @@ def test_fronts_that_disagree_leave_their_meeting_undecided():
     continues its own order, and where the two meet the pixels are left undecided: no
     decided pixel touches one of another order. (Three guards hold it, each alone: the
     votes' agreement, the depth's continuity and the last pass over the meeting.)"""
-    d = np.full((3, 18), np.nan)
+    d = np.full((4, 18), np.nan)
     d[:, :3], d[:, 15:] = 20.0, 52.0
     out, continued = _toy_fill(d, np.where(np.isfinite(d), 1, 0))
     assert np.allclose(out[:, 3:6], 20.0, atol=1e-3)

@@ -8,27 +8,27 @@ the renderer's truth.
 Examples
 --------
 Two cameras 100 mm apart (``f`` = 100 px), a projector 25 mm right of the left camera (a
-period of 8 px) and a plane at 500 mm (disparity 20): two rows, decided from column 20 on,
+period of 8 px) and a plane at 500 mm (disparity 20): four rows, decided from column 20 on,
 columns 0-19 without a candidate, their matches left of the right view:
 
->>> cols = np.arange(60, dtype=np.float32)[None].repeat(2, axis=0)
+>>> cols = np.arange(60, dtype=np.float32)[None].repeat(4, axis=0)
 >>> phase = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)
 >>> d = np.where(cols >= 20, np.float32(20), np.float32(np.nan))
 >>> n = np.where(cols >= 20, 1, 0).astype(np.int16)
 >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
->>> nearest = np.full((2, 60), np.nan, np.float32)  # the right view holds nothing nearer
->>> right = np.full((2, 60), np.nan, np.float32)  # (and no phase)
+>>> nearest = np.full((4, 60), np.nan, np.float32)  # the right view holds nothing nearer
+>>> right = np.full((4, 60), np.nan, np.float32)  # (and no phase)
 >>> rig = (0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k, np.zeros(5), np.eye(3),
 ...        np.array([-25.0, 0, 0]), 8.0, 1000, 400.0, 600.0)
->>> out, continued = continue_rows(phase, right, d, n, nearest, *rig, 1.0, 1.0, 3.0, 0.2)
+>>> out, continued = continue_rows(phase, right, d, n, nearest, *rig, 1.0, 0.3, 1.0, 3.0, 0.2)
 >>> np.round(out[0, :3], 3).tolist(), int(continued.sum())
-([20.0, 20.0, 20.0], 40)
+([20.0, 20.0, 20.0], 80)
 
 Decided from column 25 on, columns 20-24 match right pixels that see nothing nearer: they
 would be seen, so none continues.
 
 >>> d[:, 20:25] = np.nan
->>> int(continue_rows(phase, right, d, n * 0, nearest, *rig, 1.0, 1.0, 3.0, 0.2)[1].sum())
+>>> int(continue_rows(phase, right, d, n * 0, nearest, *rig, 1.0, 0.3, 1.0, 3.0, 0.2)[1].sum())
 0
 """
 
@@ -88,8 +88,8 @@ def _continue(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
               n_in: np.ndarray, nearest: np.ndarray, shift: float, f: float, cx: float,
               cy: float, tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
               rp: np.ndarray, tp: np.ndarray, period: float, width: int, zmin: float, zmax: float,
-              bound: float, reach: float, margin: float, tolerance: float
-              ) -> tuple[np.ndarray, np.ndarray]:
+              bound: float, bend: float, reach: float, margin: float,
+              tolerance: float) -> tuple[np.ndarray, np.ndarray]:
     h, w = disparity.shape
     wr = nearest.shape[1]
     dy, dx = np.array([1, -1, 0, 0, 1, 1, -1, -1]), np.array([0, 0, 1, -1, 1, -1, 1, -1])
@@ -127,6 +127,11 @@ def _continue(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
                     continue
                 k = round((absolute[my, mx] - a) / TWO_PI)
                 if abs(a + TWO_PI * k - absolute[my, mx]) > bound:
+                    continue
+                fy, fx = my + dy[i], mx + dx[i]  # the phase's line through two neighbours
+                if not (0 <= fy < h and 0 <= fx < w) or absolute[fy, fx] != absolute[fy, fx]:
+                    continue
+                if abs(a + TWO_PI * k - 2.0 * absolute[my, mx] + absolute[fy, fx]) > bend:
                     continue
                 if votes > 0 and k != order:
                     clash = True
@@ -195,15 +200,17 @@ def continue_rows(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
                   n_in: np.ndarray, nearest: np.ndarray, shift: float, f: float, cx: float,
                   cy: float, tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
                   rp: np.ndarray, tp: np.ndarray, period: float, width: int, zmin: float,
-                  zmax: float, bound: float, reach: float, margin: float,
-                  tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+                  zmax: float, bound: float, bend: float, reach: float,
+                  margin: float, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
     """Decided disparities continued into the left pixels the right camera gives no
     candidate for, breadth first from the decided pixels.
 
     A pixel of valid phase ``a`` and no candidate of its own (``n_in`` 0 or -1) takes the
     fringe order ``k`` that puts ``a + 2*pi*k`` within ``bound`` of the absolute phase of
-    each of its decided (or continued) 4-neighbours that is that near, when at least two
-    are and all of them give the same ``k``. Its disparity is where its ray meets the
+    each of its decided (or continued) 8-neighbours that is that near and within ``bend``
+    of the line through that neighbour and the next one beyond it (the phase's second
+    difference: a steep, blurred side bends it), when at least two are and all of them
+    give the same ``k``. Its disparity is where its ray meets the
     projector column of that phase; it is kept when its depth lies in ``[zmin, zmax]``,
     it lies within ``max(reach, 4 * d / f)`` pixels of every such neighbour's disparity (the
     surface turned at most 76 degrees from the ray, as :data:`~.unwrap.GRAZING`) and the
@@ -231,8 +238,9 @@ def continue_rows(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
         As :func:`~.unwrap_jit.unwrap_rows`.
     zmin, zmax : float
         The depth range (left camera frame, mm).
-    bound : float
-        The largest phase step (radians) to a neighbour.
+    bound, bend : float
+        The largest phase step (radians) to a neighbour and the largest second
+        difference.
     reach, margin : float
         The smallest disparity step limit and how much nearer (pixels) the right view's
         point must be.
@@ -251,19 +259,19 @@ def continue_rows(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
     The module's plane with the right view holding a nearer surface (disparity 30) over
     columns 0-10: columns 21-29 are hidden by it and continue too.
 
-    >>> cols = np.arange(60, dtype=np.float32)[None].repeat(2, axis=0)
+    >>> cols = np.arange(60, dtype=np.float32)[None].repeat(4, axis=0)
     >>> phase = (2 * np.pi * (cols - 5) / 8) % (2 * np.pi)
     >>> d = np.where(cols >= 30, np.float32(20), np.float32(np.nan))
     >>> n = np.where(cols >= 30, 1, 0).astype(np.int16)
     >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
     >>> nearest = np.where(cols <= 10, np.float32(30), np.float32(np.nan))
-    >>> right = np.full((2, 60), np.nan, np.float32)
+    >>> right = np.full((4, 60), np.nan, np.float32)
     >>> out, continued = continue_rows(
     ...     phase, right, d, n, nearest, 0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k,
     ...     np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]), 8.0, 1000, 400.0, 600.0, 1.0,
-    ...     1.0, 3.0, 0.2)
+    ...     0.3, 1.0, 3.0, 0.2)
     >>> int(continued.sum()), bool(np.allclose(out, 20.0, atol=1e-3))
-    (60, True)
+    (120, True)
     """
     def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
         return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
@@ -275,5 +283,6 @@ def continue_rows(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
                      np.ascontiguousarray(nearest, np.float32), float(shift), float(f),
                      float(cx), float(cy), float(tx), arr(back, (3, 3)), arr(kp, (3, 3)),
                      arr(dp, (5,)), arr(rp, (3, 3)), arr(tp, (3,)), float(period),
-                     int(width), float(zmin), float(zmax), float(bound), float(reach),
+                     int(width), float(zmin), float(zmax), float(bound), float(bend),
+                     float(reach),
                      float(margin), float(tolerance))
