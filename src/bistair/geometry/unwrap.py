@@ -19,9 +19,13 @@ from geometry instead of extra patterns:
    to four candidates takes the one within :data:`REACH` pixels of the disparity of
    :data:`GROW_SUPPORT` decided neighbours; with none or several it is left undecided
    (NaN, order -1), never guessed.
-5. The depth of a decided pixel is the left camera's ray cut by the projector column of
+5. Continuation (:func:`~.unwrap_fill.continue_unseen`): a left pixel the right camera
+   gives no candidate for (its match off the right view, or hidden there by a nearer
+   decided surface) takes the order that continues the left phase of two agreeing
+   decided neighbours, when the depth it gives lies in the range and continues theirs.
+6. The depth of a decided pixel is the left camera's ray cut by the projector column of
    its absolute phase (:func:`projector_depth`, as the published pipeline does).
-6. :func:`check_range`: when most points the search finds over a wider range (three
+7. :func:`check_range`: when most points the search finds over a wider range (three
    times as wide, about the same centre) fall outside the depth range, the range is wrong
    and refused. With the calibration's recorded pixel origin, :func:`consistent_share`
    under it and the other tells which one the data fit.
@@ -32,8 +36,9 @@ cameras, every second fringe of the right camera lines up with one of the projec
 depth range wider than about two right-camera fringes along the ray
 (:func:`ghost_spacing`) leaves pixels with two consistent candidates: undecided. A projector
 nearer one camera, a longer period or a narrower range decide more pixels. A pixel whose
-point the right camera does not see (occlusion) has no true candidate and is decided only if
-a wrong one happens to agree, which the support of the rows above and below rejects.
+point the right camera does not see (occlusion) has no true candidate: a wrong one that
+happens to agree is rejected by the support of the rows above and below, and the pixel
+is decided by continuation alone (step 5).
 
 Examples
 --------
