@@ -196,6 +196,50 @@ def _continue(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
     return out, continued & (out == out)
 
 
+@kernel()
+def _nearest(disparity: np.ndarray, shift: float, right_width: int) -> np.ndarray:
+    h, w = disparity.shape
+    out = np.full((h, right_width), np.nan, np.float32)
+    for y in range(h):
+        for x in range(w):
+            d = disparity[y, x]
+            if d != d:
+                continue
+            xr = x - shift - d
+            for c in (int(math.floor(xr)), int(math.ceil(xr))):
+                if 0 <= c < right_width and not out[y, c] >= d:
+                    out[y, c] = d
+    return out
+
+
+def right_nearest(disparity: np.ndarray, shift: float, right_width: int) -> np.ndarray:
+    """The largest decided disparity that lands on each right pixel: what the right camera
+    sees nearest there, as far as the left grid's decisions tell.
+
+    Parameters
+    ----------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32 decided disparities of the rectified left grid, NaN elsewhere.
+    shift : float
+        ``cx_left - cx_right`` of the rectification (pixels).
+    right_width : int
+        The right grid's width.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, right_width)`` float32, NaN where no decided pixel lands (each lands on the
+        two right pixels about ``x - shift - d``).
+
+    Examples
+    --------
+    >>> right_nearest(np.float32([[np.nan, 1.0, 1.0, 1.5]]), 0.0, 4).tolist()
+    [[1.0, 1.5, 1.5, nan]]
+    """
+    return _nearest(np.ascontiguousarray(disparity, np.float32), float(shift),
+                    int(right_width))
+
+
 def continue_rows(phase: np.ndarray, right: np.ndarray, disparity: np.ndarray,
                   n_in: np.ndarray, nearest: np.ndarray, shift: float, f: float, cx: float,
                   cy: float, tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
