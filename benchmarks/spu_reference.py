@@ -135,9 +135,10 @@ def _disparities(P1: np.ndarray, P2: np.ndarray, depth: tuple[float, float],
 
 def reference(left: np.ndarray, right: np.ndarray, P1: np.ndarray, P2: np.ndarray,
               Pp: np.ndarray, period: float, depth: tuple[float, float],
-              start: int = 0) -> np.ndarray:
+              start: int = 0, pixels: bool = False) -> np.ndarray | tuple[np.ndarray, ...]:
     """The published pipeline's points ``(N, 3)`` (the matrices' world frame, mm) of one
-    window of four frames starting at frame ``start`` of each camera."""
+    window of four frames starting at frame ``start`` of each camera (with ``pixels``, also
+    their left rows and columns)."""
     phl, _ = _wrapped(left)
     phr, _ = _wrapped(right)
     phl = np.mod(phl + np.pi / 2 * start, 2 * np.pi)
@@ -185,6 +186,8 @@ def reference(left: np.ndarray, right: np.ndarray, P1: np.ndarray, P2: np.ndarra
     z = np.full((h, w), np.nan)
     z[v, u] = X[:, 2]
     keep = np.abs(z - _nan_median(z, MEDIAN)) <= MEDIAN_OFF
+    if pixels:
+        return X[keep[v, u]], v[keep[v, u]], u[keep[v, u]]
     return X[keep[v, u]]
 
 
@@ -285,7 +288,7 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
         scipy.io.savemat(folder / name, {name.split(".")[0]: M})
     z = truth.depth[np.isfinite(truth.depth)]
     depth = (math.floor(z.min() - 10), math.ceil(z.max() + 10))
-    ref = reference(frames["left"], frames["right"], *P, period, depth)
+    ref, rv, ru = reference(frames["left"], frames["right"], *P, period, depth, pixels=True)
     invoke = CliRunner().invoke
     steps = [["patterns", "multifreq", "--periods", f"{period!r}", "--steps", "4",
               "--shift-sign", "-1", "--width", str(PROJECTOR[0]), "--height",
@@ -305,7 +308,8 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
     ours = read_ply(folder / "out" / "cloud.ply")
     depth = np.load(folder / "out" / "depth.npy")
     decided = np.isfinite(depth)
-    mixed = json.loads((folder / "out" / "info.json").read_text())["mixed"]
+    info = json.loads((folder / "out" / "info.json").read_text())
+    mixed = info["mixed"]
     truth_points = truth.points[truth.mask]
     near = cKDTree(ref).query(ours)[0]
     out = {"reference": len(ref), "bistair": len(ours), "ratio": len(ours) / max(len(ref), 1),
@@ -329,6 +333,13 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
         out["ours_same_pixel_truth"] = float(np.mean(same)) if same.size else 0.0
         out["ours_same_pixel_over_5mm"] = float(np.mean(over)) if over.size else 0.0
         out["mixed"] = mixed
+        # the reference's right pixels (its point within 2 mm of the truth's depth at the
+        # pixel) that bistair leaves undecided
+        with np.errstate(invalid="ignore"):
+            right = np.abs(ref[:, 2] - truth.depth[rv, ru]) < 2.0
+        out["ref_right"] = int(right.sum())
+        out["ref_right_left"] = int(np.sum(right & ~decided[rv, ru]))
+    out["continued"] = info.get("continued", 0)
     return out
 
 
@@ -338,7 +349,13 @@ def main() -> None:
     parser.add_argument("--scenes", default="two-masks,sphere-on-plane,plane")
     parser.add_argument("--projector-at", default="0.5,0.3")
     parser.add_argument("--motion", default="0", help="mm per frame along x, e.g. 0,1")
+    parser.add_argument("--without-continuation", action="store_true",
+                        help="bistair without unwrap_fill's step (for the comparison)")
     args = parser.parse_args()
+    if args.without_continuation:
+        import bistair.geometry.unwrap as unwrap
+
+        unwrap.continue_unseen = lambda lrect, rrect, d, *rest: (d, np.zeros(d.shape, bool))
     camera = tuple(int(v) for v in args.camera.split("x"))
     for scene in args.scenes.split(","):
         for at, moving in ((float(a), float(m)) for a in args.projector_at.split(",")
@@ -346,7 +363,9 @@ def main() -> None:
             with tempfile.TemporaryDirectory() as tmp:
                 r = run(scene, camera, at, Path(tmp), motion=moving)
             extra = "".join(f", {k} {v:.3f}" for k, v in r.items() if "truth" in k)
-            extra += f", mixed {r.get('mixed', 0)}"
+            extra += (f", mixed {r.get('mixed', 0)}, continued {r['continued']}, reference's "
+                      f"right pixels left {r.get('ref_right_left', 0)} of "
+                      f"{r.get('ref_right', 0)}")
             print(f"{scene:16s} at {at} moving {moving:g} mm/frame: reference "
                   f"{r['reference']} points, bistair {r['bistair']} "
                   f"({100 * r['ratio']:.1f}%), median distance "

@@ -73,8 +73,9 @@ def case(scene: str, camera: tuple[int, int], projector_at: float, period: float
     z = truth.depth[np.isfinite(truth.depth)]
     low, high = math.floor(z.min() - 10), math.ceil(z.max() + 10)
 
-    def scored(lo: float, hi: float):
-        found = unwrap_stereo(lp, rp, cal, period, lo, hi, noise, force=True)
+    def scored(lo: float, hi: float, fill: bool = True):
+        found = unwrap_stereo(lp, rp, cal, period, lo, hi, noise, force=True,
+                              continue_unseen=fill)
         Phi, order = absolute_phase(found, lp, cal, period)
         decided = order >= 0
         err = Phi - 2 * np.pi * truth.coord_x / period
@@ -86,6 +87,7 @@ def case(scene: str, camera: tuple[int, int], projector_at: float, period: float
     cpu, _ = _cpu(lambda: unwrap_stereo(lp, rp, cal, period, low, high, noise, force=True))
     info, decided, wrong, on, wrong_on = scored(low, high)
     check = info["range_check"]
+    _, plain, plain_wrong, _, plain_wrong_on = scored(low, high, fill=False)
     width = high - low
     others = []
     for lo, hi in ((high + 20, high + 20 + width), (max(low - 20 - width, 50), low - 20),
@@ -99,6 +101,8 @@ def case(scene: str, camera: tuple[int, int], projector_at: float, period: float
             f"{100 * (decided + info['mixed']) / valid:.1f}% with them) wrong {wrong} "
             f"({100 * wrong / max(decided, 1):.3f}%;"
             f" on the truth's mask {wrong_on} of {on}, {100 * wrong_on / max(on, 1):.3f}%)"
+            f" continued {info['continued']} (without: decided {100 * plain / valid:.1f}%, "
+            f"wrong {plain_wrong}, on the mask {plain_wrong_on})"
             f" check {check['outside']:.3f}/{check['points']} cpu {cpu:.3f} s "
             f"(x{cpu / base:.0f}) | wrong ranges: " + "; ".join(others))
 

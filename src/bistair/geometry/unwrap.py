@@ -19,9 +19,13 @@ from geometry instead of extra patterns:
    to four candidates takes the one within :data:`REACH` pixels of the disparity of
    :data:`GROW_SUPPORT` decided neighbours; with none or several it is left undecided
    (NaN, order -1), never guessed.
-5. The depth of a decided pixel is the left camera's ray cut by the projector column of
+5. Continuation (:func:`~.unwrap_fill.continue_unseen`): a left pixel the right camera
+   gives no candidate for (its match off the right view, or hidden there by a nearer
+   decided surface) takes the order that continues the left phase of two agreeing
+   decided neighbours, when the depth it gives lies in the range and continues theirs.
+6. The depth of a decided pixel is the left camera's ray cut by the projector column of
    its absolute phase (:func:`projector_depth`, as the published pipeline does).
-6. :func:`check_range`: when most points the search finds over a wider range (three
+7. :func:`check_range`: when most points the search finds over a wider range (three
    times as wide, about the same centre) fall outside the depth range, the range is wrong
    and refused. With the calibration's recorded pixel origin, :func:`consistent_share`
    under it and the other tells which one the data fit.
@@ -32,8 +36,9 @@ cameras, every second fringe of the right camera lines up with one of the projec
 depth range wider than about two right-camera fringes along the ray
 (:func:`ghost_spacing`) leaves pixels with two consistent candidates: undecided. A projector
 nearer one camera, a longer period or a narrower range decide more pixels. A pixel whose
-point the right camera does not see (occlusion) has no true candidate and is decided only if
-a wrong one happens to agree, which the support of the rows above and below rejects.
+point the right camera does not see (occlusion) has no true candidate: a wrong one that
+happens to agree is rejected by the support of the rows above and below, and the pixel
+is decided by continuation alone (step 5).
 
 Examples
 --------
@@ -65,6 +70,7 @@ from .stereo import (
     rectify,
 )
 from .triangulate import check_depth_range, triangulate
+from .unwrap_fill import continue_unseen
 from .unwrap_jit import grow, mixed_mask, unwrap_candidates
 
 #: The tolerance on the projector's phase is this many times the phase noise of the two
@@ -515,7 +521,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   tolerance: float | None = None, rectification: Rectification | None = None,
                   force: bool = False, check: bool = True, depth_from: str = "projector",
                   propagate: bool = True, pixel_origin: int | None = None,
-                  drop_mixed: bool = True) -> Unwrapped:
+                  drop_mixed: bool = True, continue_unseen: bool = True) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -562,6 +568,11 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     drop_mixed : bool, optional
         Leave undecided the pixels :func:`mixed_pixels` finds (mixed pixels at depth steps,
         spikes; ``info["mixed"]`` counts them).
+    continue_unseen : bool, optional
+        Continue the decided pixels into the left pixels the right camera cannot see (no
+        candidate: off its view or hidden there by a nearer surface) by the left camera's
+        own phase (:func:`~.unwrap_fill.continue_unseen`; ``info["continued"]`` counts
+        the left pixels decided so).
 
     Returns
     -------
@@ -633,9 +644,9 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                           max_depth, (0.5 * min_depth, 2.0 * max_depth))
         if far[2] is not None and far[0] > MOST_OUTSIDE_WIDE:
             (share, points, depths), limit = far, MOST_OUTSIDE_WIDE
-    n_in, crossed, alone, disparity, depth, mask, _, valid = _decide(
+    n_in, crossed, alone, disparity, depth, mask, continued, valid = _decide(
         lrect, rrect, left_phase, rect, calibration, period, tolerance, min_depth, max_depth,
-        propagate)
+        propagate, noise[0] if continue_unseen else None)
     pdepth, pmask, residual = projector_depth(depth, mask, left_phase, calibration, period,
                                               rect.rays)
     if depth_from == "projector":
@@ -658,7 +669,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         "rectified_valid": rectified_valid,
         "no_candidate": int(np.sum(np.isfinite(lrect) & (n_in == 0))),
         "undecided": int(np.sum((n_in >= 2) & np.isnan(disparity))),
-        "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone))),
+        "grown": int(np.sum(np.isfinite(disparity) & np.isnan(alone) & ~continued)),
+        "continued": _left_count(mask, continued, rect),
         "not_confirmed": int(np.sum((n_in == 1) & np.isnan(crossed) & np.isnan(disparity))),
         "unsupported": int(np.sum(np.isfinite(crossed) & np.isnan(disparity))),
         "mixed": int(mixed.sum()),
@@ -684,12 +696,20 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     return Unwrapped(kept, depth, mask, n_in, rect, info)
 
 
+def _left_count(mask: np.ndarray, rectified: np.ndarray, rect: Rectification) -> int:
+    """The left pixels of ``mask`` whose nearest rectified pixel is in ``rectified``."""
+    u, v = (np.rint(p[mask]).astype(np.int64) for p in rect.positions)
+    inside = (u >= 0) & (u < rectified.shape[1]) & (v >= 0) & (v < rectified.shape[0])
+    return int(rectified[v[inside], u[inside]].sum())
+
+
 def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
             rect: Rectification, calibration: StereoCalibration, period: float,
-            tolerance: float, min_depth: float, max_depth: float, propagate: bool
-            ) -> tuple[Any, ...]:
-    """The search both ways, the cross-check, the support, the growth and the pair's depth
-    (:func:`unwrap_stereo`'s steps 2-3)."""
+            tolerance: float, min_depth: float, max_depth: float, propagate: bool,
+            fill_noise: float | None = None) -> tuple[Any, ...]:
+    """The search both ways, the cross-check, the support, the growth, the continuation
+    into the pixels the right camera cannot see (unless ``fill_noise`` is ``None``) and the
+    pair's depth (:func:`unwrap_stereo`'s steps 2-4)."""
     n_in, disparity, _, _, kept = _search(lrect, rrect, rect, calibration, period,
                                           tolerance, min_depth, max_depth,
                                           (min_depth, max_depth), everything=True)
@@ -701,11 +721,16 @@ def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
         disparity, from_right, rect.shift, SUPPORT, contradicted=True)), EDGE)
     alone = np.where(near, np.float32(np.nan), _supported(crossed, SUPPORT))
     disparity = grow(alone, n_in, kept, near, REACH, GROW_SUPPORT) if propagate else alone
+    continued = np.zeros(disparity.shape, bool)
+    if fill_noise is not None:
+        disparity, continued = continue_unseen(lrect, rrect, disparity, n_in, rect,
+                                               calibration, period, fill_noise, tolerance,
+                                               min_depth, max_depth, REACH)
     decoded = np.where(np.isfinite(left_phase), np.float32(1), np.float32(np.nan))
-    depth, mask, _, per_row, valid = depth_counts(
+    depth, mask, _, _, valid = depth_counts(
         disparity, *rect.positions, decoded, rect.f, rect.cx_left, rect.cy, rect.tx, rect.R1,
         min_depth, max_depth)
-    return n_in, crossed, alone, disparity, depth, mask, per_row, valid
+    return n_in, crossed, alone, disparity, depth, mask, continued, valid
 
 
 def consistent_share(left_phase: np.ndarray, right_phase: np.ndarray,

@@ -59,10 +59,31 @@ def _near(difference: float) -> float:
 
 
 @inline
-def _projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
+def projector_column(px: float, py: float, pz: float, kp: np.ndarray, dp: np.ndarray,
                       rp: np.ndarray, tp: np.ndarray) -> float:
     """The projector column (OpenCV's model, distortion ``k1, k2, p1, p2, k3``) of the
-    point ``(px, py, pz)`` of the left camera's frame; NaN behind the projector."""
+    point ``(px, py, pz)`` of the left camera's frame; NaN behind the projector.
+
+    Parameters
+    ----------
+    px, py, pz : float
+        The point (left camera frame, mm).
+    kp, dp, rp, tp : numpy.ndarray
+        The projector's intrinsics ``(3, 3)``, distortion (5), rotation ``(3, 3)`` and
+        translation (3) from the left camera's frame.
+
+    Returns
+    -------
+    float
+        The column (projector pixels), NaN behind the projector.
+
+    Examples
+    --------
+    >>> k = np.array([[100.0, 0, 0], [0, 100, 0], [0, 0, 1]])
+    >>> float(projector_column(50.0, 0.0, 500.0, k, np.zeros(5), np.eye(3),
+    ...                        np.array([-25.0, 0, 0])))
+    5.0
+    """
     x = rp[0, 0] * px + rp[0, 1] * py + rp[0, 2] * pz + tp[0]
     y = rp[1, 0] * px + rp[1, 1] * py + rp[1, 2] * pz + tp[1]
     z = rp[2, 0] * px + rp[2, 1] * py + rp[2, 2] * pz + tp[2]
@@ -129,7 +150,7 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
                 py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
                 pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
-                u = _projector_column(px, py, pz, kp, dp, rp, tp)
+                u = projector_column(px, py, pz, kp, dp, rp, tp)
                 if not (-0.5 <= u <= width - 0.5):
                     continue
                 miss = abs(_wrapped(TWO_PI * u / period - a))

@@ -92,10 +92,13 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
         return
     info = res.info
     if info.get("unwrapping") == "stereo":
+        continued = info.get("continued", 0)
+        unseen = (f" and {continued} continued where the right camera cannot see them"
+                  if continued else "")
         click.echo(f"{info['decided']} points from {info['left_decoded']} decoded left pixels "
                    f"({100 * info['decided_fraction']:.1f}%; by the projector at "
                    f"{low:g}-{high:g} mm, {info.get('grown', 0)} of them by their "
-                   f"neighbours: {info['undecided']} undecided, two or more candidates "
+                   f"neighbours{unseen}: {info['undecided']} undecided, two or more candidates "
                    f"agree; {info['no_candidate']} without one; "
                    f"{info['not_confirmed'] + info['unsupported']} not confirmed by the "
                    f"right camera or the rows beside); wrote {out}")
