@@ -257,7 +257,7 @@ def read_ply(path: Path) -> np.ndarray:
 
 
 def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
-        seed: int = 1, motion: float = 0.0) -> dict[str, float]:
+        seed: int = 1, motion: float = 0.0, continue_unseen: bool = False) -> dict[str, float]:
     """Render (the objects moving ``motion`` mm per frame along x, when given), run the
     reference and bistair's commands, compare; the figures (the truth of frame 0)."""
     period = PROJECTOR[0] / FRINGES
@@ -300,7 +300,7 @@ def run(scene: str, camera: tuple[int, int], projector_at: float, folder: Path,
              ["stereo", str(folder / "1_Rectified"), str(folder / "2_Rectified"), "--spec",
               str(folder / "patterns" / "spec.json"), "--calibration",
               str(folder / "rig.json"), "--depth-range", f"{depth[0]}:{depth[1]}", "--out",
-              str(folder / "out")]]
+              str(folder / "out")] + (["--continue-unseen"] if continue_unseen else [])]
     for args in steps:
         res = invoke(cli, args)
         if res.exit_code != 0:
@@ -349,19 +349,16 @@ def main() -> None:
     parser.add_argument("--scenes", default="two-masks,sphere-on-plane,plane")
     parser.add_argument("--projector-at", default="0.5,0.3")
     parser.add_argument("--motion", default="0", help="mm per frame along x, e.g. 0,1")
-    parser.add_argument("--without-continuation", action="store_true",
-                        help="bistair without unwrap_fill's step (for the comparison)")
+    parser.add_argument("--continue-unseen", action="store_true",
+                        help="bistair stereo --continue-unseen (unwrap_fill's step)")
     args = parser.parse_args()
-    if args.without_continuation:
-        import bistair.geometry.unwrap as unwrap
-
-        unwrap.continue_unseen = lambda lrect, rrect, d, *rest: (d, np.zeros(d.shape, bool))
     camera = tuple(int(v) for v in args.camera.split("x"))
     for scene in args.scenes.split(","):
         for at, moving in ((float(a), float(m)) for a in args.projector_at.split(",")
                            for m in args.motion.split(",")):
             with tempfile.TemporaryDirectory() as tmp:
-                r = run(scene, camera, at, Path(tmp), motion=moving)
+                r = run(scene, camera, at, Path(tmp), motion=moving,
+                        continue_unseen=args.continue_unseen)
             extra = "".join(f", {k} {v:.3f}" for k, v in r.items() if "truth" in k)
             extra += (f", mixed {r.get('mixed', 0)}, continued {r['continued']}, reference's "
                       f"right pixels left {r.get('ref_right_left', 0)} of "

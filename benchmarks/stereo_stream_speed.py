@@ -53,6 +53,7 @@ STAGES = {  # what each stage of a depth map calls (module or class, name)
     "growth (grow)": [(unwrap_stream, "grow")],
     "depth (projector_pixels, plane_depth)": [(unwrap_stream, "projector_pixels"),
                                               (unwrap_stream, "plane_depth")],
+    "mixed pixels (mixed_pixels)": [(unwrap_stream, "mixed_pixels")],
 }
 
 

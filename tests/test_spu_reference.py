@@ -39,3 +39,30 @@ def test_mixed_pixels_at_the_objects_edges_are_left_undecided(tmp_path):
     assert out["ours_same_pixel_over_5mm"] <= 0.009, out
     assert out["ours_same_pixel_truth"] >= 0.97 and out["mixed"] > 100, out
     assert out["ratio"] >= 0.9 and out["ours_off_truth"] <= out["ref_off_truth"], out
+
+
+def test_continue_unseen_is_asked_for(tmp_path):
+    """``stereo --continue-unseen`` decides the left pixels the right camera cannot see
+    (two-masks, 160 x 120: a band whose matches fall off the right image), none an order
+    off (the share over 5 mm from the truth's depth at the same pixel moves by under a
+    point); without it none are continued,
+    as the published pipeline; with a stream (``--window``) it is refused, exit 2."""
+    plain = spu_reference.run("two-masks", (160, 120), 0.5, tmp_path / "plain")
+    more = spu_reference.run("two-masks", (160, 120), 0.5, tmp_path / "more",
+                             continue_unseen=True)
+    assert plain["continued"] == 0 and more["continued"] > 100, (plain, more)
+    assert more["bistair"] == plain["bistair"] + more["continued"], (plain, more)
+    assert more["ours_same_pixel_over_5mm"] <= plain["ours_same_pixel_over_5mm"] + 0.01, (
+        plain["ours_same_pixel_over_5mm"], more["ours_same_pixel_over_5mm"])
+    from click.testing import CliRunner
+
+    from bistair.app.cli import cli
+
+    folder = tmp_path / "more"
+    res = CliRunner().invoke(cli, [
+        "stereo", str(folder / "1_Rectified"), str(folder / "2_Rectified"), "--spec",
+        str(folder / "patterns" / "spec.json"), "--calibration", str(folder / "rig.json"),
+        "--depth-range", "500:700", "--window", "4", "--continue-unseen", "--out",
+        str(tmp_path / "stream")])
+    assert res.exit_code == 2 and "--continue-unseen" in res.output, res.output
+    assert not (tmp_path / "stream").exists()

@@ -68,7 +68,9 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
     the decoder when it takes it and keeps a reconstruction with few matches; ``smooth``:
     see :func:`~bistair.geometry.stereo.reconstruct_stereo` (``None``: its default, 1 px;
     a single-period spec, unwrapped by the projector, matches no projector coordinates and
-    refuses one). ``options`` are decoder options. Nothing is written on error.
+    refuses one). ``options`` are decoder options (and ``continue_unseen`` for a
+    single-period spec: :func:`~bistair.geometry.unwrap.unwrap_stereo`). Nothing is written
+    on error.
     """
     say = progress or silent
     for side in (left, right):
@@ -103,6 +105,10 @@ def stereo_folder(left: Any, right: Any, out: str | Path,
         result = _unwrapped(lstack, rstack, used, calibration, min_depth, max_depth, force,
                             options)
     else:
+        if options.pop("continue_unseen", False):
+            raise BistairError("--continue-unseen applies to a single-period spec (stereo "
+                               "phase unwrapping); a coded spec's pixels are matched by "
+                               "their absolute phase")
         say(f"decoding 2 x {len(lstack)} frames of {lstack.shape[2]}x{lstack.shape[1]} "
             f"({used.method}) and matching")
         result = stereo(lstack, rstack, used, calibration, min_depth=min_depth,
@@ -127,7 +133,7 @@ def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
         raise BistairError("one period gives no fringe order: stereo phase unwrapping needs "
                            "the projector in the calibration (bistair simulate --cameras 2 "
                            "writes one; or import-calibration --projection-matrices)")
-    unknown = sorted(set(options) - {"min_modulation", "pixel_origin"})
+    unknown = sorted(set(options) - {"min_modulation", "pixel_origin", "continue_unseen"})
     if unknown:
         raise BistairError(f"stereo phase unwrapping takes no {', '.join(unknown)} option")
     if lstack.shape != rstack.shape:
@@ -135,7 +141,8 @@ def _unwrapped(lstack: np.ndarray, rstack: np.ndarray, spec: BaseSpec,
             f"{s[0]} frames of {s[2]}x{s[1]}" for s in (lstack.shape, rstack.shape)))
     return stereo_unwrap(lstack, rstack, spec, calibration, min_depth, max_depth, force,
                          options.get("min_modulation"),
-                         pixel_origin=options.get("pixel_origin"))
+                         pixel_origin=options.get("pixel_origin"),
+                         continue_unseen=bool(options.get("continue_unseen", False)))
 
 
 def same_place(left: Any, right: Any) -> bool:

@@ -521,7 +521,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
                   tolerance: float | None = None, rectification: Rectification | None = None,
                   force: bool = False, check: bool = True, depth_from: str = "projector",
                   propagate: bool = True, pixel_origin: int | None = None,
-                  drop_mixed: bool = True, continue_unseen: bool = True) -> Unwrapped:
+                  drop_mixed: bool = True, continue_unseen: bool = False) -> Unwrapped:
     """Depth from two cameras' wrapped phase of one N-step set, the projector and a depth
     range (module docstring).
 
@@ -572,7 +572,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
         Continue the decided pixels into the left pixels the right camera cannot see (no
         candidate: off its view or hidden there by a nearer surface) by the left camera's
         own phase (:func:`~.unwrap_fill.continue_unseen`; ``info["continued"]`` counts
-        the left pixels decided so).
+        the left pixels decided so). Off by default: the published pipeline leaves them
+        (``stereo --continue-unseen`` turns it on).
 
     Returns
     -------
@@ -951,8 +952,8 @@ def wrapped_of(images: np.ndarray, spec: Any, min_modulation: float | None = Non
 def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
                   calibration: StereoCalibration, min_depth: float, max_depth: float,
                   force: bool = False, min_modulation: float | None = None,
-                  tolerance: float | None = None, pixel_origin: int | None = None
-                  ) -> StereoResult:
+                  tolerance: float | None = None, pixel_origin: int | None = None,
+                  continue_unseen: bool = False) -> StereoResult:
     """Two cameras' captures of one single-period N-step set to depth by stereo phase
     unwrapping (module docstring), as :func:`~bistair.geometry.stereo.stereo` gives it.
 
@@ -974,6 +975,8 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     pixel_origin : int, optional
         The calibration's recorded pixel origin, checked against the data
         (:func:`unwrap_stereo`).
+    continue_unseen : bool, optional
+        Continue into the left pixels the right camera cannot see (:func:`unwrap_stereo`).
 
     Returns
     -------
@@ -1025,7 +1028,8 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     if sign and not force:
         raise BistairError(sign)
     found = unwrap_stereo(lphase, rphase, calibration, period, min_depth, max_depth, noise,
-                          tolerance, force=force, pixel_origin=pixel_origin)
+                          tolerance, force=force, pixel_origin=pixel_origin,
+                          continue_unseen=continue_unseen)
     if sign:
         found.info["warnings"].insert(0, sign)
     _, order = absolute_phase(found, lphase, calibration, period)

@@ -48,6 +48,10 @@ from .options import (
               "projector coordinates]")
 @click.option("--no-previews", is_flag=True, help="skip the decodes' PNG previews (with "
               "--window: each window's depth.png)")
+@click.option("--continue-unseen", is_flag=True,
+              help="single-period spec: also decide the left pixels the right camera cannot "
+                   "see, by continuing their decided neighbours' phase (off: the published "
+                   "pipeline leaves them)")
 @click.option("--window", default=None, metavar="N|N+K",
               help="two streams of one single-period N-step set whose shift advances one "
               "step per frame: a depth map for every window of N frames (N+K: motion "
@@ -61,7 +65,8 @@ from .options import (
 def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out: Path,
            depth_range: str | None, force: bool, strategy: str | None,
            min_modulation: float | None, smooth: float | None, no_previews: bool,
-           window: str | None, starts: str | None, quiet: bool) -> None:
+           continue_unseen: bool, window: str | None, starts: str | None,
+           quiet: bool) -> None:
     """Two cameras and a projector: decode both cameras' captures of one pattern set, match
     equal absolute phase along rectified rows, triangulate.
 
@@ -77,11 +82,16 @@ def stereo(left: str, right: str, spec_path: Path | None, calibration: Path, out
 
     low, high = (0.0, np.inf) if depth_range is None else parse_depth_range(depth_range)
     if window is not None or starts is not None:
+        if continue_unseen:
+            raise CliError("--continue-unseen decides one set's unseen pixels; a stream's "
+                           "tracked windows do not continue: drop one")
         _stereo_stream(left, right, spec_path, calibration, out, (low, high), window, starts,
                        force, strategy, min_modulation, smooth, not no_previews, quiet)
         return
     options = {k: v for k, v in (("strategy", strategy), ("min_modulation", min_modulation))
                if v is not None}
+    if continue_unseen:
+        options["continue_unseen"] = True
     with Progress(quiet) as say:
         res = stereo_folder(left, right, out, calibration, spec_path, min_depth=low,
                             max_depth=high, force=force, smooth=smooth,
