@@ -11,6 +11,8 @@ code in src calls them; issue 35 moved them here from the concept modules):
   (``bistair.core.regions_jit.link_bits``);
 * :func:`mode_by_label`: the most frequent value per label
   (``bistair.codecs.bidirectional.paper_jit.run_label_modes``);
+* :func:`grow_all_seeds`: growth of decided disparities, every decided pixel a seed
+  (``bistair.geometry.unwrap_jit.grow``);
 * :func:`mixed_pixels`: the decided pixels of a stereo depth map in a ramp or a spike
   (``bistair.geometry.unwrap_jit.mixed_mask``, which ``unwrap.mixed_pixels`` runs), with
   the projector's own model (distortion and all) for the depth one column moves.
@@ -301,3 +303,48 @@ def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration, period: float
                 neighbours += np.isfinite(step)
                 near += np.abs(step) <= limit
     return mask & (ramp | ((neighbours > 0) & (near == 0)))
+
+
+def grow_all_seeds(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.ndarray,
+          reach: float, support: int) -> np.ndarray:
+    """Pure-Python reference of :func:`bistair.geometry.unwrap_jit.grow`'s pass as first
+    written: every decided pixel seeds the breadth-first queue (the compiled pass seeds only
+    those beside a pixel that may grow: the others change nothing when their turn comes)."""
+    h, w = disparity.shape
+    dy, dx = np.array([1, -1, 0, 0]), np.array([0, 0, 1, -1])
+    out = disparity.copy()
+    queue = np.empty(h * w, np.int64)
+    tail = 0
+    for y in range(h):
+        for x in range(w):
+            if out[y, x] == out[y, x]:
+                queue[tail] = y * w + x
+                tail += 1
+    head = 0
+    while head < tail:
+        y, x = queue[head] // w, queue[head] % w
+        head += 1
+        for k in range(4):
+            ny, nx = y + dy[k], x + dx[k]
+            if not (0 <= ny < h and 0 <= nx < w) or out[ny, nx] == out[ny, nx]:
+                continue
+            m = n_in[ny, nx]
+            if m < 1 or m > kept.shape[2] or blocked[ny, nx]:
+                continue
+            count, chosen = 0, math.nan
+            for c in range(m):
+                d = kept[ny, nx, c]
+                agree = 0
+                for j in range(4):
+                    my, mx = ny + dy[j], nx + dx[j]
+                    if (0 <= my < h and 0 <= mx < w and abs(out[my, mx] - d) <= reach):
+                        agree += 1
+                if agree >= 1:
+                    count += 1
+                    if agree >= support:
+                        chosen = d
+            if count == 1 and chosen == chosen:
+                out[ny, nx] = chosen
+                queue[tail] = ny * w + nx
+                tail += 1
+    return out

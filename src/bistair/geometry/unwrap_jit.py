@@ -322,11 +322,17 @@ def _grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np
     out = disparity.copy()
     queue = np.empty(h * w, np.int64)
     tail = 0
-    for y in range(h):
-        for x in range(w):
-            if out[y, x] == out[y, x]:
-                queue[tail] = y * w + x
-                tail += 1
+    for y in range(h):  # the decided pixels beside one that may grow (the others change
+        for x in range(w):  # nothing when their turn comes), in raster order
+            if out[y, x] != out[y, x]:
+                continue
+            for k in range(4):
+                ny, nx = y + dy[k], x + dx[k]
+                if (0 <= ny < h and 0 <= nx < w and out[ny, nx] != out[ny, nx]
+                        and 1 <= n_in[ny, nx] <= kept.shape[2] and not blocked[ny, nx]):
+                    queue[tail] = y * w + x
+                    tail += 1
+                    break
     head = 0
     while head < tail:
         y, x = queue[head] // w, queue[head] % w
