@@ -351,7 +351,7 @@ def projector_depth(depth: np.ndarray, mask: np.ndarray, phase: np.ndarray,
     Examples
     --------
     >>> from bistair.geometry.stereo import rectify
-    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.geometry.calibration import StereoCalibration
     >>> from bistair.sim import preset, trace
     >>> from bistair.sim.stereo import StereoRig
     >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
@@ -479,7 +479,7 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
 
     Examples
     --------
-    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.geometry.calibration import StereoCalibration
     >>> from bistair.sim import preset, trace
     >>> from bistair.sim.stereo import StereoRig
     >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
@@ -588,7 +588,7 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
 
     Examples
     --------
-    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.geometry.calibration import StereoCalibration
     >>> from bistair.sim import preset, trace
     >>> from bistair.sim.stereo import StereoRig
     >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
@@ -657,10 +657,8 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     kept = disparity
     if mixed.any():
         depth, mask = np.where(mixed, np.float32(np.nan), depth), mask & ~mixed
-        u, v = (np.rint(p[mixed]).astype(np.int64) for p in rect.positions)
-        inside = (u >= 0) & (u < disparity.shape[1]) & (v >= 0) & (v < disparity.shape[0])
         kept = disparity.copy()
-        kept[v[inside], u[inside]] = np.nan
+        kept[_nearest_rectified(mixed, rect, kept.shape)] = np.nan
     rectified_valid = int(np.isfinite(lrect).sum())
     info: dict[str, Any] = {
         "unwrapping": "stereo", "period": period, "depth_range": [min_depth, max_depth],
@@ -697,11 +695,18 @@ def unwrap_stereo(left_phase: np.ndarray, right_phase: np.ndarray,
     return Unwrapped(kept, depth, mask, n_in, rect, info)
 
 
+def _nearest_rectified(mask: np.ndarray, rect: Rectification, shape: tuple[int, ...]
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """The rows and columns of the rectified pixels (of a grid of ``shape``) nearest to the
+    left pixels of ``mask``, those inside the grid."""
+    u, v = (np.rint(p[mask]).astype(np.int64) for p in rect.positions)
+    inside = (u >= 0) & (u < shape[1]) & (v >= 0) & (v < shape[0])
+    return v[inside], u[inside]
+
+
 def _left_count(mask: np.ndarray, rectified: np.ndarray, rect: Rectification) -> int:
     """The left pixels of ``mask`` whose nearest rectified pixel is in ``rectified``."""
-    u, v = (np.rint(p[mask]).astype(np.int64) for p in rect.positions)
-    inside = (u >= 0) & (u < rectified.shape[1]) & (v >= 0) & (v < rectified.shape[0])
-    return int(rectified[v[inside], u[inside]].sum())
+    return int(rectified[_nearest_rectified(mask, rect, rectified.shape)].sum())
 
 
 def _decide(lrect: np.ndarray, rrect: np.ndarray, left_phase: np.ndarray,
@@ -855,7 +860,7 @@ def absolute_phase(unwrapped: Unwrapped, phase: np.ndarray, calibration: StereoC
 
     Examples
     --------
-    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.geometry.calibration import StereoCalibration
     >>> from bistair.sim import preset, trace
     >>> from bistair.sim.stereo import StereoRig
     >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
@@ -994,7 +999,7 @@ def stereo_unwrap(left_images: np.ndarray, right_images: np.ndarray, spec: Any,
     Examples
     --------
     >>> from bistair.codecs import encode, make_spec
-    >>> from bistair.geometry.stereo_calibration import StereoCalibration
+    >>> from bistair.geometry.calibration import StereoCalibration
     >>> from bistair.sim import preset, trace
     >>> from bistair.sim.render import Imaging, expose
     >>> from bistair.sim.stereo import StereoRig

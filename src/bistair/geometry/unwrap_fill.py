@@ -28,8 +28,9 @@ import math
 import cv2
 import numpy as np
 
+from ..core.phase import wrap
+from .calibration import StereoCalibration
 from .stereo import Rectification
-from .stereo_calibration import StereoCalibration
 from .unwrap_fill_jit import continue_rows, right_nearest
 
 #: The phase step (radians) a continued pixel may take to a neighbour: this many times the
@@ -47,11 +48,6 @@ MARGIN = 2.0
 #: 5 mm off the truth (the mask's rim) without this, 65 of 902 with 2, 26 of 803 with 3;
 #: at 320 x 240, 135 of 4134, 16 of 3904, 0 of 3698.
 RIM = 3
-
-
-def _wrap(angle: np.ndarray) -> np.ndarray:
-    """Angles wrapped into ``[-pi, pi)``."""
-    return np.mod(angle + np.pi, 2 * np.pi) - np.pi
 
 
 def phase_bound(phase: np.ndarray, decided: np.ndarray, noise: float) -> float:
@@ -83,7 +79,7 @@ def phase_bound(phase: np.ndarray, decided: np.ndarray, noise: float) -> float:
     for first, second, both in ((phase[:, :-1], phase[:, 1:], decided[:, :-1] & decided[:, 1:]),
                                 (phase[:-1], phase[1:], decided[:-1] & decided[1:])):
         if both.any():
-            step = np.abs(_wrap(second[both] - first[both]))
+            step = np.abs(wrap(second[both] - first[both]))
             steps.append(float(np.median(step)))
     bound = STEPS * max(steps) + NOISE_SIGMAS * math.sqrt(2) * noise
     return min(bound, MAX_BOUND)
@@ -117,7 +113,7 @@ def bend_bound(phase: np.ndarray, decided: np.ndarray, noise: float) -> float:
     median = 0.0
     if both.any():
         second = phase[:, 2:][both] - 2 * phase[:, 1:-1][both] + phase[:, :-2][both]
-        median = float(np.median(np.abs(_wrap(second))))
+        median = float(np.median(np.abs(wrap(second))))
     return STEPS * median + NOISE_SIGMAS * math.sqrt(6) * noise
 
 
