@@ -45,8 +45,12 @@ from ..codecs import encode, make_spec
 from ..core.captures import to_bit_depth
 from ..errors import BistairError
 from ..evaluation.benchmark import method_specs
-from ..geometry.calibration import Calibration, save_calibration
-from ..geometry.stereo_calibration import StereoCalibration, save_stereo_calibration
+from ..geometry.calibration import (
+    Calibration,
+    StereoCalibration,
+    save_calibration,
+    save_stereo_calibration,
+)
 from ..io.atomic import output_folder, write_image
 from ..io.jsonfile import write_json
 from ..sim import Imaging, Trace, expose, preset, scene_names

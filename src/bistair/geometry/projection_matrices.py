@@ -40,8 +40,7 @@ import numpy as np
 
 from ..errors import BistairError
 from ..io.atomic import output_file
-from .calibration import Device
-from .stereo_calibration import ProjectorPose, StereoCalibration
+from .calibration import Device, ProjectorPose, StereoCalibration
 
 #: The pixel origins a camera's matrix may use: 0 (OpenCV, bistair) or 1 (MATLAB).
 PIXEL_ORIGINS = (0, 1)

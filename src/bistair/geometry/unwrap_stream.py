@@ -42,7 +42,7 @@ fringes there, 19 px for 16-px fringes), outside a search 12 px wide.
 Examples
 --------
 >>> from bistair.codecs import make_spec
->>> from bistair.geometry.stereo_calibration import StereoCalibration
+>>> from bistair.geometry.calibration import StereoCalibration
 >>> from bistair.sim import preset, trace
 >>> from bistair.sim.stereo import StereoRig
 >>> rig, scene = preset("plane", camera_size=(80, 60))  # a plane at 600 mm
@@ -77,9 +77,9 @@ from ..core.captures import prepare
 from ..core.measure import measure
 from ..core.motion import PhaseStream
 from ..errors import BistairError
+from .calibration import StereoCalibration
 from .projection_matrices import with_pixel_origin
 from .stereo import Rectification, rectify
-from .stereo_calibration import StereoCalibration
 from .unwrap import (
     EDGE,
     GROW_SUPPORT,

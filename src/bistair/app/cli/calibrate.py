@@ -115,7 +115,7 @@ def import_calibration(files: tuple[Path, ...], out: Path, projector_size: str |
     if not files:
         raise CliError("give the calibration FILES (or --projection-matrices)")
     if stereo:
-        from ...geometry.stereo_calibration import short_baseline
+        from ...geometry.calibration import short_baseline
         from ..calibrate import import_stereo_calibration
 
         if projector_size is not None:
