@@ -314,25 +314,40 @@ zmin, zmax, width, rows, from_right, whole
                    bool(whole))
 
 
+@kernel(parallel=True)
+def _seeds(out: np.ndarray, n_in: np.ndarray, top: int, blocked: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    h, w = out.shape
+    columns = np.empty((h, w), np.int32)
+    counts = np.zeros(h, np.int64)
+    for y in prange(h):  # each row's decided pixels beside one that may grow
+        c = 0
+        for x in range(w):
+            if out[y, x] != out[y, x]:
+                continue
+            for k in range(4):
+                ny, nx = y + (1, -1, 0, 0)[k], x + (0, 0, 1, -1)[k]
+                if (0 <= ny < h and 0 <= nx < w and out[ny, nx] != out[ny, nx]
+                        and 1 <= n_in[ny, nx] <= top and not blocked[ny, nx]):
+                    columns[y, c] = x
+                    c += 1
+                    break
+        counts[y] = c
+    return columns, counts
+
+
 @kernel()
 def _grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.ndarray,
-          reach: float, support: int) -> np.ndarray:
+          reach: float, support: int, columns: np.ndarray, counts: np.ndarray) -> np.ndarray:
     h, w = disparity.shape
     dy, dx = np.array([1, -1, 0, 0]), np.array([0, 0, 1, -1])
     out = disparity.copy()
     queue = np.empty(h * w, np.int64)
     tail = 0
-    for y in range(h):  # the decided pixels beside one that may grow (the others change
-        for x in range(w):  # nothing when their turn comes), in raster order
-            if out[y, x] != out[y, x]:
-                continue
-            for k in range(4):
-                ny, nx = y + dy[k], x + dx[k]
-                if (0 <= ny < h and 0 <= nx < w and out[ny, nx] != out[ny, nx]
-                        and 1 <= n_in[ny, nx] <= kept.shape[2] and not blocked[ny, nx]):
-                    queue[tail] = y * w + x
-                    tail += 1
-                    break
+    for y in range(h):  # the seeds (_seeds), in raster order
+        for c in range(counts[y]):
+            queue[tail] = y * w + columns[y, c]
+            tail += 1
     head = 0
     while head < tail:
         y, x = queue[head] // w, queue[head] % w
@@ -411,10 +426,12 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
     >>> [round(float(v), 1) for v in grow(d, n, kept, np.zeros((1, 4), bool), support=2)[0]]
     [20.2, nan, nan, nan]
     """
-    return _grow(np.ascontiguousarray(disparity, np.float32),
-                 np.ascontiguousarray(n_in, np.int16),
-                 np.ascontiguousarray(kept, np.float32),
-                 np.ascontiguousarray(blocked, np.bool_), float(reach), int(support))
+    disparity = np.ascontiguousarray(disparity, np.float32)
+    n_in = np.ascontiguousarray(n_in, np.int16)
+    kept = np.ascontiguousarray(kept, np.float32)
+    blocked = np.ascontiguousarray(blocked, np.bool_)
+    columns, counts = _seeds(disparity, n_in, kept.shape[2], blocked)
+    return _grow(disparity, n_in, kept, blocked, float(reach), int(support), columns, counts)
 
 
 @kernel(parallel=True)
