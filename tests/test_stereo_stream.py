@@ -326,8 +326,8 @@ def test_every_window_leaves_mixed_pixels_undecided(sim, monkeypatch):
 
     found, real = [], unwrap_stream.mixed_pixels
 
-    def recorded(depth, mask, *args):
-        flagged = real(depth, mask, *args)
+    def recorded(depth, mask, *args, **kwargs):
+        flagged = real(depth, mask, *args, **kwargs)
         flagged.ravel()[np.flatnonzero(mask)[::50]] = True
         found.append(flagged & mask)
         return found[-1]
