@@ -470,7 +470,7 @@ def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, c
 
 
 @kernel(parallel=True)
-def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+def _plane_depth(cols: np.ndarray, rows: np.ndarray | None, u: np.ndarray, v: np.ndarray,
                  phase: np.ndarray, ax: np.ndarray, az: np.ndarray, period: float,
                  max_step: float, kp: np.ndarray, dp: np.ndarray, t0: float, t2: float,
                  zmin: float, zmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -496,7 +496,9 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
             # (reciprocals precomputed: no division but the plane's)
             k = math.floor(c * inv_period - phi * inv_two_pi + 0.5)
             xp = (phi * inv_two_pi + k) * period  # the column of the absolute phase
-            if distorted:  # the row of the sample, for the column plane's local slope
+            if rows is None:  # (a compiled version of its own: the pass vectorises)
+                xn = (xp - cxp) * inv_fx
+            elif distorted:  # the row of the sample, for the column plane's local slope
                 r = (1 - fv) * ((1 - fu) * rows[y0, x0] + fu * rows[y0, x0 + 1]) + fv * (
                     (1 - fu) * rows[y0 + 1, x0] + fu * rows[y0 + 1, x0 + 1])
                 yd = (r - cyp) * inv_fy
@@ -508,10 +510,8 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
                     dx = 2.0 * dp[2] * xn * yn + dp[3] * (r2 + 2.0 * xn * xn)
                     dy = dp[2] * (r2 + 2.0 * yn * yn) + 2.0 * dp[3] * xn * yn
                     xn, yn = (xd - dx) / radial, (yd - dy) / radial
-            elif skew != 0.0:
+            else:  # skewed
                 xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) * inv_fy)) * inv_fx
-            else:
-                xn = (xp - cxp) * inv_fx
             z = (xn * t2 - t0) / (float(ax[y, x]) - xn * float(az[y, x]))  # (0: inf, NaN)
             # (a NaN phase or corner makes z NaN; every corner decided: c is a number)
             ok = inside & (c == c) & (spread <= max_step) & (zmin <= z) & (z <= zmax)
@@ -589,13 +589,14 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray | None, u: np.ndarray, v: 
     k = np.ascontiguousarray(np.asarray(kp, np.float64).reshape(3, 3))
     d = np.ascontiguousarray(np.asarray(dp, np.float64).reshape(5))
     t = np.asarray(tp, np.float64).reshape(3)
-    if rows is None and (np.any(d) or k[0, 1] != 0.0):
+    bent = bool(np.any(d) or k[0, 1] != 0.0)  # (else None: a version without its branch)
+    if rows is None and bent:
         raise ValueError("plane_depth needs the projector rows of a distorted or skewed "
                          "projector")
     return _plane_depth(np.ascontiguousarray(columns, np.float32),
-                        np.empty((0, 0), np.float32) if rows is None
-                        else np.ascontiguousarray(rows, np.float32), np.asarray(u, np.float32),
-                        np.asarray(v, np.float32), np.asarray(phase, np.float32),
+                        np.ascontiguousarray(rows, np.float32) if bent else None,
+                        np.asarray(u, np.float32), np.asarray(v, np.float32),
+                        np.asarray(phase, np.float32),
                         np.asarray(ax, np.float32), np.asarray(az, np.float32), float(period),
                         float(max_step), k, d, float(t[0]), float(t[2]), float(zmin),
                         float(zmax))
