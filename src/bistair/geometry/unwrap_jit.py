@@ -529,6 +529,9 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
     length), at least ``sigmas * sqrt(2)`` times the depth noise (the depth one projector
     column moves along the pixel's ray, from the projector's pinhole model, times
     ``noise * period / (2*pi)`` columns), at most half the depth of one fringe period.
+    That depth is ``q_z**2`` times a term of the ray (:func:`column_terms`: no division a
+    depth map); a pixel whose decided neighbours all lie within its limits is neither
+    ramp nor spike, and only the others are tested further.
 
     Parameters
     ----------
