@@ -472,6 +472,20 @@ def _mixed(depth: np.ndarray, mask: np.ndarray, terms: np.ndarray, t2: float,
     return out
 
 
+@kernel(parallel=True)
+def _column_terms(rx: np.ndarray, ry: np.ndarray, rp: np.ndarray, tp: np.ndarray,
+                  fx: float) -> np.ndarray:
+    h, w = rx.shape
+    out = np.empty((h, w, 2), np.float64)
+    for y in prange(h):
+        for x in range(w):
+            ax = rp[0, 0] * rx[y, x] + rp[0, 1] * ry[y, x] + rp[0, 2]
+            az = rp[2, 0] * rx[y, x] + rp[2, 1] * ry[y, x] + rp[2, 2]
+            rate = abs(fx * (ax * tp[2] - tp[0] * az))
+            out[y, x, 0], out[y, x, 1] = az, 1.0 / rate if rate != 0.0 else math.inf
+    return out
+
+
 def column_terms(rays: tuple[np.ndarray, np.ndarray], rotation: np.ndarray,
                  translation: np.ndarray, fx: float) -> np.ndarray:
     """Per pixel, what the depth one projector column moves along its ray needs beside the
@@ -506,14 +520,10 @@ def column_terms(rays: tuple[np.ndarray, np.ndarray], rotation: np.ndarray,
     >>> terms[0, 0].tolist(), float(600.0 ** 2 * terms[0, 0, 1])
     ([1.0, 5e-06], 1.8)
     """
-    rp = np.asarray(rotation, np.float64)
-    tp = np.asarray(translation, np.float64).ravel()
-    rx, ry = (np.asarray(r, np.float32).astype(np.float64) for r in rays)
-    ax = rp[0, 0] * rx + rp[0, 1] * ry + rp[0, 2]
-    az = rp[2, 0] * rx + rp[2, 1] * ry + rp[2, 2]
-    rate = np.abs(float(fx) * (ax * tp[2] - tp[0] * az))
-    with np.errstate(divide="ignore"):
-        return np.stack([az, 1.0 / rate], axis=-1)
+    return _column_terms(np.ascontiguousarray(rays[0], np.float32),
+                         np.ascontiguousarray(rays[1], np.float32),
+                         np.ascontiguousarray(rotation, np.float64),
+                         np.ascontiguousarray(translation, np.float64).ravel(), float(fx))
 
 
 def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.ndarray],
