@@ -398,7 +398,7 @@ def test_the_column_terms_give_the_depth_one_column_moves():
     column moves along the ray, ``1 / |du/dz|``, here against a central difference of the
     projected column (a projector turned 12 degrees, 30 mm in front of the camera, rays
     across a 0.6-wide field, 300-900 mm) within 1e-6 of it; and the stream's terms give
-    mixed_pixels' flags."""
+    mixed_pixels' flags (terms of another size refused)."""
     from bistair.geometry.unwrap import mixed_terms
     from bistair.geometry.unwrap_jit import column_terms
 
@@ -428,6 +428,8 @@ def test_the_column_terms_give_the_depth_one_column_moves():
     z[40, 40] = 700.0
     args = (z, np.ones(z.shape, bool), cal, 48.0, 0.03, rays)
     assert np.array_equal(mixed_pixels(*args, mixed_terms(cal, rays)), mixed_pixels(*args))
+    with pytest.raises(ValueError, match="column terms of shape"):  # (never read past them)
+        mixed_pixels(*args, mixed_terms(cal, rays)[:-1])
     assert np.argwhere(mixed_pixels(*args)).tolist() == [[20, 10], [20, 11], [20, 12],
                                                          [40, 40]]
 

@@ -566,6 +566,11 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
     numpy.ndarray
         ``(H, W)`` bool.
 
+    Raises
+    ------
+    ValueError
+        ``terms`` not of the depth map's shape (and 2).
+
     Examples
     --------
     >>> z = np.full((5, 9), 600.0, np.float32)
@@ -580,6 +585,9 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
     """
     if terms is None:
         terms = column_terms(rays, rotation, translation, fx)
+    if np.shape(terms) != (*np.shape(depth), 2):
+        raise ValueError(f"column terms of shape {np.shape(terms)} for a depth map of "
+                         f"{np.shape(depth)}: another rig's or size's")
     return _mixed(np.ascontiguousarray(depth, np.float32), np.ascontiguousarray(mask, bool),
                   np.ascontiguousarray(terms, np.float64),
                   float(np.asarray(translation, np.float64).ravel()[2]), float(f_left),
