@@ -326,8 +326,8 @@ def test_every_window_leaves_mixed_pixels_undecided(sim, monkeypatch):
 
     found, real = [], unwrap_stream.mixed_pixels
 
-    def recorded(depth, mask, *args):
-        flagged = real(depth, mask, *args)
+    def recorded(depth, mask, *args, **kwargs):
+        flagged = real(depth, mask, *args, **kwargs)
         flagged.ravel()[np.flatnonzero(mask)[::50]] = True
         found.append(flagged & mask)
         return found[-1]
@@ -339,3 +339,55 @@ def test_every_window_leaves_mixed_pixels_undecided(sim, monkeypatch):
         assert result.info["mixed"] == mixed.sum()
         assert np.isnan(result.depth[mixed]).all() and np.isnan(result.phase[mixed]).all()
         assert (result.order[mixed] == -1).all() and not result.mask[mixed].any()
+
+
+def test_the_depth_passes_equal_the_projection_and_the_reference(sim, monkeypatch):
+    """The stream's depth through an undistorted projector: the projector columns from the
+    row's coefficients (``projector_pixels(..., rows=False)``: one division a pixel) are
+    the projected points' (``rows=True``, OpenCV's model) within 1e-4 px, undecided at the
+    same pixels; ``plane_depth``'s pass without branches gives its NumPy reference's
+    order exactly, depth and column to float32's rounding (1e-6 of the value: 6e-4 mm,
+    6e-4 px at 600; the reference divides where the pass multiplies by reciprocals),
+    every window, also with every 35th column a period off (its neighbours' corners spread
+    too far: undecided)."""
+    from support import reference
+
+    from bistair.geometry import unwrap_stream
+
+    calls: dict[str, list] = {"projector_pixels": [], "plane_depth": []}
+
+    def recorder(name):
+        real, found = getattr(unwrap_stream, name), calls[name]
+
+        def recorded(*args, **kwargs):
+            found.append(([np.copy(a) if isinstance(a, np.ndarray) else a for a in args],
+                          kwargs))
+            return real(*args, **kwargs)
+        return recorded
+
+    for name in calls:
+        monkeypatch.setattr(unwrap_stream, name, recorder(name))
+    windows(sim, 0, 6.0)
+    monkeypatch.undo()
+    assert len(calls["plane_depth"]) == 7
+    for (cargs, kwargs), (dargs, _) in zip(*calls.values(), strict=True):
+        assert kwargs == {"rows": False}
+        fast, rows = unwrap_stream.projector_pixels(*cargs, rows=False)
+        slow = unwrap_stream.projector_pixels(*cargs, rows=True)[0]
+        assert rows is None and np.array_equal(np.isnan(fast), np.isnan(slow))
+        assert np.isfinite(fast).sum() > 5000 and np.nanmax(np.abs(fast - slow)) < 1e-4
+        cols, _, u, v, phase, ax, az, period, step, kp, dp, tp, zmin, zmax = dargs
+        assert not np.any(dp) and kp[0, 1] == 0
+        bumped = cols.copy()  # (and columns a period off: corners that spread too far)
+        bumped[::7, ::5] += period
+        decided = []
+        for grid in (cols, bumped):
+            got = unwrap_stream.plane_depth(grid, *dargs[1:])
+            want = reference.plane_depth(grid, u, v, phase, ax, az, period, step, kp, tp,
+                                         zmin, zmax)
+            assert np.array_equal(got[1], want[1])
+            for a, b in ((got[0], want[0]), (got[2], want[2])):
+                assert np.array_equal(np.isnan(a), np.isnan(b))
+                assert np.nanmax(np.abs(a - b) / np.maximum(np.abs(b), 1)) < 1e-6  # 2 ulps
+            decided.append(int((got[1] >= 0).sum()))
+        assert decided[0] > 5000 and 1000 < decided[1] < 0.95 * decided[0], decided

@@ -392,6 +392,48 @@ def test_the_compiled_mixed_pixels_are_the_reference():
     assert slow.sum() > 50 and (fast != slow).sum() <= 2, (slow.sum(), (fast != slow).sum())
 
 
+def test_the_column_terms_give_the_depth_one_column_moves():
+    """:func:`~bistair.geometry.unwrap_jit.column_terms` (``a_z`` and ``1 / |fx (a_x t_z -
+    t_x a_z)|``, ``z`` cancelled): ``q_z**2`` times the second is the depth one projector
+    column moves along the ray, ``1 / |du/dz|``, here against a central difference of the
+    projected column (a projector turned 12 degrees, 30 mm in front of the camera, rays
+    across a 0.6-wide field, 300-900 mm) within 1e-6 of it; and the stream's terms give
+    mixed_pixels' flags (terms of another size refused)."""
+    from bistair.geometry.unwrap import mixed_terms
+    from bistair.geometry.unwrap_jit import column_terms
+
+    turn = np.deg2rad(12.0)
+    rot = np.array([[np.cos(turn), 0, np.sin(turn)], [0, 1, 0], [-np.sin(turn), 0, np.cos(turn)]])
+    shift, fx = np.array([-100.0, 5.0, 30.0]), 1800.0
+    rx, ry = np.meshgrid(np.linspace(-0.3, 0.3, 7), np.linspace(-0.2, 0.2, 5))
+    rays = (rx.astype(np.float32), ry.astype(np.float32))
+    terms = column_terms(rays, rot, shift, fx)
+    ray = np.stack([rays[0], rays[1], np.ones_like(rays[0])], axis=-1).astype(np.float64)
+
+    def column(z):
+        q = (z[..., None] * ray) @ rot.T + shift
+        return fx * q[..., 0] / q[..., 2]
+
+    for z in (300.0, 600.0, 900.0):
+        depth = np.full(rx.shape, z)
+        slope = (column(depth + 1e-3) - column(depth - 1e-3)) / 2e-3
+        qz = z * terms[..., 0] + shift[2]
+        assert np.allclose(qz ** 2 * terms[..., 1], 1 / np.abs(slope), rtol=1e-6, atol=0)
+    rig, _ = preset("plane", camera_size=(80, 60))
+    cal = StereoCalibration.from_rig(StereoRig.default(camera_size=(80, 60),
+                                                       projector_size=rig.projector.size))
+    rays = rectify(cal).rays
+    z = np.full((60, 80), 600.0, np.float32)
+    z[20, 10:13], z[20, 13:] = [630.0, 660.0, 690.0], 720.0  # a ramp to a step, a spike
+    z[40, 40] = 700.0
+    args = (z, np.ones(z.shape, bool), cal, 48.0, 0.03, rays)
+    assert np.array_equal(mixed_pixels(*args, mixed_terms(cal, rays)), mixed_pixels(*args))
+    with pytest.raises(ValueError, match="column terms of shape"):  # (never read past them)
+        mixed_pixels(*args, mixed_terms(cal, rays)[:-1])
+    assert np.argwhere(mixed_pixels(*args)).tolist() == [[20, 10], [20, 11], [20, 12],
+                                                         [40, 40]]
+
+
 def test_unseen_pixels_are_continued_from_their_neighbours():
     """sphere-on-plane, projector at 0.3, 48-px fringes: the left pixels the right camera
     gives no candidate for (their search reaches past the right view, or the sphere hides

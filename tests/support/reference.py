@@ -15,7 +15,9 @@ code in src calls them; issue 35 moved them here from the concept modules):
   (``bistair.geometry.unwrap_jit.grow``);
 * :func:`mixed_pixels`: the decided pixels of a stereo depth map in a ramp or a spike
   (``bistair.geometry.unwrap_jit.mixed_mask``, which ``unwrap.mixed_pixels`` runs), with
-  the projector's own model (distortion and all) for the depth one column moves.
+  the projector's own model (distortion and all) for the depth one column moves;
+* :func:`plane_depth`: a stream's depth through an undistorted projector's column planes
+  (``bistair.geometry.unwrap_stream_jit.plane_depth``, a pass without branches).
 """
 
 from __future__ import annotations
@@ -348,3 +350,31 @@ def grow_all_seeds(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, bl
                 queue[tail] = ny * w + nx
                 tail += 1
     return out
+
+
+def plane_depth(columns: np.ndarray, u: np.ndarray, v: np.ndarray, phase: np.ndarray,
+                ax: np.ndarray, az: np.ndarray, period: float, max_step: float,
+                kp: np.ndarray, tp: np.ndarray, zmin: float, zmax: float
+                ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """NumPy reference of :func:`bistair.geometry.unwrap_stream_jit.plane_depth` through an
+    undistorted projector without skew: the columns read bilinearly at each left pixel's
+    rectified position (four finite corners within ``max_step``), the order nearest that
+    column, ``z = (x_n t_z - t_x) / (a_x - x_n a_z)`` in the range; depth, order and
+    column (NaN, -1, NaN elsewhere)."""
+    gh, gw = columns.shape
+    x0, y0 = np.floor(u.astype(np.float64)), np.floor(v.astype(np.float64))
+    inside = (x0 >= 0) & (y0 >= 0) & (x0 + 1 < gw) & (y0 + 1 < gh)
+    xi, yi = np.where(inside, x0, 0).astype(np.int64), np.where(inside, y0, 0).astype(np.int64)
+    fu, fv = u - xi, v - yi
+    g = np.stack([columns[yi, xi], columns[yi, xi + 1], columns[yi + 1, xi],
+                  columns[yi + 1, xi + 1]]).astype(np.float64)
+    c = (1 - fu) * (1 - fv) * g[0] + fu * (1 - fv) * g[1] + (1 - fu) * fv * g[2] + fu * fv * g[3]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.floor(c / period - phase / TWO_PI + 0.5)
+        xp = (phase / TWO_PI + k) * period
+        xn = (xp - kp[0, 2]) / kp[0, 0]
+        z = (xn * tp[2] - tp[0]) / (ax - xn * az)
+        ok = (inside & np.isfinite(c) & (g.max(0) - g.min(0) <= max_step) & (z >= zmin)
+              & (z <= zmax))
+    return (np.where(ok, z, np.nan).astype(np.float32), np.where(ok, k, -1).astype(np.int32),
+            np.where(ok, xp, np.nan).astype(np.float32))

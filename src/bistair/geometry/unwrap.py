@@ -71,7 +71,7 @@ from .stereo import (
 )
 from .triangulate import check_depth_range, triangulate
 from .unwrap_fill import continue_unseen
-from .unwrap_jit import grow, mixed_mask, unwrap_candidates
+from .unwrap_jit import column_terms, grow, mixed_mask, unwrap_candidates
 
 #: The tolerance on the projector's phase is this many times the phase noise of the two
 #: cameras together (at least :data:`MIN_TOLERANCE` radians).
@@ -379,8 +379,8 @@ def projector_depth(depth: np.ndarray, mask: np.ndarray, phase: np.ndarray,
 
 
 def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibration,
-                 period: float, noise: float, rays: tuple[np.ndarray, np.ndarray]
-                 ) -> np.ndarray:
+                 period: float, noise: float, rays: tuple[np.ndarray, np.ndarray],
+                 terms: np.ndarray | None = None) -> np.ndarray:
     """The decided left pixels whose depth is no surface's: mixed pixels at a depth step
     and spikes (:data:`GRAZING`), to be left undecided.
 
@@ -408,6 +408,9 @@ def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibra
     rays : tuple of numpy.ndarray
         The left pixels' undistorted rays ``x / z``, ``y / z`` (:class:`~.stereo.
         Rectification` ``rays``).
+    terms : numpy.ndarray, optional
+        :func:`mixed_terms` of ``calibration`` and ``rays`` (what does not change between
+        depth maps of one rig: a stream computes it once); by default computed here.
 
     Returns
     -------
@@ -433,7 +436,41 @@ def mixed_pixels(depth: np.ndarray, mask: np.ndarray, calibration: StereoCalibra
     """
     proj = calibration.projector
     return mixed_mask(depth, mask, rays, proj.R, proj.T, proj.device.K[0, 0],
-                      calibration.left.K[0, 0], noise, period, GRAZING, EDGE_SIGMAS)
+                      calibration.left.K[0, 0], noise, period, GRAZING, EDGE_SIGMAS, terms)
+
+
+def mixed_terms(calibration: StereoCalibration, rays: tuple[np.ndarray, np.ndarray]
+                ) -> np.ndarray:
+    """What :func:`mixed_pixels` needs of each left pixel beside its depth, for the depth
+    one projector column moves along its ray (:func:`~.unwrap_jit.column_terms`).
+
+    Parameters
+    ----------
+    calibration : StereoCalibration
+        The cameras and the projector.
+    rays : tuple of numpy.ndarray
+        The left pixels' undistorted rays (as for :func:`mixed_pixels`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 2)`` float64.
+
+    Examples
+    --------
+    >>> from bistair.geometry.stereo import rectify
+    >>> from bistair.sim.stereo import StereoRig
+    >>> cal = StereoCalibration.from_rig(StereoRig.default(camera_size=(80, 60)))
+    >>> rays = rectify(cal).rays
+    >>> z = np.full((60, 80), 600.0, np.float32)
+    >>> z[30, 40] = 700.0  # a spike
+    >>> mixed = mixed_pixels(z, np.ones(z.shape, bool), cal, 48.0, 0.03, rays,
+    ...                      mixed_terms(cal, rays))
+    >>> np.argwhere(mixed).tolist()
+    [[30, 40]]
+    """
+    proj = calibration.projector
+    return column_terms(rays, proj.R, proj.T, proj.device.K[0, 0])
 
 
 def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,

@@ -434,53 +434,119 @@ def grow(disparity: np.ndarray, n_in: np.ndarray, kept: np.ndarray, blocked: np.
     return _grow(disparity, n_in, kept, blocked, float(reach), int(support), columns, counts)
 
 
+@inline
+def _decided(depth: np.ndarray, mask: np.ndarray, y: int, x: int) -> float:
+    """The depth at ``(y, x)`` where inside and decided, else NaN."""
+    if 0 <= y < depth.shape[0] and 0 <= x < depth.shape[1] and mask[y, x]:
+        return float(depth[y, x])
+    return math.nan
+
+
+@inline
+def _pair(ahead: float, behind: float, limit: float) -> tuple[bool, int, int]:
+    """One direction's test: a ramp (both steps over ``limit``, the same way), the steps
+    seen and those within ``limit`` (a NaN step is neither)."""
+    over = abs(ahead) > limit and abs(behind) > limit and (ahead > 0.0) == (behind > 0.0)
+    seen = (ahead == ahead) + (behind == behind)
+    return over, seen, (abs(ahead) <= limit) + (abs(behind) <= limit)
+
+
 @kernel(parallel=True)
-def _mixed(depth: np.ndarray, mask: np.ndarray, rx: np.ndarray, ry: np.ndarray,
-           rp: np.ndarray, tp: np.ndarray, fx: float, f_left: float, noise: float,
-           period: float, grazing: float, sigmas: float) -> np.ndarray:
+def _mixed(depth: np.ndarray, mask: np.ndarray, terms: np.ndarray, t2: float,
+           f_left: float, noise: float, period: float, grazing: float, sigmas: float
+           ) -> np.ndarray:
     h, w = depth.shape
-    dys, dxs = np.array([0, 1, 1, 1]), np.array([1, 0, 1, -1])
     out = np.zeros((h, w), np.bool_)
+    noise_columns = sigmas * math.sqrt(2.0) * noise * period / TWO_PI
+    footprint, root2 = grazing / f_left, math.sqrt(2.0)
     for y in prange(h):
         for x in range(w):
             z = np.float64(depth[y, x])
             if not mask[y, x] or z != z:
                 continue
-            # the depth one projector column moves along this pixel's ray (pinhole model)
+            # the depth one projector column moves along this pixel's ray (column_terms)
+            qz = z * terms[y, x, 0] + t2
+            per_column = qz * qz * terms[y, x, 1]
+            floor, cap = noise_columns * per_column, 0.5 * per_column * period
+            straight = min(max(footprint * z, floor), cap)
+            diagonal = min(max(footprint * z * root2, floor), cap)
+            e, o = _decided(depth, mask, y, x + 1) - z, z - _decided(depth, mask, y, x - 1)
+            s, n = _decided(depth, mask, y + 1, x) - z, z - _decided(depth, mask, y - 1, x)
+            se = _decided(depth, mask, y + 1, x + 1) - z
+            nw = z - _decided(depth, mask, y - 1, x - 1)
+            sw = _decided(depth, mask, y + 1, x - 1) - z
+            ne = z - _decided(depth, mask, y - 1, x + 1)
+            if not ((abs(e) > straight) | (abs(o) > straight) | (abs(s) > straight)
+                    | (abs(n) > straight) | (abs(se) > diagonal) | (abs(nw) > diagonal)
+                    | (abs(sw) > diagonal) | (abs(ne) > diagonal)):
+                continue  # every decided neighbour within its limit: neither ramp nor spike
+            r0, s0, n0 = _pair(e, o, straight)
+            r1, s1, n1 = _pair(s, n, straight)
+            r2, s2, n2 = _pair(se, nw, diagonal)
+            r3, s3, n3 = _pair(sw, ne, diagonal)
+            out[y, x] = (r0 or r1 or r2 or r3) or (s0 + s1 + s2 + s3 > 0
+                                                    and n0 + n1 + n2 + n3 == 0)
+    return out
+
+
+@kernel(parallel=True)
+def _column_terms(rx: np.ndarray, ry: np.ndarray, rp: np.ndarray, tp: np.ndarray,
+                  fx: float) -> np.ndarray:
+    h, w = rx.shape
+    out = np.empty((h, w, 2), np.float64)
+    for y in prange(h):
+        for x in range(w):
             ax = rp[0, 0] * rx[y, x] + rp[0, 1] * ry[y, x] + rp[0, 2]
             az = rp[2, 0] * rx[y, x] + rp[2, 1] * ry[y, x] + rp[2, 2]
-            qx, qz = z * ax + tp[0], z * az + tp[2]
-            du = fx * (ax * qz - qx * az) / (qz * qz)
-            per_column = 1.0 / abs(du) if du != 0.0 else math.inf
-            floor = sigmas * math.sqrt(2.0) * per_column * noise * period / TWO_PI
-            cap = 0.5 * per_column * period
-            straight = min(max(grazing * z / f_left, floor), cap)
-            diagonal = min(max(grazing * z / f_left * math.sqrt(2.0), floor), cap)
-            ramp, seen, near = False, 0, 0
-            for k in range(4):
-                dy, dx = dys[k], dxs[k]
-                limit = straight if k < 2 else diagonal
-                ahead, behind = math.nan, math.nan
-                if 0 <= y + dy < h and 0 <= x + dx < w and mask[y + dy, x + dx]:
-                    ahead = depth[y + dy, x + dx] - z
-                if ahead == ahead:
-                    seen += 1
-                    near += abs(ahead) <= limit
-                if 0 <= y - dy < h and 0 <= x - dx < w and mask[y - dy, x - dx]:
-                    behind = z - depth[y - dy, x - dx]
-                if behind == behind:
-                    seen += 1
-                    near += abs(behind) <= limit
-                if (abs(ahead) > limit and abs(behind) > limit
-                        and (ahead > 0.0) == (behind > 0.0)):
-                    ramp = True
-            out[y, x] = ramp or (seen > 0 and near == 0)
+            rate = abs(fx * (ax * tp[2] - tp[0] * az))
+            out[y, x, 0], out[y, x, 1] = az, 1.0 / rate if rate != 0.0 else math.inf
     return out
+
+
+def column_terms(rays: tuple[np.ndarray, np.ndarray], rotation: np.ndarray,
+                 translation: np.ndarray, fx: float) -> np.ndarray:
+    """Per pixel, what the depth one projector column moves along its ray needs beside the
+    depth: the ray's ``a_z`` and ``1 / |fx (a_x t_z - t_x a_z)|``, with ``a = R (x, y, 1)``.
+
+    The point ``z (x, y, 1)`` is ``q = z a + t`` in the projector's frame; its column moves
+    by ``du/dz = fx (a_x q_z - q_x a_z) / q_z**2 = fx (a_x t_z - t_x a_z) / q_z**2`` (``z``
+    cancels), so one column is ``q_z**2`` times the second term in depth: no division
+    per window (:func:`mixed_mask`).
+
+    Parameters
+    ----------
+    rays : tuple of numpy.ndarray
+        The pixels' undistorted rays ``x / z``, ``y / z`` (each ``(H, W)``).
+    rotation, translation : numpy.ndarray
+        The projector's pose (``X_p = R X + T``).
+    fx : float
+        The projector's focal length (pixels).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 2)`` float64: ``a_z`` and the depth of one column over ``q_z**2`` (inf
+        where a column does not move along the ray).
+
+    Examples
+    --------
+    A projector 100 mm to the side, ``fx`` 2000: at 600 mm, one column is 1.8 mm deep.
+
+    >>> one = np.zeros((1, 1), np.float32)
+    >>> terms = column_terms((one, one), np.eye(3), np.array([-100.0, 0.0, 0.0]), 2000.0)
+    >>> terms[0, 0].tolist(), float(600.0 ** 2 * terms[0, 0, 1])
+    ([1.0, 5e-06], 1.8)
+    """
+    return _column_terms(np.ascontiguousarray(rays[0], np.float32),
+                         np.ascontiguousarray(rays[1], np.float32),
+                         np.ascontiguousarray(rotation, np.float64),
+                         np.ascontiguousarray(translation, np.float64).ravel(), float(fx))
 
 
 def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.ndarray],
                rotation: np.ndarray, translation: np.ndarray, fx: float, f_left: float,
-               noise: float, period: float, grazing: float, sigmas: float) -> np.ndarray:
+               noise: float, period: float, grazing: float, sigmas: float,
+               terms: np.ndarray | None = None) -> np.ndarray:
     """The decided pixels of a depth map that are no surface's: in a ramp (the depth steps
     the same way to both neighbours along a row, column or diagonal, each step over the
     limit) or a spike (over the limit from every decided 8-neighbour), the compiled pass of
@@ -490,6 +556,9 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
     length), at least ``sigmas * sqrt(2)`` times the depth noise (the depth one projector
     column moves along the pixel's ray, from the projector's pinhole model, times
     ``noise * period / (2*pi)`` columns), at most half the depth of one fringe period.
+    That depth is ``q_z**2`` times a term of the ray (:func:`column_terms`: no division a
+    depth map); a pixel whose decided neighbours all lie within its limits is neither
+    ramp nor spike, and only the others are tested further.
 
     Parameters
     ----------
@@ -505,11 +574,19 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
         The phase noise (radians) and the fringe period (projector pixels).
     grazing, sigmas : float
         The limit's footprints and noise multiples.
+    terms : numpy.ndarray, optional
+        :func:`column_terms` of ``rays`` and the pose (a stream computes them once); by
+        default computed here.
 
     Returns
     -------
     numpy.ndarray
         ``(H, W)`` bool.
+
+    Raises
+    ------
+    ValueError
+        ``terms`` not of the depth map's shape (and 2).
 
     Examples
     --------
@@ -523,9 +600,12 @@ def mixed_mask(depth: np.ndarray, mask: np.ndarray, rays: tuple[np.ndarray, np.n
     >>> np.argwhere(m).tolist()
     [[2, 3], [2, 4], [2, 5]]
     """
+    if terms is None:
+        terms = column_terms(rays, rotation, translation, fx)
+    if np.shape(terms) != (*np.shape(depth), 2):
+        raise ValueError(f"column terms of shape {np.shape(terms)} for a depth map of "
+                         f"{np.shape(depth)}: another rig's or size's")
     return _mixed(np.ascontiguousarray(depth, np.float32), np.ascontiguousarray(mask, bool),
-                  np.ascontiguousarray(rays[0], np.float32),
-                  np.ascontiguousarray(rays[1], np.float32),
-                  np.ascontiguousarray(rotation, np.float64),
-                  np.ascontiguousarray(translation, np.float64).ravel(), float(fx),
-                  float(f_left), float(noise), float(period), float(grazing), float(sigmas))
+                  np.ascontiguousarray(terms, np.float64),
+                  float(np.asarray(translation, np.float64).ravel()[2]), float(f_left),
+                  float(noise), float(period), float(grazing), float(sigmas))

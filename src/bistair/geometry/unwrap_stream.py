@@ -90,6 +90,7 @@ from .unwrap import (
     grow,
     is_single_period,
     mixed_pixels,
+    mixed_terms,
     unwrap_stereo,
 )
 from .unwrap_stream_jit import (
@@ -206,6 +207,9 @@ class StereoStream:
         rp = np.asarray(proj.R, np.float64)
         self.ax = (rp[0, 0] * rx + rp[0, 1] * ry + rp[0, 2]).astype(np.float32)
         self.az = (rp[2, 0] * rx + rp[2, 1] * ry + rp[2, 2]).astype(np.float32)
+        self.mixed_terms = mixed_terms(cal, rect.rays)  # (mixed_pixels' per pixel)
+        # plane_depth reads the projector rows only through distortion or skew
+        self.rows = bool(np.any(proj.device.dist) or proj.device.K[0, 1] != 0.0)
         self.buffers: list[dict] = [{}, {}]  # rectify_pair's
 
     @property
@@ -304,7 +308,7 @@ class StereoStream:
             info.update(searched_near=0, searched_full=int(np.isfinite(disparity).sum()))
         else:
             disparity, info = self._track(lrect, rrect)
-        cols, rows = projector_pixels(disparity, *self.geometry)
+        cols, rows = projector_pixels(disparity, *self.geometry, rows=self.rows)
         proj = self.calibration.projector
         u, v = rect.positions
         depth, order, column = plane_depth(cols, rows, u, v, lphase, self.ax, self.az,
@@ -314,7 +318,7 @@ class StereoStream:
             self.previous, self.previous_right = disparity, None
         mask = np.isfinite(depth)
         mixed = mixed_pixels(depth, mask, self.calibration, self.period, self.noise[0],
-                             rect.rays)  # (as unwrap_stereo: ramps at depth steps, spikes)
+                             rect.rays, terms=self.mixed_terms)  # (as unwrap_stereo)
         if mixed.any():
             depth[mixed], order[mixed], column[mixed], mask[mixed] = np.nan, -1, np.nan, False
         decided = int(mask.sum())

@@ -390,30 +390,44 @@ def match_targets(disparity: np.ndarray, shift: float, width: int) -> np.ndarray
 @kernel(parallel=True)
 def _columns(disparity: np.ndarray, shift: float, f: float, cx: float, cy: float, tx: float,
              back: np.ndarray, kp: np.ndarray, dp: np.ndarray, rp: np.ndarray,
-             tp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+             tp: np.ndarray, plain: bool) -> tuple[np.ndarray, np.ndarray]:
     h, w = disparity.shape
-    cols = np.full((h, w), np.nan, np.float32)
-    rows = np.full((h, w), np.nan, np.float32)
+    cols = np.empty((h, w), np.float32)
+    rows = np.empty((0, 0) if plain else (h, w), np.float32)
+    nan32, inv_f, k = np.float32(np.nan), 1.0 / f, -f * tx
     for y in prange(h):
+        if plain:  # the row's coefficients, linear in x and d: one division (_row_plane)
+            plane = np.empty(8, np.float64)
+            _row_plane((y - cy) * inv_f, k, back, kp, rp, tp, plane)
+            for x in range(w):  # (no branch: the pass vectorises)
+                d, xl = float(disparity[y, x]), (x - cx) * inv_f
+                z = plane[3] * xl + plane[4] + tp[2] * d  # the projector's Z times d
+                u = (plane[0] * xl + plane[1] + plane[2] * d) / z + kp[0, 2]
+                cols[y, x] = np.float32(u) if (d * tx < 0.0) & (z * d > 0.0) else nan32
+            continue
         for x in range(w):
             d = float(disparity[y, x])
+            cols[y, x] = rows[y, x] = nan32
             if not d * tx < 0.0:
                 continue
-            zr = -f * tx / d
+            zr = k / d
             qx, qy = (x - cx) / f * zr, (y - cy) / f * zr
             px = back[0, 0] * qx + back[0, 1] * qy + back[0, 2] * zr
             py = back[1, 0] * qx + back[1, 1] * qy + back[1, 2] * zr
             pz = back[2, 0] * qx + back[2, 1] * qy + back[2, 2] * zr
-            u, v = _project(px, py, pz, kp, dp, rp, tp)
-            cols[y, x] = u
-            rows[y, x] = v
+            cols[y, x], rows[y, x] = _project(px, py, pz, kp, dp, rp, tp)
     return cols, rows
 
 
 def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, cy: float,
                      tx: float, back: np.ndarray, kp: np.ndarray, dp: np.ndarray,
-                     rp: np.ndarray, tp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                     rp: np.ndarray, tp: np.ndarray, rows: bool = True
+                     ) -> tuple[np.ndarray, np.ndarray | None]:
     """The projector pixel (column, row) of each rectified left pixel's point.
+
+    Without distortion and without ``rows``, each column comes from coefficients of its
+    row linear in the pixel and the disparity (one division a pixel: the row search's
+    ``_row_plane``), equal to the projection to rounding.
 
     Parameters
     ----------
@@ -421,11 +435,15 @@ def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, c
         ``(H, W)`` float32 on the rectified left grid, NaN where undecided.
     shift, f, cx, cy, tx, back, kp, dp, rp, tp
         As for :func:`track_rows` (``shift`` is not used: disparities are relative to it).
+    rows : bool, optional
+        Give the rows too (:func:`plane_depth` reads them only through a distorted
+        projector); ``False`` gives None for them where ``dp`` is all 0.
 
     Returns
     -------
     columns, rows : numpy.ndarray
-        ``(H, W)`` float32 projector pixel, NaN where ``disparity`` is.
+        ``(H, W)`` float32 projector pixel, NaN where ``disparity`` is (``rows`` None:
+        not asked for, the projector undistorted).
 
     Examples
     --------
@@ -434,58 +452,53 @@ def projector_pixels(disparity: np.ndarray, shift: float, f: float, cx: float, c
     ...                         np.eye(3), k, np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]))
     >>> [round(float(a), 3) for a in (u[0, 0], v[0, 0])], bool(np.isnan(u[0, 1]))
     ([-5.0, 0.0], True)
+    >>> u, v = projector_pixels(np.float32([[20.0, np.nan]]), 0.0, 100.0, 0.0, 0.0, -100.0,
+    ...                         np.eye(3), k, np.zeros(5), np.eye(3), np.array([-25.0, 0, 0]),
+    ...                         rows=False)
+    >>> round(float(u[0, 0]), 3), v is None
+    (-5.0, True)
     """
     def arr(a: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
         return np.ascontiguousarray(np.asarray(a, np.float64).reshape(shape))
 
-    return _columns(np.ascontiguousarray(disparity, np.float32), float(shift), float(f),
-                    float(cx), float(cy), float(tx), arr(back, (3, 3)), arr(kp, (3, 3)),
-                    arr(dp, (5,)), arr(rp, (3, 3)), arr(tp, (3,)))
-
-
-@inline
-def _corner(grid: np.ndarray, y: int, x: int, w: float, total: float, low: float,
-            high: float) -> tuple[float, float, float]:
-    """Add one corner of a bilinear sample: its weighted value, and the spread seen."""
-    g = float(grid[y, x])
-    return total + w * g, min(low, g), max(high, g)
+    plain = not (rows or np.any(arr(dp, (5,))))  # (no rows: None)
+    cols, out_rows = _columns(np.ascontiguousarray(disparity, np.float32), float(shift),
+                              float(f), float(cx), float(cy), float(tx), arr(back, (3, 3)),
+                              arr(kp, (3, 3)), arr(dp, (5,)), arr(rp, (3, 3)), arr(tp, (3,)),
+                              plain)
+    return cols, None if plain else out_rows
 
 
 @kernel(parallel=True)
-def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+def _plane_depth(cols: np.ndarray, rows: np.ndarray | None, u: np.ndarray, v: np.ndarray,
                  phase: np.ndarray, ax: np.ndarray, az: np.ndarray, period: float,
                  max_step: float, kp: np.ndarray, dp: np.ndarray, t0: float, t2: float,
                  zmin: float, zmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     h, w = u.shape
-    gh, gw = cols.shape
-    depth = np.full((h, w), np.nan, np.float32)
-    order = np.full((h, w), -1, np.int32)
-    column = np.full((h, w), np.nan, np.float32)
+    (gh, gw), nan32 = cols.shape, np.float32(np.nan)
+    depth = np.empty((h, w), np.float32)  # (each pixel written once: no fill before)
+    order = np.empty((h, w), np.int32)
+    column = np.empty((h, w), np.float32)
     fx, skew, cxp, fy, cyp = kp[0, 0], kp[0, 1], kp[0, 2], kp[1, 1], kp[1, 2]
     distorted = dp[0] != 0.0 or dp[1] != 0.0 or dp[2] != 0.0 or dp[3] != 0.0 or dp[4] != 0.0
     inv_period, inv_two_pi, inv_fx, inv_fy = 1.0 / period, 1.0 / TWO_PI, 1.0 / fx, 1.0 / fy
     for y in prange(h):
-        for x in range(w):
-            phi = float(phase[y, x])
-            if phi != phi:
-                continue
-            su, sv = float(u[y, x]), float(v[y, x])
-            x0, y0 = int(math.floor(su)), int(math.floor(sv))
-            if x0 < 0 or y0 < 0 or x0 + 1 >= gw or y0 + 1 >= gh:
-                continue
+        for x in range(w):  # (no branch but the rig's: the pass vectorises)
+            phi, su, sv = float(phase[y, x]), float(u[y, x]), float(v[y, x])
+            fx0, fy0 = math.floor(su), math.floor(sv)
+            inside = (fx0 >= 0.0) & (fy0 >= 0.0) & (fx0 + 1.0 < gw) & (fy0 + 1.0 < gh)
+            x0, y0 = int(fx0) if inside else 0, int(fy0) if inside else 0
             fu, fv = su - x0, sv - y0
-            c, lo, hi = 0.0, math.inf, -math.inf
-            c, lo, hi = _corner(cols, y0, x0, (1 - fu) * (1 - fv), c, lo, hi)
-            c, lo, hi = _corner(cols, y0, x0 + 1, fu * (1 - fv), c, lo, hi)
-            c, lo, hi = _corner(cols, y0 + 1, x0, (1 - fu) * fv, c, lo, hi)
-            c, lo, hi = _corner(cols, y0 + 1, x0 + 1, fu * fv, c, lo, hi)
-            if not hi - lo <= max_step:  # (NaN: a corner undecided)
-                continue
+            g0, g1 = float(cols[y0, x0]), float(cols[y0, x0 + 1])  # the four corners
+            g2, g3 = float(cols[y0 + 1, x0]), float(cols[y0 + 1, x0 + 1])
+            c = (1 - fu) * (1 - fv) * g0 + fu * (1 - fv) * g1 + (1 - fu) * fv * g2 + fu * fv * g3
+            spread = max(max(g0, g1), max(g2, g3)) - min(min(g0, g1), min(g2, g3))
             # (reciprocals precomputed: no division but the plane's)
             k = math.floor(c * inv_period - phi * inv_two_pi + 0.5)
             xp = (phi * inv_two_pi + k) * period  # the column of the absolute phase
-            yn = 0.0
-            if distorted:  # the row of the sample, for the column plane's local slope
+            if rows is None:  # (a compiled version of its own: the pass vectorises)
+                xn = (xp - cxp) * inv_fx
+            elif distorted:  # the row of the sample, for the column plane's local slope
                 r = (1 - fv) * ((1 - fu) * rows[y0, x0] + fu * rows[y0, x0 + 1]) + fv * (
                     (1 - fu) * rows[y0 + 1, x0] + fu * rows[y0 + 1, x0 + 1])
                 yd = (r - cyp) * inv_fy
@@ -497,22 +510,18 @@ def _plane_depth(cols: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarra
                     dx = 2.0 * dp[2] * xn * yn + dp[3] * (r2 + 2.0 * xn * xn)
                     dy = dp[2] * (r2 + 2.0 * yn * yn) + 2.0 * dp[3] * xn * yn
                     xn, yn = (xd - dx) / radial, (yd - dy) / radial
-            elif skew != 0.0:
+            else:  # skewed
                 xn = (xp - cxp - skew * ((float(rows[y0, x0]) - cyp) * inv_fy)) * inv_fx
-            else:
-                xn = (xp - cxp) * inv_fx
-            den = float(ax[y, x]) - xn * float(az[y, x])
-            if den == 0.0:
-                continue
-            z = (xn * t2 - t0) / den
-            if zmin <= z <= zmax:
-                depth[y, x] = z
-                order[y, x] = int(k)
-                column[y, x] = xp
+            z = (xn * t2 - t0) / (float(ax[y, x]) - xn * float(az[y, x]))  # (0: inf, NaN)
+            # (a NaN phase or corner makes z NaN; every corner decided: c is a number)
+            ok = inside & (c == c) & (spread <= max_step) & (zmin <= z) & (z <= zmax)
+            depth[y, x] = np.float32(z) if ok else nan32
+            order[y, x] = int(k) if ok else -1
+            column[y, x] = np.float32(xp) if ok else nan32
     return depth, order, column
 
 
-def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndarray,
+def plane_depth(columns: np.ndarray, rows: np.ndarray | None, u: np.ndarray, v: np.ndarray,
                 phase: np.ndarray, ax: np.ndarray, az: np.ndarray, period: float,
                 max_step: float, kp: np.ndarray, dp: np.ndarray, tp: np.ndarray,
                 zmin: float, zmax: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -531,7 +540,8 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndar
     ----------
     columns, rows : numpy.ndarray
         ``(h, w)`` float32 projector pixel of each rectified left pixel
-        (:func:`projector_pixels`), NaN where undecided.
+        (:func:`projector_pixels`), NaN where undecided; ``rows`` is read only through a
+        distorted or skewed projector (None else).
     u, v : numpy.ndarray
         ``(H, W)`` float32 the left pixels' rectified positions.
     phase : numpy.ndarray
@@ -557,6 +567,11 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndar
         ``(H, W)`` float32 the projector column of the absolute phase
         (``Phi * period / (2*pi)``), NaN where ``depth`` is.
 
+    Raises
+    ------
+    ValueError
+        ``rows`` None where the projector is distorted or skewed.
+
     Examples
     --------
     A projector 25 mm right of the camera, both ``f`` = 100 px, columns ``x - 5`` on a
@@ -574,9 +589,14 @@ def plane_depth(columns: np.ndarray, rows: np.ndarray, u: np.ndarray, v: np.ndar
     k = np.ascontiguousarray(np.asarray(kp, np.float64).reshape(3, 3))
     d = np.ascontiguousarray(np.asarray(dp, np.float64).reshape(5))
     t = np.asarray(tp, np.float64).reshape(3)
+    bent = bool(np.any(d) or k[0, 1] != 0.0)  # (else None: a version without its branch)
+    if rows is None and bent:
+        raise ValueError("plane_depth needs the projector rows of a distorted or skewed "
+                         "projector")
     return _plane_depth(np.ascontiguousarray(columns, np.float32),
-                        np.ascontiguousarray(rows, np.float32), np.asarray(u, np.float32),
-                        np.asarray(v, np.float32), np.asarray(phase, np.float32),
+                        np.ascontiguousarray(rows, np.float32) if bent else None,
+                        np.asarray(u, np.float32), np.asarray(v, np.float32),
+                        np.asarray(phase, np.float32),
                         np.asarray(ax, np.float32), np.asarray(az, np.float32), float(period),
                         float(max_step), k, d, float(t[0]), float(t[2]), float(zmin),
                         float(zmax))
