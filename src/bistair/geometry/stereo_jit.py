@@ -93,6 +93,157 @@ def remap_valid(values: np.ndarray, map_x: np.ndarray, map_y: np.ndarray,
                   np.asarray(map_y, np.float32), float(max_step))
 
 
+#: A rectified pixel is known where its known corners carry this much of the bilinear
+#: weight (an unknown corner or one outside the image at most 0.001).
+KNOWN_WEIGHT = np.float32(0.999)
+_PI32, _TWO_PI32 = np.float32(math.pi), np.float32(2.0 * math.pi)
+
+
+@inline
+def _corner(phase: np.ndarray, y: int, x: int, w: np.float32) -> np.float32:
+    """``phase[y, x]`` for a corner of weight ``w > 0`` inside the image, else NaN."""
+    if w > 0.0 and 0 <= y < phase.shape[0] and 0 <= x < phase.shape[1]:
+        return phase[y, x]
+    return np.float32(np.nan)
+
+
+@inline
+def _link(p: np.float32, w: np.float32, last: np.float32, at: np.float32, first: np.float32,
+          acc: np.float32, good: np.float32
+          ) -> tuple[np.float32, np.float32, np.float32, np.float32, np.float32]:
+    """A known corner ``p`` unwrapped against the last known one before it around the
+    square (``last``, unwrapped to ``at`` about the ``first``: the step between them
+    wrapped into ``[-pi, pi)``) and added with weight ``w``."""
+    if p != p:
+        return last, at, first, acc, good
+    u = np.float32(0.0)
+    if last == last:
+        d = p - last
+        d = d - _TWO_PI32 if d >= _PI32 else d
+        u = at + (d + _TWO_PI32 if d < -_PI32 else d)
+    else:
+        first = p
+    return p, u, first, acc + w * u, good + w
+
+
+@inline
+def _wrapped_sample(phase: np.ndarray, sx: np.float32, sy: np.float32) -> np.float32:
+    """The wrapped ``phase`` at ``(sx, sy)``: the known corners unwrapped around the square
+    (each step between two wrapped into ``[-pi, pi)``) and averaged bilinearly, in
+    ``[0, 2*pi)``; NaN where the known corners inside the image carry less than
+    :data:`KNOWN_WEIGHT`."""
+    if not (sx > -1.0 and sy > -1.0 and sx < phase.shape[1] and sy < phase.shape[0]):
+        return np.float32(np.nan)  # (also NaN)
+    fx0, fy0 = np.floor(sx), np.floor(sy)
+    x0, y0 = int(fx0), int(fy0)
+    fx, fy = np.float32(sx - fx0), np.float32(sy - fy0)
+    gx, gy = np.float32(1.0) - fx, np.float32(1.0) - fy
+    w00, w01, w11, w10 = gx * gy, fx * gy, fx * fy, gx * fy
+    nan, zero = np.float32(np.nan), np.float32(0.0)
+    last, at, first, acc, good = nan, zero, nan, zero, zero
+    last, at, first, acc, good = _link(_corner(phase, y0, x0, w00), w00, last, at, first,
+                                       acc, good)
+    last, at, first, acc, good = _link(_corner(phase, y0, x0 + 1, w01), w01, last, at,
+                                       first, acc, good)
+    last, at, first, acc, good = _link(_corner(phase, y0 + 1, x0 + 1, w11), w11, last, at,
+                                       first, acc, good)
+    last, at, first, acc, good = _link(_corner(phase, y0 + 1, x0, w10), w10, last, at,
+                                       first, acc, good)
+    if not good >= KNOWN_WEIGHT:
+        return nan
+    if good < np.float32(0.99999):  # (an unknown corner of weight <= 0.001)
+        acc = acc / good
+    out = first + acc
+    if out < zero:
+        out = out + _TWO_PI32
+    elif out >= _TWO_PI32:
+        out = out - _TWO_PI32
+    return zero if out >= _TWO_PI32 else out
+
+
+@kernel(parallel=True)
+def _resample(phi: np.ndarray, mod: np.ndarray, threshold: float, map_x: np.ndarray,
+              map_y: np.ndarray, phase: np.ndarray, out: np.ndarray) -> int:
+    h, w = phi.shape
+    count = 0
+    for y in prange(h):
+        for x in range(w):
+            if mod[y, x] >= threshold:
+                phase[y, x] = phi[y, x]
+                count += 1
+            else:
+                phase[y, x] = np.float32(np.nan)
+    oh, ow = map_x.shape
+    for y in prange(oh):
+        for x in range(ow):
+            out[y, x] = _wrapped_sample(phase, map_x[y, x], map_y[y, x])
+    return count
+
+
+def resample_wrapped(phi: np.ndarray, maps: tuple[np.ndarray, np.ndarray],
+                     mod: np.ndarray | None = None, threshold: float = 0.0,
+                     buffers: dict | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """A wrapped phase, NaN where its modulation is below ``threshold``, and that phase
+    resampled onto a rectified grid, in one compiled pass over each grid.
+
+    Each rectified pixel reads the four camera pixels around its table position: the
+    phase there is the first known corner's plus the bilinear mean of every known corner's
+    difference from it, each wrapped into ``[-pi, pi)`` (never across a wrap; no cosine or
+    sine), wrapped into ``[0, 2*pi)``. It is unknown (NaN) where the known corners inside
+    the image carry less than :data:`KNOWN_WEIGHT` of the weight (exact weights; an unknown
+    corner of weight at most 0.001 is left out, the others' weights renormalised).
+
+    Parameters
+    ----------
+    phi : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase (radians, ``[0, 2*pi)``), NaN where unknown.
+    maps : tuple of numpy.ndarray
+        The rectified grid's remap tables (rectified pixel -> camera pixel, float32).
+    mod : numpy.ndarray, optional
+        ``(H, W)`` modulation; by default every finite pixel of ``phi`` is known.
+    threshold : float, optional
+        The modulation a known pixel needs.
+    buffers : dict, optional
+        Arrays to reuse from one call to the next (an empty dict at first; the results
+        are among them: the next call overwrites them).
+
+    Returns
+    -------
+    phase : numpy.ndarray
+        ``(H, W)`` float32 ``phi``, NaN where not known.
+    rectified : numpy.ndarray
+        ``maps``' shape, float32: the phase on the rectified grid, in ``[0, 2*pi)``, NaN
+        where unknown.
+    known : int
+        The known pixels of ``phase``.
+
+    Examples
+    --------
+    Half way between 6.2 and 0.1 rad (across the wrap: not 3.15), half way to a pixel
+    below the threshold (unknown), and half a thousandth of a pixel from it
+    (its weight left out):
+
+    >>> phi = np.float32([[6.2, 0.1, 3.0]])
+    >>> mod = np.float32([[1.0, 1.0, 0.0]])
+    >>> maps = (np.float32([[0.5, 1.5, 1.0005]]), np.float32([[0.0, 0.0, 0.0]]))
+    >>> phase, rect, n = resample_wrapped(phi, maps, mod, 0.5)
+    >>> [round(float(v), 4) for v in rect[0]], n, bool(np.isnan(phase[0, 2]))
+    ([0.0084, nan, 0.1], 2, True)
+    """
+    phi = np.ascontiguousarray(phi, np.float32)
+    if mod is None:
+        mod, threshold = phi, -math.inf  # (NaN is not >= -inf)
+    shape = maps[0].shape
+    b = {} if buffers is None else buffers
+    if "phase" not in b or b["phase"].shape != phi.shape or b["rectified"].shape != shape:
+        b["phase"] = np.empty(phi.shape, np.float32)
+        b["rectified"] = np.empty(shape, np.float32)
+    count = _resample(phi, np.ascontiguousarray(mod, np.float32), float(threshold),
+                      np.ascontiguousarray(maps[0], np.float32),
+                      np.ascontiguousarray(maps[1], np.float32), b["phase"], b["rectified"])
+    return b["phase"], b["rectified"], int(count)
+
+
 @kernel(parallel=True)
 def _positions(k: np.ndarray, dist: np.ndarray, rot: np.ndarray, f: float, cx: float,
                cy: float, h: int, w: int
