@@ -100,65 +100,58 @@ _PI32, _TWO_PI32 = np.float32(math.pi), np.float32(2.0 * math.pi)
 
 
 @inline
-def _corner(phase: np.ndarray, y: int, x: int, w: np.float32) -> np.float32:
-    """``phase[y, x]`` for a corner of weight ``w > 0`` inside the image, else NaN."""
-    if w > 0.0 and 0 <= y < phase.shape[0] and 0 <= x < phase.shape[1]:
-        return phase[y, x]
-    return np.float32(np.nan)
+def _near32(d: np.float32) -> np.float32:
+    """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (float32,
+    by selects)."""
+    e = d - _TWO_PI32 if d >= _PI32 else d
+    return e + _TWO_PI32 if d < -_PI32 else e
 
 
 @inline
-def _link(p: np.float32, w: np.float32, last: np.float32, at: np.float32, first: np.float32,
-          acc: np.float32, good: np.float32
-          ) -> tuple[np.float32, np.float32, np.float32, np.float32, np.float32]:
-    """A known corner ``p`` unwrapped against the last known one before it around the
-    square (``last``, unwrapped to ``at`` about the ``first``: the step between them
-    wrapped into ``[-pi, pi)``) and added with weight ``w``."""
-    if p != p:
-        return last, at, first, acc, good
-    u = np.float32(0.0)
-    if last == last:
-        d = p - last
-        d = d - _TWO_PI32 if d >= _PI32 else d
-        u = at + (d + _TWO_PI32 if d < -_PI32 else d)
-    else:
-        first = p
-    return p, u, first, acc + w * u, good + w
+def _wrap32(a: np.float32) -> np.float32:
+    """A phase wrapped into ``[0, 2*pi)`` (float32: one that rounds to ``2*pi`` is 0)."""
+    if a < np.float32(0.0) or a >= _TWO_PI32:
+        a = a - _TWO_PI32 * np.floor(a / _TWO_PI32)
+        if a < np.float32(0.0):
+            a = a + _TWO_PI32
+    return np.float32(0.0) if a >= _TWO_PI32 else a
 
 
 @inline
-def _wrapped_sample(phase: np.ndarray, sx: np.float32, sy: np.float32) -> np.float32:
-    """The wrapped ``phase`` at ``(sx, sy)``: the known corners unwrapped around the square
-    (each step between two wrapped into ``[-pi, pi)``) and averaged bilinearly, in
-    ``[0, 2*pi)``; NaN where the known corners inside the image carry less than
-    :data:`KNOWN_WEIGHT`."""
+def _edge_sample(phase: np.ndarray, sx: np.float32, sy: np.float32) -> np.float32:
+    """The wrapped ``phase`` at ``(sx, sy)`` from the known corners of nonzero weight
+    inside the image: each unwrapped against the last before it around the square
+    ``(0, 0), (0, 1), (1, 1), (1, 0)`` (their step wrapped into ``[-pi, pi)``), averaged
+    with their bilinear weights renormalised, in ``[0, 2*pi)``; NaN where they carry less
+    than :data:`KNOWN_WEIGHT`."""
     if not (sx > -1.0 and sy > -1.0 and sx < phase.shape[1] and sy < phase.shape[0]):
         return np.float32(np.nan)  # (also NaN)
     fx0, fy0 = np.floor(sx), np.floor(sy)
     x0, y0 = int(fx0), int(fy0)
     fx, fy = np.float32(sx - fx0), np.float32(sy - fy0)
-    gx, gy = np.float32(1.0) - fx, np.float32(1.0) - fy
-    w00, w01, w11, w10 = gx * gy, fx * gy, fx * fy, gx * fy
-    nan, zero = np.float32(np.nan), np.float32(0.0)
-    last, at, first, acc, good = nan, zero, nan, zero, zero
-    last, at, first, acc, good = _link(_corner(phase, y0, x0, w00), w00, last, at, first,
-                                       acc, good)
-    last, at, first, acc, good = _link(_corner(phase, y0, x0 + 1, w01), w01, last, at,
-                                       first, acc, good)
-    last, at, first, acc, good = _link(_corner(phase, y0 + 1, x0 + 1, w11), w11, last, at,
-                                       first, acc, good)
-    last, at, first, acc, good = _link(_corner(phase, y0 + 1, x0, w10), w10, last, at,
-                                       first, acc, good)
+    last, at, first = np.float32(np.nan), np.float32(0.0), np.float32(np.nan)
+    acc, good = np.float32(0.0), np.float32(0.0)
+    for k in range(4):
+        dx, dy = int(k == 1 or k == 2), k // 2
+        w = (fx if dx else np.float32(1.0) - fx) * (fy if dy else np.float32(1.0) - fy)
+        y, x = y0 + dy, x0 + dx
+        if not (w > 0.0 and 0 <= y < phase.shape[0] and 0 <= x < phase.shape[1]):
+            continue
+        p = phase[y, x]
+        if p != p:
+            continue
+        if last == last:
+            at = at + _near32(p - last)
+        else:
+            first = p
+        last = p
+        acc += w * at
+        good += w
     if not good >= KNOWN_WEIGHT:
-        return nan
+        return np.float32(np.nan)
     if good < np.float32(0.99999):  # (an unknown corner of weight <= 0.001)
         acc = acc / good
-    out = first + acc
-    if out < zero:
-        out = out + _TWO_PI32
-    elif out >= _TWO_PI32:
-        out = out - _TWO_PI32
-    return zero if out >= _TWO_PI32 else out
+    return _wrap32(first + acc)
 
 
 @kernel(parallel=True)
@@ -173,10 +166,33 @@ def _resample(phi: np.ndarray, mod: np.ndarray, threshold: float, map_x: np.ndar
                 count += 1
             else:
                 phase[y, x] = np.float32(np.nan)
-    oh, ow = map_x.shape
-    for y in prange(oh):
-        for x in range(ow):
-            out[y, x] = _wrapped_sample(phase, map_x[y, x], map_y[y, x])
+    flat = phase.reshape(-1)  # (unsigned flat indices: no wraparound tests)
+    right, below = np.float32(w - 1), np.float32(h - 1)
+    step, one, zero = np.uint64(w), np.uint64(1), np.float32(0.0)
+    for y in prange(map_x.shape[0]):
+        for x in range(map_x.shape[1]):
+            sx, sy = map_x[y, x], map_y[y, x]
+            v = np.float32(-1.0)  # (to the next loop)
+            if sx >= zero and sy >= zero and sx < right and sy < below:
+                x0, y0 = np.uint64(sx), np.uint64(sy)
+                i = y0 * step + x0
+                p00, p01 = flat[i], flat[i + one]
+                p11, p10 = flat[i + step + one], flat[i + step]
+                fx, fy = sx - np.float32(x0), sy - np.float32(y0)
+                gx, gy = np.float32(1.0) - fx, np.float32(1.0) - fy
+                if p00 == p00 and p01 == p01 and p11 == p11 and p10 == p10:
+                    u01 = _near32(p01 - p00)  # (around the square, as _edge_sample)
+                    u11 = u01 + _near32(p11 - p01)
+                    u10 = u11 + _near32(p10 - p11)
+                    v = _wrap32(p00 + (fx * gy * u01 + fx * fy * u11 + gx * fy * u10))
+                elif ((p00 == p00) * gx * gy + (p01 == p01) * fx * gy + (p11 == p11) * fx * fy
+                      + (p10 == p10) * gx * fy) < KNOWN_WEIGHT:
+                    v = np.float32(np.nan)  # (the common unknown pixel)
+            out[y, x] = v
+    for y in prange(map_x.shape[0]):  # (a loop of its own: inlined into the loop above,
+        for x in range(map_x.shape[1]):  # it slows the common pixels threefold)
+            if out[y, x] < 0.0:
+                out[y, x] = _edge_sample(phase, map_x[y, x], map_y[y, x])
     return count
 
 
@@ -238,9 +254,9 @@ def resample_wrapped(phi: np.ndarray, maps: tuple[np.ndarray, np.ndarray],
     if "phase" not in b or b["phase"].shape != phi.shape or b["rectified"].shape != shape:
         b["phase"] = np.empty(phi.shape, np.float32)
         b["rectified"] = np.empty(shape, np.float32)
-    count = _resample(phi, np.ascontiguousarray(mod, np.float32), float(threshold),
-                      np.ascontiguousarray(maps[0], np.float32),
-                      np.ascontiguousarray(maps[1], np.float32), b["phase"], b["rectified"])
+    mx, my = (np.ascontiguousarray(m, np.float32) for m in maps)
+    count = _resample(phi, np.ascontiguousarray(mod, np.float32), float(threshold), mx, my,
+                      b["phase"], b["rectified"])
     return b["phase"], b["rectified"], int(count)
 
 
