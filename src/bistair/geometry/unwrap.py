@@ -490,7 +490,7 @@ def check_range(lrect: np.ndarray, rrect: np.ndarray, rect: Rectification,
     (0.023, 640, [600, 600])
     >>> share, points, depths = check_range(lrect, rrect, rect, cal, 48.0, 0.1, 650.0, 750.0)
     >>> round(share, 3), points, [round(d) for d in depths]  # the plane is nearer: refused
-    (1.0, 625, [599, 601])
+    (1.0, 625, [600, 600])
     >>> check_range(lrect, rrect, rect, cal, 48.0, 0.1, 800.0, 900.0)  # 700-1000 finds none
     (0.0, 0, None)
     """
