@@ -1,10 +1,13 @@
 """Compiled passes of the rectified grids (:mod:`bistair.geometry.stereo`): where each raw
-pixel lands on the rectified grid, maps resampled without mixing surfaces, and the points
-on the left camera's own grid (depth, counts per row, points and the cloud).
+pixel lands on the rectified grid, maps resampled without mixing surfaces, a wrapped phase
+resampled without crossing a wrap (:func:`resample_wrapped`), and the points on the left
+camera's own grid (depth, counts per row, points and the cloud).
 
 Each runs over image rows on every core; none has a NumPy twin, so
-``tests/test_stereo_jit.py`` checks them against exact answers. The row search between
-them is :mod:`bistair.geometry.stereo_match_jit`.
+``tests/test_stereo_jit.py`` checks them against exact answers (the wrapped phase:
+``tests/test_stereo_stream.py``, against the renderer's truth and the ``cv2.remap`` of its
+cosine and sine that it replaced). The row search between them is
+:mod:`bistair.geometry.stereo_match_jit`.
 
 Examples
 --------
