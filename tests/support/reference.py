@@ -18,12 +18,16 @@ code in src calls them; issue 35 moved them here from the concept modules):
   the projector's own model (distortion and all) for the depth one column moves;
 * :func:`plane_depth`: a stream's depth through an undistorted projector's column planes
   (``bistair.geometry.unwrap_stream_jit.plane_depth``, a pass without branches).
+* :func:`rectified_phase_cv2`: a wrapped phase resampled onto a rectified grid through
+  ``cv2.remap`` of its cosine, sine and validity (the resampler before
+  ``bistair.geometry.stereo_jit.resample_wrapped``).
 """
 
 from __future__ import annotations
 
 import math
 
+import cv2
 import numpy as np
 
 from bistair.core.phase import TWO_PI
@@ -378,3 +382,41 @@ def plane_depth(columns: np.ndarray, u: np.ndarray, v: np.ndarray, phase: np.nda
               & (z <= zmax))
     return (np.where(ok, z, np.nan).astype(np.float32), np.where(ok, k, -1).astype(np.int32),
             np.where(ok, xp, np.nan).astype(np.float32))
+
+
+def rectified_phase_cv2(phase: np.ndarray, maps: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+    """The wrapped phase on a rectified grid as ``cv2.remap`` gives it (bilinear, 1/32-px
+    fixed-point weights, 0 outside the image) from the cosine and sine of the known pixels
+    and their validity: ``arctan2`` in ``[0, 2*pi)``, NaN where the validity resampled is
+    below 0.999 (what :func:`bistair.geometry.stereo_jit.resample_wrapped` replaced).
+
+    Parameters
+    ----------
+    phase : numpy.ndarray
+        ``(H, W)`` wrapped phase (radians), NaN where unknown.
+    maps : tuple of numpy.ndarray
+        The grid's remap tables (rectified pixel -> camera pixel).
+
+    Returns
+    -------
+    numpy.ndarray
+        float32, the tables' shape.
+
+    Examples
+    --------
+    >>> phase = np.float32([[6.2, 0.1, np.nan]])
+    >>> out = rectified_phase_cv2(phase, (np.float32([[0.5, 1.5]]), np.float32([[0, 0]])))
+    >>> round(float(out[0, 0]), 4), bool(np.isnan(out[0, 1]))
+    (0.0084, True)
+    """
+    valid = np.isfinite(phase)
+    ph = np.where(valid, phase, 0).astype(np.float32)
+    planes = [np.where(valid, np.cos(ph), 0).astype(np.float32),
+              np.where(valid, np.sin(ph), 0).astype(np.float32), valid.astype(np.float32)]
+    c, s, w = (cv2.remap(p, maps[0], maps[1], cv2.INTER_LINEAR,
+                         borderMode=cv2.BORDER_CONSTANT, borderValue=0) for p in planes)
+    out = np.arctan2(s, c).astype(np.float32)
+    out[out < 0] += np.float32(2 * np.pi)
+    out[out >= np.float32(2 * np.pi)] = 0
+    out[w < 0.999] = np.nan
+    return out

@@ -32,8 +32,9 @@ module                        what it holds
 ``stereo.py`` (+ ``_jit``)    two cameras: ``stereo``, ``reconstruct_stereo``, ``readings``,
                               ``decode_options``, ``rectify``, ``Rectification``,
                               ``StereoResult``; its twin: ``remap_valid``,
-                              ``rectified_positions``, ``grid_depth``, ``depth_counts``,
-                              ``pick_finite``, ``grid_points``, ``cloud_points``
+                              ``resample_wrapped``, ``rectified_positions``, ``grid_depth``,
+                              ``depth_counts``, ``pick_finite``, ``grid_points``,
+                              ``cloud_points``
 ``stereo_match.py``           the row search between them: ``match``, ``Matched``; its twin
                               ``stereo_match_jit.py``: ``drop_kinks``, ``line_coefficients``,
                               ``smooth_runs``, ``match_pair``, ``supported``, ``count_status``

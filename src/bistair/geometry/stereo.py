@@ -80,12 +80,13 @@ from .stereo_checks import (
     projector_misfits,
     same_captures,
 )
-from .stereo_jit import (  # depth_counts: the face's for unwrap.py
+from .stereo_jit import (  # depth_counts, resample_wrapped: the face's for unwrap*.py
     cloud_points,
     depth_counts,  # noqa: F401
     grid_points,
     pick_finite,
     rectified_positions,
+    resample_wrapped,  # noqa: F401
 )
 from .stereo_match import Matched, match
 from .triangulate import check_depth_range

@@ -1,10 +1,13 @@
 """Compiled passes of the rectified grids (:mod:`bistair.geometry.stereo`): where each raw
-pixel lands on the rectified grid, maps resampled without mixing surfaces, and the points
-on the left camera's own grid (depth, counts per row, points and the cloud).
+pixel lands on the rectified grid, maps resampled without mixing surfaces, a wrapped phase
+resampled without crossing a wrap (:func:`resample_wrapped`), and the points on the left
+camera's own grid (depth, counts per row, points and the cloud).
 
 Each runs over image rows on every core; none has a NumPy twin, so
-``tests/test_stereo_jit.py`` checks them against exact answers. The row search between
-them is :mod:`bistair.geometry.stereo_match_jit`.
+``tests/test_stereo_jit.py`` checks them against exact answers (the wrapped phase:
+``tests/test_stereo_stream.py``, against the renderer's truth and the ``cv2.remap`` of its
+cosine and sine that it replaced). The row search between them is
+:mod:`bistair.geometry.stereo_match_jit`.
 
 Examples
 --------
@@ -91,6 +94,173 @@ def remap_valid(values: np.ndarray, map_x: np.ndarray, map_y: np.ndarray,
     """
     return _remap(np.ascontiguousarray(values, np.float32), np.asarray(map_x, np.float32),
                   np.asarray(map_y, np.float32), float(max_step))
+
+
+#: A rectified pixel is known where its known corners carry this much of the bilinear
+#: weight (an unknown corner or one outside the image at most 0.001).
+KNOWN_WEIGHT = np.float32(0.999)
+_PI32, _TWO_PI32 = np.float32(math.pi), np.float32(2.0 * math.pi)
+
+
+@inline
+def _near32(d: np.float32) -> np.float32:
+    """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (float32,
+    by selects)."""
+    e = d - _TWO_PI32 if d >= _PI32 else d
+    return e + _TWO_PI32 if d < -_PI32 else e
+
+
+@inline
+def _wrap32(a: np.float32) -> np.float32:
+    """A phase wrapped into ``[0, 2*pi)`` (float32: one that rounds to ``2*pi`` is 0)."""
+    if a < np.float32(0.0) or a >= _TWO_PI32:
+        a = a - _TWO_PI32 * np.floor(a / _TWO_PI32)
+        if a < np.float32(0.0):
+            a = a + _TWO_PI32
+    return np.float32(0.0) if a >= _TWO_PI32 else a
+
+
+@inline
+def _edge_sample(phase: np.ndarray, sx: np.float32, sy: np.float32) -> np.float32:
+    """The wrapped ``phase`` at ``(sx, sy)`` from the known corners of nonzero weight
+    inside the image: each unwrapped against the last before it around the square
+    ``(0, 0), (0, 1), (1, 1), (1, 0)`` (their step wrapped into ``[-pi, pi)``), averaged
+    with their bilinear weights renormalised, in ``[0, 2*pi)``; NaN where they carry less
+    than :data:`KNOWN_WEIGHT`."""
+    if not (sx > -1.0 and sy > -1.0 and sx < phase.shape[1] and sy < phase.shape[0]):
+        return np.float32(np.nan)  # (also NaN)
+    fx0, fy0 = np.floor(sx), np.floor(sy)
+    x0, y0 = int(fx0), int(fy0)
+    fx, fy = np.float32(sx - fx0), np.float32(sy - fy0)
+    last, at, first = np.float32(np.nan), np.float32(0.0), np.float32(np.nan)
+    acc, good = np.float32(0.0), np.float32(0.0)
+    for k in range(4):
+        dx, dy = int(k == 1 or k == 2), k // 2
+        w = (fx if dx else np.float32(1.0) - fx) * (fy if dy else np.float32(1.0) - fy)
+        y, x = y0 + dy, x0 + dx
+        if not (w > 0.0 and 0 <= y < phase.shape[0] and 0 <= x < phase.shape[1]):
+            continue
+        p = phase[y, x]
+        if p != p:
+            continue
+        if last == last:
+            at = at + _near32(p - last)
+        else:
+            first = p
+        last = p
+        acc += w * at
+        good += w
+    if not good >= KNOWN_WEIGHT:
+        return np.float32(np.nan)
+    if good < np.float32(0.99999):  # (an unknown corner of weight <= 0.001)
+        acc = acc / good
+    return _wrap32(first + acc)
+
+
+@kernel(parallel=True)
+def _resample(phi: np.ndarray, mod: np.ndarray, threshold: float, map_x: np.ndarray,
+              map_y: np.ndarray, phase: np.ndarray, out: np.ndarray) -> int:
+    h, w = phi.shape
+    count = 0
+    for y in prange(h):
+        for x in range(w):
+            if mod[y, x] >= threshold:
+                phase[y, x] = phi[y, x]
+                count += 1
+            else:
+                phase[y, x] = np.float32(np.nan)
+    flat = phase.reshape(-1)  # (unsigned flat indices: no wraparound tests)
+    right, below = np.float32(w - 1), np.float32(h - 1)
+    step, one, zero = np.uint64(w), np.uint64(1), np.float32(0.0)
+    for y in prange(map_x.shape[0]):
+        for x in range(map_x.shape[1]):
+            sx, sy = map_x[y, x], map_y[y, x]
+            v = np.float32(-1.0)  # (to the next loop)
+            if sx >= zero and sy >= zero and sx < right and sy < below:
+                x0, y0 = np.uint64(sx), np.uint64(sy)
+                i = y0 * step + x0
+                p00, p01 = flat[i], flat[i + one]
+                p11, p10 = flat[i + step + one], flat[i + step]
+                fx, fy = sx - np.float32(x0), sy - np.float32(y0)
+                gx, gy = np.float32(1.0) - fx, np.float32(1.0) - fy
+                if p00 == p00 and p01 == p01 and p11 == p11 and p10 == p10:
+                    u01 = _near32(p01 - p00)  # (around the square, as _edge_sample)
+                    u11 = u01 + _near32(p11 - p01)
+                    u10 = u11 + _near32(p10 - p11)
+                    v = _wrap32(p00 + (fx * gy * u01 + fx * fy * u11 + gx * fy * u10))
+                elif ((p00 == p00) * gx * gy + (p01 == p01) * fx * gy + (p11 == p11) * fx * fy
+                      + (p10 == p10) * gx * fy) < KNOWN_WEIGHT:
+                    v = np.float32(np.nan)  # (the common unknown pixel)
+            out[y, x] = v
+    for y in prange(map_x.shape[0]):  # (a loop of its own: inlined into the loop above,
+        for x in range(map_x.shape[1]):  # it slows the common pixels threefold)
+            if out[y, x] < 0.0:
+                out[y, x] = _edge_sample(phase, map_x[y, x], map_y[y, x])
+    return count
+
+
+def resample_wrapped(phi: np.ndarray, maps: tuple[np.ndarray, np.ndarray],
+                     mod: np.ndarray | None = None, threshold: float = 0.0,
+                     buffers: dict | None = None) -> tuple[np.ndarray, np.ndarray, int]:
+    """A wrapped phase, NaN where its modulation is below ``threshold``, and that phase
+    resampled onto a rectified grid, in one compiled pass over each grid.
+
+    Each rectified pixel reads the four camera pixels around its table position: the
+    phase there is the first known corner's plus the bilinear mean of every known corner's
+    difference from it, each wrapped into ``[-pi, pi)`` (never across a wrap; no cosine or
+    sine), wrapped into ``[0, 2*pi)``. It is unknown (NaN) where the known corners inside
+    the image carry less than :data:`KNOWN_WEIGHT` of the weight (exact weights; an unknown
+    corner of weight at most 0.001 is left out, the others' weights renormalised).
+
+    Parameters
+    ----------
+    phi : numpy.ndarray
+        ``(H, W)`` float32 wrapped phase (radians, ``[0, 2*pi)``), NaN where unknown.
+    maps : tuple of numpy.ndarray
+        The rectified grid's remap tables (rectified pixel -> camera pixel, float32).
+    mod : numpy.ndarray, optional
+        ``(H, W)`` modulation; by default every finite pixel of ``phi`` is known.
+    threshold : float, optional
+        The modulation a known pixel needs.
+    buffers : dict, optional
+        Arrays to reuse from one call to the next (an empty dict at first; the results
+        are among them: the next call overwrites them).
+
+    Returns
+    -------
+    phase : numpy.ndarray
+        ``(H, W)`` float32 ``phi``, NaN where not known.
+    rectified : numpy.ndarray
+        ``maps``' shape, float32: the phase on the rectified grid, in ``[0, 2*pi)``, NaN
+        where unknown.
+    known : int
+        The known pixels of ``phase``.
+
+    Examples
+    --------
+    Half way between 6.2 and 0.1 rad (across the wrap: not 3.15), half way to a pixel
+    below the threshold (unknown), and half a thousandth of a pixel from it
+    (its weight left out):
+
+    >>> phi = np.float32([[6.2, 0.1, 3.0]])
+    >>> mod = np.float32([[1.0, 1.0, 0.0]])
+    >>> maps = (np.float32([[0.5, 1.5, 1.0005]]), np.float32([[0.0, 0.0, 0.0]]))
+    >>> phase, rect, n = resample_wrapped(phi, maps, mod, 0.5)
+    >>> [round(float(v), 4) for v in rect[0]], n, bool(np.isnan(phase[0, 2]))
+    ([0.0084, nan, 0.1], 2, True)
+    """
+    phi = np.ascontiguousarray(phi, np.float32)
+    if mod is None:
+        mod, threshold = phi, -math.inf  # (NaN is not >= -inf)
+    shape = maps[0].shape
+    b = {} if buffers is None else buffers
+    if "phase" not in b or b["phase"].shape != phi.shape or b["rectified"].shape != shape:
+        b["phase"] = np.empty(phi.shape, np.float32)
+        b["rectified"] = np.empty(shape, np.float32)
+    mx, my = (np.ascontiguousarray(m, np.float32) for m in maps)
+    count = _resample(phi, np.ascontiguousarray(mod, np.float32), float(threshold), mx, my,
+                      b["phase"], b["rectified"])
+    return b["phase"], b["rectified"], int(count)
 
 
 @kernel(parallel=True)

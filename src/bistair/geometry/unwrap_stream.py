@@ -6,9 +6,11 @@ through a :class:`~bistair.core.motion.PhaseStream` (running sums: a new frame c
 multiply-adds a pixel; order ``K`` compensates motion). For each window:
 
 1. The wrapped phases (NaN below the modulation threshold measured on the first ``N``
-   frames) are resampled onto the rectified grids in one pass a camera
-   (:func:`~.unwrap_stream_jit.rectify_pair`: what
-   :func:`~bistair.geometry.unwrap.rectified_phase` gives, with fewer passes).
+   frames) are resampled onto the rectified grids in one compiled pass a camera, on every
+   core (:func:`~.unwrap_stream_jit.rectify_pair`: the threshold and
+   :func:`~bistair.geometry.stereo_jit.resample_wrapped`, the resampler of
+   :func:`~bistair.geometry.unwrap.rectified_phase`, so the first window and the later
+   ones read the same numbers; no trigonometry).
 2. The first window is unwrapped by :func:`~bistair.geometry.unwrap.unwrap_stereo`, as the
    one-set ``stereo`` command does, its depth range checked. Each later window searches
    each pixel of both rectified grids only within :data:`MARGIN` pixels of its single

@@ -40,10 +40,10 @@ from __future__ import annotations
 
 import math
 
-import cv2
 import numpy as np
 
 from ..core.jit import inline, kernel
+from .stereo import resample_wrapped
 from .unwrap_jit import KEPT
 
 prange = range  # numba's prange once the first kernel of this module compiles
@@ -711,47 +711,14 @@ def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: n
     return out, blocked, int(nc.sum()), int(un.sum())
 
 
-@kernel(parallel=True)
-def _mask(phi: np.ndarray, mod: np.ndarray, threshold: float, phase: np.ndarray,
-          zeroed: np.ndarray, valid: np.ndarray) -> int:
-    h, w = phi.shape
-    count = 0
-    for y in prange(h):
-        for x in range(w):
-            if mod[y, x] >= threshold:
-                phase[y, x] = zeroed[y, x] = phi[y, x]
-                valid[y, x] = np.float32(1.0)
-                count += 1
-            else:
-                phase[y, x] = np.float32(np.nan)
-                zeroed[y, x] = valid[y, x] = np.float32(0.0)
-    return count
-
-
-@kernel(parallel=True)
-def _finish(angle: np.ndarray, valid: np.ndarray) -> None:
-    oh, ow = angle.shape
-    two_pi = np.float32(TWO_PI)
-    for y in prange(oh):
-        for x in range(ow):
-            a = angle[y, x]
-            if valid[y, x] < np.float32(0.999):
-                angle[y, x] = np.float32(np.nan)
-            elif a < np.float32(0.0):
-                a = a + two_pi
-                angle[y, x] = np.float32(0.0) if a >= two_pi else a
-            elif a >= two_pi:
-                angle[y, x] = np.float32(0.0)
-
-
 def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
                  maps: tuple[np.ndarray, np.ndarray], buffers: dict | None = None
                  ) -> tuple[np.ndarray, np.ndarray, int]:
     """A camera's wrapped phase, NaN where its modulation is below ``threshold``, and that
-    phase resampled onto its rectified grid: bit for bit what ``np.where(mod >=
-    threshold, phi, nan)`` and :func:`~bistair.geometry.unwrap.rectified_phase` give (the
-    same ``cv2.remap`` of the cosine, sine and validity, NumPy's own ``cos``, ``sin`` and
-    ``arctan2``), the masks in two compiled passes, into reused buffers.
+    phase resampled onto its rectified grid, in one compiled pass over each grid, into
+    reused buffers: :func:`~bistair.geometry.stereo_jit.resample_wrapped`, the resampler
+    of :func:`~bistair.geometry.unwrap.rectified_phase` too (the first window and the later
+    ones read the same numbers).
 
     Parameters
     ----------
@@ -783,25 +750,7 @@ def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
     >>> round(float(rect[0, 0]), 4), bool(np.isnan(rect[0, 1])), n
     (0.0084, True, 2)
     """
-    phi = np.ascontiguousarray(phi, np.float32)
-    shape = maps[0].shape
-    b = {} if buffers is None else buffers
-    if "phase" not in b or b["phase"].shape != phi.shape or b["angle"].shape != shape:
-        for name in ("phase", "zeroed", "valid", "cos", "sin"):
-            b[name] = np.empty(phi.shape, np.float32)
-        for name in ("c", "s", "v", "angle"):
-            b[name] = np.empty(shape, np.float32)
-    count = _mask(phi, np.ascontiguousarray(mod, np.float32), float(threshold), b["phase"],
-                  b["zeroed"], b["valid"])
-    np.cos(b["zeroed"], out=b["cos"])
-    np.sin(b["zeroed"], out=b["sin"])
-    np.multiply(b["cos"], b["valid"], out=b["cos"])  # (0 where not valid: cos 0 is 1)
-    for plane, out in (("cos", "c"), ("sin", "s"), ("valid", "v")):
-        cv2.remap(b[plane], maps[0], maps[1], cv2.INTER_LINEAR, dst=b[out],
-                  borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    np.arctan2(b["s"], b["c"], out=b["angle"])
-    _finish(b["angle"], b["v"])
-    return b["phase"], b["angle"], int(count)
+    return resample_wrapped(phi, maps, mod, threshold, buffers)
 
 
 @kernel(parallel=True)
