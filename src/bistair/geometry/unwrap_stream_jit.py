@@ -12,7 +12,12 @@ has ``e_j = near(o_j - a)`` and ``e_(j+1)`` of opposite signs less than pi apart
 ``|e_j| + |e_(j+1)|`` is the phase step ``|near(o_(j+1) - o_j)|``. One pass without
 branches (float32, :data:`SLACK` for its rounding) keeps the intervals where the sum is at
 most the step (about one a pixel in a search 12 px wide, against 13); only those are
-tested as before, in float64: the same candidates in the same order. The candidate's
+tested as before, in float64: the same candidates in the same order. Fewer are scanned:
+the phase moves at most ``steps`` (SLACK included) an interval, so a crossing in interval
+``i`` of a search ``first..end`` lies at most the steps' sum from ``first`` to ``i + 1``
+away from ``o_first`` and from ``i`` to ``end`` away from ``o_end`` (a NaN step counts as
+4, more than any phase distance): two bisections of the row's running sums of steps
+(float64, exact) bound the intervals scanned. The candidate's
 projector column comes, without distortion, from coefficients of the row linear in the
 pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
 same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
@@ -72,11 +77,18 @@ def _near32(difference: np.float32) -> np.float32:
 
 
 @inline
-def _steps(other: np.ndarray, y: int, steps: np.ndarray) -> None:
+def _steps(other: np.ndarray, y: int, steps: np.ndarray, sums: np.ndarray) -> None:
     """``steps[j]``: the phase step from column ``j`` to ``j + 1`` of ``other``'s row ``y``
-    (``|_near|`` of their difference, in float32) plus :data:`SLACK`; NaN beside a NaN."""
+    (``|_near|`` of their difference, in float32) plus :data:`SLACK`; NaN beside a NaN.
+    ``sums[j]``: the steps before column ``j`` added up (float64, exact), a NaN step
+    counted as 4 (more than any phase distance)."""
+    total = 0.0
     for j in range(other.shape[1] - 1):
         steps[j] = abs(_near32(other[y, j + 1] - other[y, j])) + SLACK
+        sums[j] = total
+        step = float(steps[j])
+        total += step if step == step else 4.0
+    sums[other.shape[1] - 1] = total
 
 
 @inline
@@ -92,9 +104,11 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
     first ``kept.shape[2]`` candidates' disparities into ``kept[y, x]``.
 
     With ``skip``, only the intervals whose ends' phase distances to ``a`` add up to at
-    most the step between them (``steps``: :func:`_steps`) are tested: a crossing needs it
-    (the module's docstring); the same candidates, in the same order. ``plane``:
-    :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector is distorted)."""
+    most the step between them (``steps``: :func:`_steps`) are tested, and only those
+    between the two bounds of the steps' sums (``plane[8:]``: :func:`_steps`' ``sums``):
+    a crossing needs both (the module's docstring); the same candidates, in the same
+    order. ``plane[:8]``: :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector
+    is distorted)."""
     count = 0
     found = math.nan
     first = max(j0, 0)
@@ -103,8 +117,28 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
     if skip:  # (one pass without branches)
         a32 = np.float32(a)
         n = 0
-        after = abs(_near32(other[y, first] - a32))
-        for j in range(first, end):
+        start, stop = first, end  # (the intervals start .. stop - 1)
+        if end - first > 4:  # (bisections of the sums: the first and last that may cross)
+            below = plane[8 + first] + float(abs(_near32(other[y, first] - a32)))
+            above = plane[8 + end] - float(abs(_near32(other[y, end] - a32)))
+            if below == below:  # start: the first interval i with sums[i + 1] >= below
+                top = end
+                while start < top:
+                    m = (start + top) >> 1
+                    if plane[9 + m] < below:
+                        start = m + 1
+                    else:
+                        top = m
+            if above == above:  # stop: the first interval i past start with sums[i] > above
+                stop, top = start, end
+                while stop < top:
+                    m = (stop + top) >> 1
+                    if plane[8 + m] <= above:
+                        stop = m + 1
+                    else:
+                        top = m
+        after = abs(_near32(other[y, start] - a32))
+        for j in range(start, stop):
             before = after
             after = abs(_near32(other[y, j + 1] - a32))
             index[n] = j
@@ -216,11 +250,11 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
         yr = (y - cy) / f
         steps = np.empty(wr, np.float32)
         index = np.empty(wr, np.int64)
-        plane = np.zeros(8, np.float64)  # (plane[7]: 1 without distortion)
+        plane = np.zeros(8 + wr, np.float64)  # (plane[7]: 1 without distortion; sums)
         if plain:
             _row_plane(yr, -f * tx, back, kp, rp, tp, plane)
         if skip:
-            _steps(other, y, steps)
+            _steps(other, y, steps, plane[8:])
         for x in range(w):
             a = float(own[y, x])
             if a != a:
