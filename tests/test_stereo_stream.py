@@ -317,10 +317,11 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
 
 def test_the_bounded_row_search_on_rough_rows():
     """The fast search scans only the intervals between two bounds of the row's running
-    sums of phase steps (a NaN step counted as 4): on rows of random steps (forwards and
-    back, up to 2.5 rad), holes of NaN and every phase a pixel may have, with the projector
-    and depth tests wide open (every crossing a candidate), it gives what the plain scan
-    gives, bit for bit, narrow and full searches, both grids."""
+    sums of phase steps (:mod:`~bistair.geometry.unwrap_stream_bounds_jit`, a NaN step
+    counted as 4): on rows of random steps (forwards and back, up to 2.5 rad), holes of NaN
+    and every phase a pixel may have, with the projector and depth tests wide open (every
+    crossing a candidate), it gives what the plain scan gives, bit for bit, narrow and full
+    searches, both grids."""
     from bistair.geometry.unwrap_stream_jit import track_rows
 
     rng = np.random.default_rng(7)

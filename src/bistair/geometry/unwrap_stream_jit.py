@@ -13,15 +13,12 @@ has ``e_j = near(o_j - a)`` and ``e_(j+1)`` of opposite signs less than pi apart
 branches (float32, :data:`SLACK` for its rounding) keeps the intervals where the sum is at
 most the step (about one a pixel in a search 12 px wide, against 13); only those are
 tested as before, in float64: the same candidates in the same order. Fewer are scanned:
-the phase moves at most ``steps`` (SLACK included) an interval, so a crossing in interval
-``i`` of a search ``first..end`` lies at most the steps' sum from ``first`` to ``i + 1``
-away from ``o_first`` and from ``i`` to ``end`` away from ``o_end`` (a NaN step counts as
-4, more than any phase distance): two bisections of the row's running sums of steps
-(float64, exact) bound the intervals scanned (1.3 of the 13 of a narrow search on
-average, two-masks at 640 x 480). The candidate's projector column comes, without
-distortion, from coefficients of the row linear in the pixel and the disparity
-(:func:`_row_plane`: one division, the full search's four): the same test to rounding
-(``unwrap_rows``' decisions, bit for bit, on the test stream).
+the phase moves at most a step an interval, so two bisections of the row's running sums of
+steps bound the intervals where a crossing may lie (:mod:`.unwrap_stream_bounds_jit`): 1.3
+of the 13 of a narrow search on average (two-masks at 640 x 480). The candidate's
+projector column comes, without distortion, from coefficients of the row linear in the
+pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
+same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
 
 Examples
 --------
@@ -51,6 +48,7 @@ import numpy as np
 
 from ..core.jit import inline, kernel
 from .unwrap_jit import KEPT
+from .unwrap_stream_bounds_jit import crossing_bounds, running_sums
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -81,15 +79,10 @@ def _near32(difference: np.float32) -> np.float32:
 def _steps(other: np.ndarray, y: int, steps: np.ndarray, sums: np.ndarray) -> None:
     """``steps[j]``: the phase step from column ``j`` to ``j + 1`` of ``other``'s row ``y``
     (``|_near|`` of their difference, in float32) plus :data:`SLACK`; NaN beside a NaN.
-    ``sums[j]``: the steps before column ``j`` added up (float64, exact), a NaN step
-    counted as 4 (more than any phase distance)."""
-    total = 0.0
+    ``sums``: their running sums (:func:`~.unwrap_stream_bounds_jit.running_sums`)."""
     for j in range(other.shape[1] - 1):
         steps[j] = abs(_near32(other[y, j + 1] - other[y, j])) + SLACK
-        sums[j] = total
-        step = float(steps[j])
-        total += step if step == step else 4.0
-    sums[other.shape[1] - 1] = total
+    running_sums(steps, other.shape[1] - 1, sums)
 
 
 @inline
@@ -115,29 +108,11 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
     first = max(j0, 0)
     end = min(j1, other.shape[1] - 1)
     n = end - first
-    if skip:  # (one pass without branches)
-        a32 = np.float32(a)
-        n = 0
-        start, stop = first, end  # (the intervals start .. stop - 1)
-        if end - first > 4:  # (bisections of the sums: the first and last that may cross)
-            below = plane[8 + first] + float(abs(_near32(other[y, first] - a32)))
-            above = plane[8 + end] - float(abs(_near32(other[y, end] - a32)))
-            if below == below:  # start: the first interval i with sums[i + 1] >= below
-                top = end
-                while start < top:
-                    m = (start + top) >> 1
-                    if plane[9 + m] < below:
-                        start = m + 1
-                    else:
-                        top = m
-            if above == above:  # stop: the first interval i past start with sums[i] > above
-                stop, top = start, end
-                while stop < top:
-                    m = (stop + top) >> 1
-                    if plane[8 + m] <= above:
-                        stop = m + 1
-                    else:
-                        top = m
+    if skip:  # (one pass without branches, between the bounds of the sums)
+        a32, n = np.float32(a), 0
+        start, stop = crossing_bounds(plane[8:], first, end,
+                                      float(abs(_near32(other[y, first] - a32))),
+                                      float(abs(_near32(other[y, end] - a32))))
         after = abs(_near32(other[y, start] - a32))
         for j in range(start, stop):
             before = after
@@ -249,8 +224,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
     near = np.zeros((h, w), np.uint8)
     for y in prange(h):
         yr = (y - cy) / f
-        steps = np.empty(wr, np.float32)
-        index = np.empty(wr, np.int64)
+        steps, index = np.empty(wr, np.float32), np.empty(wr, np.int64)
         plane = np.zeros(8 + wr, np.float64)  # (plane[7]: 1 without distortion; sums)
         if plain:
             _row_plane(yr, -f * tx, back, kp, rp, tp, plane)
