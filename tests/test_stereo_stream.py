@@ -419,6 +419,38 @@ def test_the_fast_row_search_equals_the_plain_one(sim, monkeypatch):
     assert near > 10000
 
 
+def test_the_bounded_row_search_on_rough_rows():
+    """The fast search scans only the intervals between two bounds of the row's running
+    sums of phase steps (:mod:`~bistair.geometry.unwrap_stream_bounds_jit`, a NaN step
+    counted as 4): on rows of random steps (forwards and back, up to 2.5 rad), holes of NaN
+    and every phase a pixel may have, with the projector and depth tests wide open (every
+    crossing a candidate), it gives what the plain scan gives, bit for bit, narrow and full
+    searches, both grids."""
+    from bistair.geometry.unwrap_stream_jit import track_rows
+
+    rng = np.random.default_rng(7)
+    h, w = 60, 160
+    other = np.cumsum(rng.uniform(-0.8, 2.5, (h, w)), axis=1) % (2 * np.pi)
+    other[rng.random((h, w)) < 0.06] = np.nan
+    other[::7, 40:43] = np.nan  # (runs of holes)
+    own = rng.uniform(0, 2 * np.pi, (h, w))
+    own[rng.random((h, w)) < 0.05] = np.nan
+    previous = rng.uniform(2.0, 40.0, (h, w)).astype(np.float32)
+    previous[rng.random((h, w)) < 0.2] = np.nan
+    k = np.array([[100.0, 0, 5000], [0, 100, 0], [0, 0, 1]])
+    rig = (0.0, 100.0, 0.0, 0.0, -100.0, np.eye(3), k, np.zeros(5), np.eye(3),
+           np.array([-25.0, 0, 0]), 8.0, np.pi, 1.0, 1e6, 10000)
+    for side in (False, True):
+        out = [track_rows(own, other, previous, 6.0, 1.0, 40.0, *rig, from_right=side,
+                          skip=skip) for skip in (True, False)]
+        fast, slow = out
+        assert np.array_equal(fast[0], slow[0]) and np.array_equal(fast[2], slow[2])
+        assert np.array_equal(fast[1], slow[1], equal_nan=True)
+        read = np.arange(fast[3].shape[2]) < np.clip(fast[0], 0, None)[..., None]
+        assert np.array_equal(fast[3][read], slow[3][read])
+        assert fast[2].sum() > 1000 and np.sum(fast[0] >= 2) > 1000
+
+
 def test_every_window_leaves_mixed_pixels_undecided(sim, monkeypatch):
     """Every window, tracked or searched in full, leaves undecided the pixels
     :func:`~bistair.geometry.unwrap.mixed_pixels` finds in its depth (ramps across depth
