@@ -222,6 +222,45 @@ def test_a_twin_is_imported_only_by_its_face():
     assert not {n: h for n, h in offences.items() if _held(n, "twin imports")}
 
 
+#: What a compiled twin may import besides other twins and core/jit.py: the install's
+#: kernel build (app/kernels.py) imports the twins in an environment without scipy or
+#: OpenCV, so a twin that imports a face (which does) fails to build its kernels.
+TWIN_LIBRARIES = {"__future__", "math", "numpy", "numba", "typing", "dataclasses"}
+
+
+def twin_outside_imports(path: Path, root: Path = SRC) -> list[str]:
+    """The imports of a ``*_jit.py`` module (of the package at ``root``) that are neither a
+    twin, ``core/jit.py`` nor one of :data:`TWIN_LIBRARIES`."""
+    tree = ast.parse(path.read_text())
+    package = path.relative_to(root.parent).with_suffix("").parts[:-1]
+    found = []
+    for node in tree.body:
+        if isinstance(node, ast.Import):
+            found += [a.name for a in node.names if a.name.split(".")[0] not in TWIN_LIBRARIES]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level == 0:
+                if (node.module or "").split(".")[0] not in TWIN_LIBRARIES:
+                    found.append(node.module or "")
+                continue
+            base = list(package[:len(package) - node.level + 1])
+            target = ".".join(base + (node.module or "").split("."))
+            if not (target.endswith("_jit") or target == "bistair.core.jit"):
+                found.append(target)
+    return found
+
+
+def test_a_twin_imports_only_twins_and_numerical_libraries(tmp_path):
+    offences = {str(p.relative_to(SRC)): twin_outside_imports(p) for p in SRC.rglob("*_jit.py")}
+    assert len(offences) > 20
+    assert not {k: v for k, v in offences.items() if v}
+    planted = tmp_path / "bistair" / "geometry" / "planted_jit.py"
+    planted.parent.mkdir(parents=True)
+    planted.write_text("import numpy as np\nfrom .stereo import rectify\n"
+                       "from .stereo_jit import resample_wrapped\nimport cv2\n")
+    assert twin_outside_imports(planted, tmp_path / "bistair") == [
+        "bistair.geometry.stereo", "cv2"]
+
+
 def test_the_door_rules_catch_planted_violations(tmp_path):
     pkg = tmp_path / "bistair" / "core"
     pkg.mkdir(parents=True)

@@ -46,7 +46,7 @@ def type_name(numba_type: Any) -> str:
 
 def parse_type(text: str) -> Any:
     """A numba type from its name: arrays (``readonly array(float32, 2d, C)``), scalars,
-    ``UniTuple(T x N)`` and ``Tuple(T, ...)``."""
+    ``none`` (an argument given as None), ``UniTuple(T x N)`` and ``Tuple(T, ...)``."""
     found, rest = _parse(text.strip())
     if rest.strip():
         raise ValueError(f"cannot read the type {text!r}")
@@ -74,6 +74,8 @@ def _parse(text: str) -> tuple[Any, str]:
     match = re.match(r"[a-z][a-z0-9_]*", text)
     if match is None or readonly:
         raise ValueError(f"cannot read the type {text!r}")
+    if match.group(0) == "none":  # (an argument passed as None: a kernel's optional input)
+        return numba.types.none, text[match.end():]
     return numba.from_dtype(np.dtype(match.group(0))), text[match.end():]
 
 

@@ -46,7 +46,7 @@ import math
 import numpy as np
 
 from ..core.jit import inline, kernel
-from .stereo import resample_wrapped
+from .stereo_jit import resample_wrapped
 from .unwrap_jit import KEPT
 from .unwrap_stream_bounds_jit import crossing_bounds, running_sums
 
