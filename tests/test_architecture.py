@@ -226,11 +226,14 @@ def test_a_twin_is_imported_only_by_its_face():
 #: kernel build (app/kernels.py) imports the twins in an environment without scipy or
 #: OpenCV, so a twin that imports a face (which does) fails to build its kernels.
 TWIN_LIBRARIES = {"__future__", "math", "numpy", "numba", "typing", "dataclasses"}
+#: The package's modules a twin may import besides twins (the standard library and NumPy
+#: alone: the compile options and the memory the row bands fit in).
+TWIN_HELPERS = {"bistair.core.jit", "bistair.core.memory"}
 
 
 def twin_outside_imports(path: Path, root: Path = SRC) -> list[str]:
     """The imports of a ``*_jit.py`` module (of the package at ``root``) that are neither a
-    twin, ``core/jit.py`` nor one of :data:`TWIN_LIBRARIES`."""
+    twin, one of :data:`TWIN_HELPERS` nor one of :data:`TWIN_LIBRARIES`."""
     tree = ast.parse(path.read_text())
     package = path.relative_to(root.parent).with_suffix("").parts[:-1]
     found = []
@@ -244,7 +247,7 @@ def twin_outside_imports(path: Path, root: Path = SRC) -> list[str]:
                 continue
             base = list(package[:len(package) - node.level + 1])
             target = ".".join(base + (node.module or "").split("."))
-            if not (target.endswith("_jit") or target == "bistair.core.jit"):
+            if not (target.endswith("_jit") or target in TWIN_HELPERS):
                 found.append(target)
     return found
 
