@@ -2,7 +2,10 @@
 
 two-masks seen by the virtual rig's two cameras (640 x 480 each, 200 mm apart, the
 projector halfway), a four-step stream of period 48 (uint8 frames, default imaging: frame
-``i`` shows shift ``i mod 4``, each frame its own noise), depth range 520:650 mm. The
+``i`` shows shift ``i mod 4``, each frame its own noise), depth range 520:650 mm; still,
+and moving ``--motion`` mm a frame towards the cameras and back (a triangle wave over the
+``--frames`` frames, so that they repeat without a jump; 2 mm a frame moves a disparity
+about 1.3 px at 600 mm, 0.18 m/s at 90 frames a second). The
 steady state is timed: each new frame pair updates both cameras' sums, unwraps (the search
 near the previous disparity, the full range where that fails, the confirmations) and
 triangulates (the projector's column planes). Process CPU time, the minimum of interleaved
@@ -17,15 +20,18 @@ depth map serial), beside the wall time measured here and the load average: othe
 the cores lower the measured share and the rate. The row searches of one depth map (both
 grids, one thread) are timed again as they were before the fast path: every interval of a
 search tested and each candidate projected as the full search does (``track_rows(...,
-skip=False)``, the same result). The decided pixels an
-order off are counted against the renderer's truth after the timing.
+skip=False)``, the same result). The decided pixels an order off are counted against the
+renderer's truth after the timing (a moving window's truth: the mean of the true columns
+of the frames about its middle).
 
     python benchmarks/stereo_stream_speed.py [--camera 640x480] [--frames 24] [--rounds 5]
+        [--motion 2]
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import os
 import time
 from collections import defaultdict
@@ -41,9 +47,11 @@ from bistair.geometry import unwrap_stream
 from bistair.geometry.stereo_calibration import StereoCalibration
 from bistair.geometry.unwrap_stream import StereoStream
 from bistair.sim import Imaging, expose, preset, trace
+from bistair.sim.motion import parse_motion, trace_frames
 from bistair.sim.stereo import StereoRig
 
 RANGE = (520.0, 650.0)
+MOVING = ", moving"  # the moving scene's streams: "4, moving"
 WHOLE = "whole depth map"
 STAGES = {  # what each stage of a depth map calls (module or class, name)
     "running sums (PhaseStream)": [(PhaseStream, "update")],
@@ -57,21 +65,32 @@ STAGES = {  # what each stage of a depth map calls (module or class, name)
 }
 
 
-def scene_frames(width: int, height: int, count: int
+def scene_frames(width: int, height: int, count: int, motion: float = 0.0
                  ) -> tuple[StereoCalibration, object, np.ndarray, np.ndarray, np.ndarray]:
     """The calibration, the spec, ``count`` frames of each camera and the left camera's
-    true projector column (NaN where it sees no surface)."""
+    true projector column of each frame (NaN where it sees no surface). With ``motion``
+    (mm a frame towards the cameras), the masks move there and back: frame ``i`` shows them
+    at the time of a triangle wave of period ``count`` (``count`` a multiple of 4), so the
+    frames repeat without a jump and frame ``i`` still shows shift ``i mod 4``."""
     rig, scene = preset("two-masks", camera_size=(width, height))
     srig = StereoRig.default(camera_size=(width, height), projector_size=rig.projector.size)
     spec = make_spec("multifreq", width=rig.projector.size[0], height=rig.projector.size[1],
                      periods=(48,), steps=4)
     patterns = encode(spec)[np.arange(count) % 4]
+    times = [min(i, count - i) for i in range(count)]
+    moving = parse_motion(f"0,0,{-motion:g}mm")
     frames, columns = [], []
     for i, side in enumerate(("left", "right")):
         imaging = Imaging(seed=i)
-        traced = trace(srig.rig(side), scene, imaging)
-        frames.append(expose(traced, patterns, imaging))
-        columns.append(traced.truth.coord_x)
+        if motion:
+            traces = trace_frames(srig.rig(side), scene, moving, times, imaging)
+            frames.append(np.stack([expose(tr, patterns[k:k + 1], imaging, first_frame=k)[0]
+                                    for k, tr in enumerate(traces)]))
+            columns.append(np.stack([tr.truth.coord_x for tr in traces]))
+        else:
+            traced = trace(srig.rig(side), scene, imaging)
+            frames.append(expose(traced, patterns, imaging))
+            columns.append(np.broadcast_to(traced.truth.coord_x, (count, height, width)))
     return StereoCalibration.from_rig(srig), spec, frames[0], frames[1], columns[0]
 
 
@@ -176,35 +195,49 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--camera", default="640x480")
     parser.add_argument("--frames", type=int, default=24)
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--motion", type=float, default=2.0,
+                        help="mm a frame of the moving scene's masks (0: no moving scene)")
     args = parser.parse_args(argv)
     width, height = (int(v) for v in args.camera.lower().split("x"))
+    args.frames += -args.frames % 4
     cal, spec, left, right, truth = scene_frames(width, height, args.frames)
+    data = {"": (left, right, truth)}
+    if args.motion:
+        data[MOVING] = scene_frames(width, height, args.frames, args.motion)[2:]
     streams: dict[str, StereoStream] = {}
-    for window, order in (("4", 0), ("4+2", 2)):  # warm: the first window, the kernels
+    for window, order, scene in (("4", 0, ""), ("4+2", 2, ""), ("4", 0, MOVING),
+                                 ("4+2", 2, MOVING)):
+        if scene not in data:
+            continue
         stream = StereoStream(cal, spec, *RANGE, order=order)
-        for i in range(8):
-            stream.push(left[i], right[i])
-        streams[window] = stream
+        for i in range(8):  # warm: the first window, the kernels
+            stream.push(data[scene][0][i], data[scene][1][i])
+        streams[window + scene] = stream
     position = {name: 8 for name in streams}
     shares: dict[str, list[float]] = {name: [] for name in streams}
-    kept: dict[str, list[tuple[np.ndarray, np.ndarray]]] = {name: [] for name in streams}
+    kept: dict[str, list[tuple[np.ndarray, np.ndarray, np.ndarray]]] = {
+        name: [] for name in streams}
     image = left[0].astype(np.float32)
     maps = np.mgrid[:height, :width][::-1].astype(np.float32) + np.float32(0.3)
     four = left[:4]
 
     def push(name: str) -> None:
+        frames = data[MOVING if name.endswith(MOVING) else ""]
         i = position[name] % args.frames
         position[name] += 1
-        result = streams[name].push(left[i], right[i])
-        kept[name].append((result.phase, result.mask))
+        stream = streams[name]
+        result = stream.push(frames[0][i], frames[1][i])
+        centre = i - (stream.spec.steps + stream.order - 1) + stream.lag  # the window's time
+        seen = 0.5 * (frames[2][math.floor(centre) % args.frames]
+                      + frames[2][math.ceil(centre) % args.frames])
+        kept[name].append((result.phase, result.mask, seen))
         shares[name].append(result.info["decided_fraction"])
 
     tasks = {
         "cv2.remap 640x480 float32 (baseline)": lambda: cv2.remap(
             image, maps[0], maps[1], cv2.INTER_LINEAR),
         "numpy sum of 4 frames (baseline)": lambda: four.sum(axis=0, dtype=np.float32),
-        "depth map, --window 4": lambda: push("4"),
-        "depth map, --window 4+2": lambda: push("4+2"),
+        **{f"depth map, --window {name}": lambda name=name: push(name) for name in streams},
     }
     repeat = {name: 20 if "baseline" in name else 8 for name in tasks}
     best = {name: float("inf") for name in tasks}
@@ -216,7 +249,9 @@ def main(argv: list[str] | None = None) -> int:
             wall[name] = min(wall[name], (time.perf_counter() - clock) / repeat[name])
     base = best["cv2.remap 640x480 float32 (baseline)"]
     print(f"# two-masks {width}x{height}, both cameras, 4 steps, period 48, "
-          f"{RANGE[0]:g}:{RANGE[1]:g} mm; min of {args.rounds} interleaved rounds; "
+          f"{RANGE[0]:g}:{RANGE[1]:g} mm"
+          + (f" (moving: {args.motion:g} mm a frame towards the cameras and back)"
+             if args.motion else "") + f"; min of {args.rounds} interleaved rounds; "
           f"{numba.get_num_threads()} numba threads; load average "
           f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print("| per depth map | CPU ms | / remap | maps/s (CPU) | wall ms | maps/s (wall) |")
@@ -226,7 +261,11 @@ def main(argv: list[str] | None = None) -> int:
               f"{1 / best[name]:.0f} | {1000 * wall[name]:.2f} | {1 / wall[name]:.0f} |")
     cores = max(numba.get_num_threads(), 2)
     for name, stream in streams.items():
-        split = parallel_split(stream, left, right, position[name], args.frames, cores)
+        if name == "4+2" + MOVING:  # (its stages: as 4+2's and the moving 4's)
+            continue
+        frames = data[MOVING if name.endswith(MOVING) else ""]
+        split = parallel_split(stream, frames[0], frames[1], position[name], args.frames,
+                               cores)
         position[name] += 2 * args.frames
         work = split.pop(WHOLE)
         print(f"\n| --window {name}: stage (both cameras) | work ms (1 thread) | CPU ms "
@@ -255,8 +294,8 @@ def main(argv: list[str] | None = None) -> int:
     print()
     off = {name: [0, 0] for name in streams}
     for name, results in kept.items():  # (after the timing)
-        for phase, mask in results:
-            error = np.abs(phase - 2 * np.pi * truth / 48)[mask]
+        for phase, mask, seen in results:
+            error = np.abs(phase - 2 * np.pi * seen / 48)[mask]
             off[name][0] += int(np.sum(error[np.isfinite(error)] > np.pi))  # an order off
             off[name][1] += int(mask.sum())
     for name, values in shares.items():
