@@ -9,7 +9,9 @@ steps' sum from ``first`` to ``i + 1`` away from ``o_first`` and at most the sum
 to ``end`` away from ``o_end`` (the phase distance on the circle obeys the triangle
 inequality; a NaN step counts as 4, more than any phase distance). The sums of float32
 steps are exact in float64, the slack of each step covers the float32 rounding of the
-distances: the bounds keep every interval the float32 pass keeps.
+distances: the bounds keep every interval the float32 pass keeps. A long search (more
+than :data:`LONG` intervals) skips the bounds and keeps its intervals from the distances
+of a pass of their own (:func:`kept_intervals`).
 
 Examples
 --------
@@ -29,6 +31,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..core.jit import inline
+
+#: A search of more intervals than this is not bounded: its distances, then their test.
+LONG = 24
 
 
 @inline
@@ -107,3 +112,40 @@ def crossing_bounds(sums: np.ndarray, first: int, end: int, near_first: float,
         else:
             top = m
     return start, stop
+
+
+@inline
+def kept_intervals(dist: np.ndarray, steps: np.ndarray, first: int, index: np.ndarray) -> int:
+    """The intervals of a search whose ends' phase distances to a pixel's phase add up to
+    at most the phase step between them, in order.
+
+    Parameters
+    ----------
+    dist : numpy.ndarray
+        float32 phase distances of the search's columns to the phase (one more than
+        ``steps``).
+    steps : numpy.ndarray
+        float32 phase steps of the search's intervals.
+    first : int
+        The search's first column.
+    index : numpy.ndarray
+        int64, longer than ``steps``: the kept intervals' first columns are written first.
+
+    Returns
+    -------
+    int
+        The kept intervals.
+
+    Examples
+    --------
+    >>> index = np.empty(4, np.int64)
+    >>> dist, steps = np.float32([0.5, 0.2, 0.3, 1.0]), np.float32([0.75, 0.75, 0.75])
+    >>> kept_intervals(dist, steps, 10, index), index[:2].tolist()
+    (2, [10, 11])
+    """
+    n = 0
+    for i in range(steps.shape[0]):
+        if dist[i] + dist[i + 1] <= steps[i]:
+            index[n] = first + i
+            n += 1
+    return n

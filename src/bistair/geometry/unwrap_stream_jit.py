@@ -15,7 +15,11 @@ most the step (about one a pixel in a search 12 px wide, against 13); only those
 tested as before, in float64: the same candidates in the same order. Fewer are scanned:
 the phase moves at most a step an interval, so two bisections of the row's running sums of
 steps bound the intervals where a crossing may lie (:mod:`.unwrap_stream_bounds_jit`): 1.3
-of the 13 of a narrow search on average (two-masks at 640 x 480). The candidate's
+of the 13 of a narrow search on average (two-masks at 640 x 480). A search of more than
+``LONG`` intervals (the full range: ~92 at the benchmark's rig) is not bounded (the bounds
+cut little there; the bisections cost more than they save) and splits its pass in two: the
+distances in a loop that vectorises, then the test of their sums (the same float32
+expressions: the same intervals). The candidate's
 projector column comes, without distortion, from coefficients of the row linear in the
 pixel and the disparity (:func:`_row_plane`: one division, the full search's four): the
 same test to rounding (``unwrap_rows``' decisions, bit for bit, on the test stream).
@@ -48,7 +52,7 @@ import numpy as np
 from ..core.jit import inline, kernel
 from .stereo_jit import resample_wrapped
 from .unwrap_jit import KEPT
-from .unwrap_stream_bounds_jit import crossing_bounds, running_sums
+from .unwrap_stream_bounds_jit import LONG, crossing_bounds, kept_intervals, running_sums
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
@@ -101,14 +105,21 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
     most the step between them (``steps``: :func:`_steps`) are tested, and only those
     between the two bounds of the steps' sums (``plane[8:]``: :func:`_steps`' ``sums``):
     a crossing needs both (the module's docstring); the same candidates, in the same
-    order. ``plane[:8]``: :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector
-    is distorted)."""
+    order; a search of more than ``LONG`` intervals tests its distances (kept in ``steps``'
+    second half) in a pass of their own, unbounded (the module's docstring). ``plane[:8]``:
+    :func:`_row_plane`'s coefficients (``plane[7]`` 0: the projector is distorted)."""
     count = 0
     found = math.nan
     first = max(j0, 0)
     end = min(j1, other.shape[1] - 1)
     n = end - first
-    if skip:  # (one pass without branches, between the bounds of the sums)
+    if skip and n > LONG:  # (a pass of distances that vectorises, then the test; unbounded)
+        dist = steps[other.shape[1]:other.shape[1] + n + 1]
+        row, a32 = other[y, first:end + 1], np.float32(a)
+        for i in range(n + 1):
+            dist[i] = abs(_near32(row[i] - a32))
+        n = kept_intervals(dist, steps[first:end], first, index)
+    elif skip:  # (one pass without branches, between the bounds of the sums)
         a32, n = np.float32(a), 0
         start, stop = crossing_bounds(plane[8:], first, end,
                                       float(abs(_near32(other[y, first] - a32))),
@@ -224,7 +235,7 @@ def _track(own: np.ndarray, other: np.ndarray, previous: np.ndarray, margin: flo
     near = np.zeros((h, w), np.uint8)
     for y in prange(h):
         yr = (y - cy) / f
-        steps, index = np.empty(wr, np.float32), np.empty(wr, np.int64)
+        steps, index = np.empty(2 * wr, np.float32), np.empty(wr, np.int64)  # (steps, scratch)
         plane = np.zeros(8 + wr, np.float64)  # (plane[7]: 1 without distortion; sums)
         if plain:
             _row_plane(yr, -f * tx, back, kp, rp, tp, plane)
