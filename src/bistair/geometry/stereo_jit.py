@@ -103,9 +103,24 @@ _PI32, _TWO_PI32 = np.float32(math.pi), np.float32(2.0 * math.pi)
 
 
 @inline
-def _near32(d: np.float32) -> np.float32:
+def near32(d: np.float32) -> np.float32:
     """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (float32,
-    by selects)."""
+    by selects, so that its loops vectorise; also the stream's row search's).
+
+    Parameters
+    ----------
+    d : numpy.float32
+        The difference, in ``(-2*pi, 2*pi)``.
+
+    Returns
+    -------
+    numpy.float32
+
+    Examples
+    --------
+    >>> round(float(near32(np.float32(6.0))), 4), round(float(near32(np.float32(-0.5))), 4)
+    (-0.2832, -0.5)
+    """
     e = d - _TWO_PI32 if d >= _PI32 else d
     return e + _TWO_PI32 if d < -_PI32 else e
 
@@ -144,7 +159,7 @@ def _edge_sample(phase: np.ndarray, sx: np.float32, sy: np.float32) -> np.float3
         if p != p:
             continue
         if last == last:
-            at = at + _near32(p - last)
+            at = at + near32(p - last)
         else:
             first = p
         last = p
@@ -184,9 +199,9 @@ def _resample(phi: np.ndarray, mod: np.ndarray, threshold: float, map_x: np.ndar
                 fx, fy = sx - np.float32(x0), sy - np.float32(y0)
                 gx, gy = np.float32(1.0) - fx, np.float32(1.0) - fy
                 if p00 == p00 and p01 == p01 and p11 == p11 and p10 == p10:
-                    u01 = _near32(p01 - p00)  # (around the square, as _edge_sample)
-                    u11 = u01 + _near32(p11 - p01)
-                    u10 = u11 + _near32(p10 - p11)
+                    u01 = near32(p01 - p00)  # (around the square, as _edge_sample)
+                    u11 = u01 + near32(p11 - p01)
+                    u10 = u11 + near32(p10 - p11)
                     v = _wrap32(p00 + (fx * gy * u01 + fx * fy * u11 + gx * fy * u10))
                 elif ((p00 == p00) * gx * gy + (p01 == p01) * fx * gy + (p11 == p11) * fx * fy
                       + (p10 == p10) * gx * fy) < KNOWN_WEIGHT:

@@ -48,9 +48,24 @@ def _wrapped(angle: float) -> float:
 
 
 @inline
-def _near(difference: float) -> float:
+def near(difference: float) -> float:
     """The difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)`` (NaN
-    stays NaN)."""
+    stays NaN; also the stream's row search's).
+
+    Parameters
+    ----------
+    difference : float
+        In ``(-2*pi, 2*pi)``.
+
+    Returns
+    -------
+    float
+
+    Examples
+    --------
+    >>> round(near(6.0), 4), near(-0.5), math.isnan(near(math.nan))
+    (-0.2832, -0.5, True)
+    """
     if difference >= math.pi:
         return difference - TWO_PI
     if difference < -math.pi:
@@ -130,10 +145,10 @@ def _unwrap(left: np.ndarray, right: np.ndarray, lo: float, hi: float, shift: fl
                 continue
             best = math.inf
             first = max(j0, 0)
-            e1 = _near(float(right[y, first]) - a)  # NaN where unknown
+            e1 = near(float(right[y, first]) - a)  # NaN where unknown
             for j in range(first, min(j1, wr - 1)):
                 e0 = e1
-                e1 = _near(float(right[y, j + 1]) - a)
+                e1 = near(float(right[y, j + 1]) - a)
                 # a crossing of a (not a wrap, where the difference jumps by 2 pi)
                 if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
                     continue  # (also when either is NaN)

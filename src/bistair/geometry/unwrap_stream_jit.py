@@ -50,42 +50,24 @@ import math
 import numpy as np
 
 from ..core.jit import inline, kernel
-from .stereo_jit import resample_wrapped
-from .unwrap_jit import KEPT
+from .stereo_jit import near32, resample_wrapped
+from .unwrap_jit import KEPT, near
 from .unwrap_stream_bounds_jit import LONG, crossing_bounds, kept_intervals, running_sums
 
 prange = range  # numba's prange once the first kernel of this module compiles
 TWO_PI = 2.0 * math.pi
 INV_TWO_PI = 1.0 / TWO_PI
-PI32, TWO_PI32 = np.float32(math.pi), np.float32(TWO_PI)
 #: What the skip leaves for rounding (radians; float32's own is below 1e-6).
 SLACK = np.float32(1e-4)
 
 
 @inline
-def _near(difference: float) -> float:
-    """A difference of two phases in ``[0, 2*pi)`` wrapped into ``[-pi, pi)``."""
-    if difference >= math.pi:
-        return difference - TWO_PI
-    if difference < -math.pi:
-        return difference + TWO_PI
-    return difference
-
-
-@inline
-def _near32(difference: np.float32) -> np.float32:
-    """:func:`_near` in float32, by selects (so that its loops vectorise)."""
-    d = difference - TWO_PI32 if difference >= PI32 else difference
-    return d + TWO_PI32 if difference < -PI32 else d
-
-
-@inline
 def _steps(other: np.ndarray, y: int, steps: np.ndarray, sums: np.ndarray) -> None:
     """``steps[j]``: the phase step from column ``j`` to ``j + 1`` of ``other``'s row ``y``
-    (``|_near|`` of their difference, in float32) plus :data:`SLACK`; NaN beside a NaN.
+    (``|near32|`` of their difference) plus :data:`SLACK`; NaN beside a NaN.
     ``sums``: their running sums (:func:`~.unwrap_stream_bounds_jit.running_sums`)."""
     for j in range(other.shape[1] - 1):
-        steps[j] = abs(_near32(other[y, j + 1] - other[y, j])) + SLACK
+        steps[j] = abs(near32(other[y, j + 1] - other[y, j])) + SLACK
     running_sums(steps, other.shape[1] - 1, sums)
 
 
@@ -117,30 +99,30 @@ def _scan(own: np.ndarray, other: np.ndarray, steps: np.ndarray, index: np.ndarr
         dist = steps[other.shape[1]:other.shape[1] + n + 1]
         row, a32 = other[y, first:end + 1], np.float32(a)
         for i in range(n + 1):
-            dist[i] = abs(_near32(row[i] - a32))
+            dist[i] = abs(near32(row[i] - a32))
         n = kept_intervals(dist, steps[first:end], first, index)
     elif skip:  # (one pass without branches, between the bounds of the sums)
         a32, n = np.float32(a), 0
         start, stop = crossing_bounds(plane[8:], first, end,
-                                      float(abs(_near32(other[y, first] - a32))),
-                                      float(abs(_near32(other[y, end] - a32))))
-        after = abs(_near32(other[y, start] - a32))
+                                      float(abs(near32(other[y, first] - a32))),
+                                      float(abs(near32(other[y, end] - a32))))
+        after = abs(near32(other[y, start] - a32))
         for j in range(start, stop):
             before = after
-            after = abs(_near32(other[y, j + 1] - a32))
+            after = abs(near32(other[y, j + 1] - a32))
             index[n] = j
             n += before + after <= steps[j]
     k = -f * tx  # the depth times the disparity
     inv_f, per_column = 1.0 / f, TWO_PI / period
-    e1 = _near(float(other[y, first]) - a)
+    e1 = near(float(other[y, first]) - a)
     for q in range(n):
         if skip:
             j = index[q]
-            e0 = _near(float(other[y, j]) - a)
+            e0 = near(float(other[y, j]) - a)
         else:  # (every interval: the last one's end)
             j = first + q
             e0 = e1
-        e1 = _near(float(other[y, j + 1]) - a)
+        e1 = near(float(other[y, j + 1]) - a)
         if not ((e0 <= 0.0 < e1) or (e1 <= 0.0 < e0)) or abs(e1 - e0) > math.pi:
             continue
         xs = j + e0 / (e0 - e1)
