@@ -55,7 +55,7 @@ MOVING = ", moving"  # the moving scene's streams: "4, moving"
 WHOLE = "whole depth map"
 STAGES = {  # what each stage of a depth map calls (module or class, name)
     "running sums (PhaseStream)": [(PhaseStream, "update")],
-    "resampling (rectify_pair)": [(unwrap_stream, "rectify_pair")],
+    "resampling (resample_wrapped)": [(unwrap_stream, "resample_wrapped")],
     "row searches (track_rows)": [(unwrap_stream, "track_rows")],
     "confirmation (confirm)": [(unwrap_stream, "confirm")],
     "growth (grow)": [(unwrap_stream, "grow")],

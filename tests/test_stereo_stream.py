@@ -331,13 +331,14 @@ def test_resampling_against_the_truth():
             assert _wrapped_error(rectified_phase_cv2(phase, maps), want)[ok].max() > 0.1
 
 
-def test_rectify_pair_and_rectified_phase_are_one_door():
-    """The stream's resampling (``rectify_pair``: the threshold and the resampling in one
-    pass, into reused buffers) gives what the one-set path gives (``np.where`` of the
-    threshold, then ``rectified_phase``), bit for bit, on both grids: the first window
-    and the later ones read the same numbers; every phase in [0, 2*pi)."""
+def test_the_stream_resampling_and_rectified_phase_are_one_door():
+    """The stream's resampling (``resample_wrapped`` with a modulation: the threshold and
+    the resampling in one pass, into reused buffers) gives what the one-set path gives
+    (``np.where`` of the threshold, then ``rectified_phase``), bit for bit, on both
+    grids: the first window and the later ones read the same numbers; every phase in [0,
+    2*pi)."""
+    from bistair.geometry.stereo import resample_wrapped
     from bistair.geometry.unwrap import rectified_phase
-    from bistair.geometry.unwrap_stream_jit import rectify_pair
 
     rect = _crooked_rig()
     rng = np.random.default_rng(4)
@@ -347,7 +348,7 @@ def test_rectify_pair_and_rectified_phase_are_one_door():
             phi, mod = _random_phase(rng, SIZE[::-1])
             want_phase = np.where(mod >= 0.3, phi, np.float32(np.nan)).astype(np.float32)
             want = rectified_phase(want_phase, maps)
-            phase, got, valid = rectify_pair(phi, mod, 0.3, maps, buffers)
+            phase, got, valid = resample_wrapped(phi, maps, mod, 0.3, buffers)
             assert valid == int(np.sum(mod >= 0.3))
             assert np.array_equal(phase, want_phase, equal_nan=True)
             assert np.array_equal(got, want, equal_nan=True)

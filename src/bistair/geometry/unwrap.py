@@ -183,7 +183,7 @@ def rectified_phase(phase: np.ndarray, maps: tuple[np.ndarray, np.ndarray]) -> n
     """A wrapped phase map resampled onto a rectified grid (float32, ``[0, 2*pi)``, NaN
     where the known pixels around the sample carry less than 0.999 of its bilinear weight):
     :func:`~bistair.geometry.stereo_jit.resample_wrapped`, as a stream resamples each
-    window (:func:`~.unwrap_stream_jit.rectify_pair`).
+    window (with its modulation threshold).
 
     Parameters
     ----------

@@ -7,10 +7,9 @@ multiply-adds a pixel; order ``K`` compensates motion). For each window:
 
 1. The wrapped phases (NaN below the modulation threshold measured on the first ``N``
    frames) are resampled onto the rectified grids in one compiled pass a camera, on every
-   core (:func:`~.unwrap_stream_jit.rectify_pair`: the threshold and
-   :func:`~bistair.geometry.stereo_jit.resample_wrapped`, the resampler of
-   :func:`~bistair.geometry.unwrap.rectified_phase`, so the first window and the later
-   ones read the same numbers; no trigonometry).
+   core (:func:`~bistair.geometry.stereo_jit.resample_wrapped`: the threshold and the
+   resampler of :func:`~bistair.geometry.unwrap.rectified_phase`, so the first window and
+   the later ones read the same numbers; no trigonometry).
 2. The first window is unwrapped by :func:`~bistair.geometry.unwrap.unwrap_stereo`, as the
    one-set ``stereo`` command does, its depth range checked. Each later window searches
    each pixel of both rectified grids only within :data:`MARGIN` pixels of its single
@@ -81,7 +80,7 @@ from ..core.motion import PhaseStream
 from ..errors import BistairError
 from .calibration import StereoCalibration
 from .projection_matrices import with_pixel_origin
-from .stereo import Rectification, rectify
+from .stereo import Rectification, rectify, resample_wrapped
 from .unwrap import (
     EDGE,
     GROW_SUPPORT,
@@ -100,7 +99,6 @@ from .unwrap_stream_jit import (
     match_targets,
     plane_depth,
     projector_pixels,
-    rectify_pair,
     track_rows,
     window_counts,
 )
@@ -212,7 +210,7 @@ class StereoStream:
         self.mixed_terms = mixed_terms(cal, rect.rays)  # (mixed_pixels' per pixel)
         # plane_depth reads the projector rows only through distortion or skew
         self.rows = bool(np.any(proj.device.dist) or proj.device.K[0, 1] != 0.0)
-        self.buffers: list[dict] = [{}, {}]  # rectify_pair's
+        self.buffers: list[dict] = [{}, {}]  # resample_wrapped's
 
     @property
     def lag(self) -> float:
@@ -256,7 +254,7 @@ class StereoStream:
             return None
         assert self.thresholds is not None
         states = [s.state for s in self.streams]
-        rectified = [rectify_pair(st.phase, st.mod, t, table, buffers)
+        rectified = [resample_wrapped(st.phase, table, st.mod, t, buffers)
                      for st, t, table, buffers in zip(
                          states, self.thresholds, (self.rect.maps_left, self.rect.maps_right),
                          self.buffers, strict=True)]
@@ -289,7 +287,7 @@ class StereoStream:
                 right: tuple[np.ndarray, np.ndarray, int], start: int) -> StreamDepth:
         """One window's depth from the two wrapped phases (each camera's, NaN where not
         modulated, on its own grid and on its rectified grid, and its count of valid
-        pixels: :func:`~.unwrap_stream_jit.rectify_pair`)."""
+        pixels: :func:`~bistair.geometry.stereo_jit.resample_wrapped`)."""
         rect = self.rect
         (lphase, lrect, valid), (rphase, rrect, _) = left, right
         info: dict[str, Any]

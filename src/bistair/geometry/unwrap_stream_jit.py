@@ -50,7 +50,7 @@ import math
 import numpy as np
 
 from ..core.jit import inline, kernel
-from .stereo_jit import near32, resample_wrapped
+from .stereo_jit import near32
 from .unwrap_jit import KEPT, near
 from .unwrap_stream_bounds_jit import LONG, crossing_bounds, kept_intervals, running_sums
 
@@ -711,48 +711,6 @@ def confirm(disparity: np.ndarray, n_in: np.ndarray, valid: np.ndarray, right: n
                                        np.ascontiguousarray(right, np.float32), float(shift),
                                        float(support), int(edge))
     return out, blocked, int(nc.sum()), int(un.sum())
-
-
-def rectify_pair(phi: np.ndarray, mod: np.ndarray, threshold: float,
-                 maps: tuple[np.ndarray, np.ndarray], buffers: dict | None = None
-                 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """A camera's wrapped phase, NaN where its modulation is below ``threshold``, and that
-    phase resampled onto its rectified grid, in one compiled pass over each grid, into
-    reused buffers: :func:`~bistair.geometry.stereo_jit.resample_wrapped`, the resampler
-    of :func:`~bistair.geometry.unwrap.rectified_phase` too (the first window and the later
-    ones read the same numbers).
-
-    Parameters
-    ----------
-    phi, mod : numpy.ndarray
-        ``(H, W)`` float32 wrapped phase and modulation.
-    threshold : float
-        The modulation a valid pixel needs.
-    maps : tuple of numpy.ndarray
-        The rectified grid's remap tables (rectified pixel -> camera pixel).
-    buffers : dict, optional
-        Arrays to reuse from one call to the next (an empty dict at first; the results
-        are among them: the next call overwrites them).
-
-    Returns
-    -------
-    phase : numpy.ndarray
-        ``(H, W)`` float32 the phase, NaN below the threshold.
-    rectified : numpy.ndarray
-        The phase on the rectified grid, in ``[0, 2*pi)``, NaN where unknown.
-    valid : int
-        The pixels of known phase.
-
-    Examples
-    --------
-    >>> phi = np.float32([[6.2, 0.1, 3.0]])
-    >>> mod = np.float32([[1.0, 1.0, 0.0]])
-    >>> maps = (np.float32([[0.5, 1.5]]), np.float32([[0.0, 0.0]]))
-    >>> phase, rect, n = rectify_pair(phi, mod, 0.5, maps)
-    >>> round(float(rect[0, 0]), 4), bool(np.isnan(rect[0, 1])), n
-    (0.0084, True, 2)
-    """
-    return resample_wrapped(phi, maps, mod, threshold, buffers)
 
 
 @kernel(parallel=True)
